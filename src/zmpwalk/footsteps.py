@@ -1,0 +1,223 @@
+"""Step commands to foot placements: which foot swings, where it lands.
+
+Each command becomes one or more *stages*; a stage is one swing of one foot
+lasting the command's ``duration`` (the paper's step, from ``t1`` to ``t2``).
+A forward step is one stage; a side or turn step is two (open stance with the
+leading foot, then recovery with the other). The feet alternate; when a side
+or turn step would have to start with the wrong foot, one plain stage with the
+same step time and stride is inserted first, and the stage says so.
+
+Landing rule (top view, Fig. 19 generalised): the swinging foot ``s`` lands
+relative to the supporting foot ``o`` at
+
+.. math::
+    p_s = p_o + R(\\psi_o) \\left[ (0, \\sigma w/2) + R(\\Delta\\psi)(f, \\sigma (w/2 + a)) \\right],
+    \\quad \\psi_s = \\psi_o + \\Delta\\psi
+
+with ``sigma = +1`` for the left foot, ``w`` the ready-posture ankle spacing,
+``f`` the stride, ``a`` the side opening and ``Delta psi`` the turn. A turn
+thus rotates the feet about the middle of the stance, not about one ankle.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from zmpwalk.commands import StepCommand
+from zmpwalk.errors import InvalidParameterError
+from zmpwalk.robots.model import RobotModel
+from zmpwalk.schedule import Schedule, ShapeParameters
+
+LEFT = 1
+RIGHT = -1
+
+
+@dataclass(frozen=True)
+class Pose2D:
+    """A foot's pose on the ground: ankle position and yaw in world [m, m, rad]."""
+
+    x: float  # [m]
+    y: float  # [m]
+    yaw: float  # [rad], unwrapped (continuous over the walk)
+
+    def compose(self, forward: float, left: float, dyaw: float = 0.0) -> Pose2D:
+        """The pose ``(forward, left)`` ahead in this pose's frame, rotated by ``dyaw``."""
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        return Pose2D(self.x + c * forward - s * left, self.y + s * forward + c * left, self.yaw + dyaw)
+
+
+@dataclass(frozen=True)
+class StagePlan:
+    """Where one swing goes: the output of the footstep planner for one stage.
+
+    Attributes:
+        swing: ``LEFT`` (+1) or ``RIGHT`` (-1), the foot that swings.
+        support_pose: Pose of the supporting foot (fixed during the stage).
+        swing_start: Pose of the swinging foot at the stage start.
+        swing_end: Landing pose of the swinging foot.
+        forward: The stride ``f`` of this swing [m].
+        duration: Step time ``T`` [s].
+        parameters: Shape factors and parameters of this stage.
+        stop: True if the robot comes to rest at the end of the stage.
+        kind: ``"step"``, ``"open"``, ``"recovery"``, ``"inserted"``, ``"stop"`` (the
+            closing swing), or, with both feet down, ``"start"`` and ``"settle"``.
+    """
+
+    swing: int
+    support_pose: Pose2D
+    swing_start: Pose2D
+    swing_end: Pose2D
+    forward: float  # [m]
+    duration: float  # [s]
+    parameters: ShapeParameters
+    stop: bool
+    kind: str
+
+
+@dataclass(frozen=True)
+class Stance:
+    """Both feet on the ground between stages, and which foot swings next (0 = either)."""
+
+    left: Pose2D
+    right: Pose2D
+    next_swing: int = 0
+
+    @classmethod
+    def ready(cls, robot: RobotModel) -> Stance:
+        """The ready posture at the world origin, facing +x."""
+        half = robot.hip_spacing / 2
+        return cls(Pose2D(0.0, half, 0.0), Pose2D(0.0, -half, 0.0), 0)
+
+    def pose(self, foot: int) -> Pose2D:
+        return self.left if foot == LEFT else self.right
+
+    def with_foot(self, foot: int, pose: Pose2D) -> Stance:
+        if foot == LEFT:
+            return Stance(pose, self.right, RIGHT)
+        return Stance(self.left, pose, LEFT)
+
+
+def landing_pose(support: Pose2D, swing: int, spacing: float, forward: float, opening: float,
+                 dyaw: float) -> Pose2D:
+    """Landing pose of the swinging foot by the rule of the module docstring."""
+    middle = support.compose(0.0, swing * spacing / 2)
+    return Pose2D(middle.x, middle.y, support.yaw + dyaw).compose(forward, swing * (spacing / 2 + opening))
+
+
+def plan_command(
+    stance: Stance, command: StepCommand, robot: RobotModel, schedule: Schedule
+) -> tuple[list[StagePlan], Stance]:
+    """Stages of one command from a stance, and the stance after them.
+
+    Raises:
+        InvalidParameterError: The command would make the feet overlap, or its
+            double support does not fit in its step time.
+    """
+    first, second = schedule.stage_parameters(command, robot)
+    if first.dsp_time >= command.duration:
+        raise InvalidParameterError(
+            "duration", command.duration,
+            f"a step time longer than the double-support time d = {first.dsp_time:g} s",
+        )
+    spacing = robot.hip_spacing
+    stages: list[StagePlan] = []
+    if command.stop:
+        swing = stance.next_swing or LEFT
+        stages.append(_stage(stance, swing, spacing, 0.0, 0.0, 0.0, command, first, "stop"))
+        landed = _after(stance, stages)
+        stages.append(grounded_stage(landed, swing, command.duration, first, "settle"))
+    elif not command.is_two_stage:
+        swing = stance.next_swing or LEFT
+        stages.append(_stage(stance, swing, spacing, command.forward, 0.0, 0.0, command, first, "step"))
+    else:
+        leading = command.leading_side
+        if stance.next_swing not in (0, leading):
+            plain = replace(command, side=0.0, turn=0.0)
+            plain_parameters, _ = schedule.stage_parameters(plain, robot)
+            stages.append(
+                _stage(stance, -leading, spacing, command.forward, 0.0, 0.0, command, plain_parameters,
+                       "inserted")
+            )
+        current = _after(stance, stages)
+        stages.append(
+            _stage(current, leading, spacing, command.forward, abs(command.side), command.turn, command, first,
+                   "open")
+        )
+        current = _after(stance, stages)
+        stages.append(_stage(current, -leading, spacing, command.forward, 0.0, 0.0, command, second, "recovery"))
+    for stage in stages:
+        if stage.kind != "settle":
+            _check_clearance(stage, robot, command)
+    return stages, _after(stance, stages)
+
+
+GROUNDED_STRETCH = 1.0  # start/settle: the sway cubic to or from rest lasts this many step times
+
+
+def grounded_stage(stance: Stance, support: int, step_time: float, parameters: ShapeParameters,
+                   kind: str) -> StagePlan:
+    """A stage with both feet down in which the pelvis sways towards ``support`` and back.
+
+    ``"start"`` begins a walk from standstill; ``"settle"`` ends one (the robot
+    comes to rest in the middle of the feet). It lasts
+    ``(GROUNDED_STRETCH + (1 - d1) / 2) * step_time``: one slow sway cubic to or
+    from rest and one regular cubic (see :func:`zmpwalk.patterns.polynomial.sway_times`).
+    """
+    still = stance.pose(-support)
+    duration = (GROUNDED_STRETCH + (1.0 - parameters.d1) / 2.0) * step_time
+    return StagePlan(-support, stance.pose(support), still, still, 0.0, duration, parameters,
+                     kind == "settle", kind)
+
+
+
+def _after(stance: Stance, stages: list[StagePlan]) -> Stance:
+    for stage in stages:
+        stance = stance.with_foot(stage.swing, stage.swing_end)
+    return stance
+
+
+def _stage(
+    stance: Stance, swing: int, spacing: float, forward: float, opening: float, dyaw: float,
+    command: StepCommand, parameters: ShapeParameters, kind: str, stop: bool = False,
+) -> StagePlan:
+    support = stance.pose(-swing)
+    end = landing_pose(support, swing, spacing, forward, opening, dyaw)
+    return StagePlan(swing, support, stance.pose(swing), end, forward, command.duration, parameters, stop, kind)
+
+
+def foot_corners(pose: Pose2D, foot: int, robot: RobotModel) -> np.ndarray:
+    """Sole corners of a foot in world, counter-clockwise, shape (4, 2) [m]."""
+    half_l, half_w = robot.foot_length / 2, robot.foot_width / 2
+    cx, cy = robot.sole_center_x, foot * robot.sole_center_y
+    local = np.array([[cx - half_l, cy - half_w], [cx + half_l, cy - half_w],
+                      [cx + half_l, cy + half_w], [cx - half_l, cy + half_w]])
+    c, s = math.cos(pose.yaw), math.sin(pose.yaw)
+    return local @ np.array([[c, s], [-s, c]]) + np.array([pose.x, pose.y])
+
+
+def _rectangles_overlap(a: np.ndarray, b: np.ndarray) -> bool:
+    """Separating-axis test for two convex quadrilaterals."""
+    for polygon in (a, b):
+        for i in range(4):
+            edge = polygon[(i + 1) % 4] - polygon[i]
+            axis = np.array([-edge[1], edge[0]])
+            pa, pb = a @ axis, b @ axis
+            if pa.max() < pb.min() or pb.max() < pa.min():
+                return False
+    return True
+
+
+def _check_clearance(stage: StagePlan, robot: RobotModel, command: StepCommand) -> None:
+    """Reject a landing that puts one sole on top of the other."""
+    swing = foot_corners(stage.swing_end, stage.swing, robot)
+    support = foot_corners(stage.support_pose, -stage.swing, robot)
+    if _rectangles_overlap(swing, support):
+        name = "turn" if command.turn != 0 else ("side" if command.side != 0 else "forward")
+        value = getattr(command, name)
+        raise InvalidParameterError(
+            name, value, "a step whose landing foot does not overlap the supporting foot "
+            f"(the {('left' if stage.swing == LEFT else 'right')} sole would land on the other one)",
+        )

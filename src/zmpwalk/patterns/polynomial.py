@@ -1,0 +1,534 @@
+"""The online walking pattern of KHR-3 (HUBO): Park, Kim and Oh (2008), Section 3.
+
+One *stage* is one swing of one foot from ``t1`` to ``t2 = t1 + T``. All its
+trajectories are fixed at the stage start from boundary conditions, so the
+next stage's parameters (step time, stride, mode) can change freely:
+
+* **Pelvis, sagittal** (Eqs. 12-13): a cubic in normalised time from the
+  middle of the ankles at ``t1`` to the middle at ``t2``. The end velocity is
+  ``alpha f`` per unit normalised time (``alpha f / T`` in m/s). The start
+  velocity is the previous stage's end velocity, which is the paper's
+  ``alpha b`` when step time and ``alpha`` stay the same, and keeps the velocity
+  continuous when they change.
+* **Pelvis, lateral sway** (Eqs. 18-20): two cubics on the modified time
+  ``t_bar`` with staying ratio ``d1``: from the ankles' middle towards the
+  supporting foot by ``beta1 S_y`` and back. ``V_y`` is a slope per unit of
+  each cubic's own normalised time ``2 t_bar`` (Fig. 16: ``V_y = 100`` mm with
+  ``S_y = 40`` mm: the range ``1.5 S_y < alpha1 V_y < 3 S_y`` is where the sway
+  cubic has neither the inflection of too small an ``alpha1`` nor the reverse
+  action of too large an ``alpha1 V_y``, as the paper describes). The start
+  slope is inherited from the previous stage, the end slope is
+  ``alpha1 V_y`` towards the next supporting foot, 0 at a stop.
+* **Pelvis, side walking** (Eqs. 15-16): when the ankles' middle moves
+  sideways, the pelvis follows with a half cosine in the half of the step
+  whose sway goes the same way (second half of the open stance, first half of
+  the recovery).
+* **Swing ankle** (Eq. 11): cycloid along the supporting foot's heading and
+  half cosine across it (Eqs. 14-17), both on the swing interval
+  ``[t1 + d/2, t2 - d/2]`` so that a foot in double support stays still.
+* **Foot height** (Fig. 12): quintic rise over ``u`` of the swing, fall over the rest.
+* **Turning** (Eqs. 21-23): the swinging foot's yaw follows a half cosine on
+  the swing interval and the pelvis yaw is the mean of the feet's yaws, so the
+  hip yaws are ``+-(theta/4)(1 -+ cos)`` exactly as in Eqs. 21-23.
+
+The pelvis height is constant (the paper's assumption) and the ZMP is the
+cart-table ZMP of Eqs. 1-2, ``p - (l/g) p''``, computed in closed form.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zmpwalk import curves
+from zmpwalk.commands import StepCommand
+from zmpwalk.errors import InvalidParameterError, ZmpwalkError
+from zmpwalk.footsteps import GROUNDED_STRETCH, LEFT, Pose2D, Stance, StagePlan, foot_corners, grounded_stage, plan_command
+from zmpwalk.kinematics import check_leg_reach
+from zmpwalk.patterns.result import StepRecord, SupportPhase, WalkingPattern
+from zmpwalk.robots.model import RobotModel
+from zmpwalk.schedule import Schedule
+from zmpwalk.zmp import convex_hull
+
+Array = NDArray[np.float64]
+
+SUPPORT_DOUBLE = 0
+SUPPORT_LEFT = 1
+SUPPORT_RIGHT = 2
+SUPPORT_NAMES = ("double", "left", "right")
+
+
+@dataclass(frozen=True)
+class Boundary:
+    """Continuity state handed from one stage to the next.
+
+    Attributes:
+        time: Stage boundary time [s].
+        pelvis_velocity: Horizontal pelvis velocity in world [m/s], shape (2,).
+        sway_velocity: The sway part of it, in world [m/s], shape (2,).
+    """
+
+    time: float  # [s]
+    pelvis_velocity: tuple[float, float] = (0.0, 0.0)  # [m/s]
+    sway_velocity: tuple[float, float] = (0.0, 0.0)  # [m/s]
+    at_rest: bool = True
+
+
+@dataclass(frozen=True)
+class Stage:
+    """Everything needed to evaluate one stage at any time; see the module docstring.
+
+    Positions in world [m], velocities in world [m/s], slopes per unit of the
+    curve's own normalised time [m].
+    """
+
+    plan: StagePlan
+    start: float  # [s] t1
+    duration: float  # [s] T
+    dsp_time: float  # [s] d
+    base_start: tuple[float, float]  # [m] ankles' middle at t1
+    base_sagittal: tuple[float, float]  # [m] part of the middle's motion done by the cubic
+    base_lateral: tuple[float, float]  # [m] part done by the half cosine (side walking)
+    lateral_in_first_half: bool
+    base_slope_start: tuple[float, float]  # [m] per unit tau
+    base_slope_end: tuple[float, float]  # [m] per unit tau
+    sway_direction: tuple[float, float]  # unit vector, left of the supporting foot
+    sway_amplitude: float  # [m] signed, along sway_direction
+    sway_slope_start: float  # [m] per unit 2*t_bar
+    sway_slope_end: float  # [m] per unit 2*t_bar
+    sway_out_time: float  # [s] length of the outgoing sway cubic, (1 - d1) T / 2 in Eq. 18
+    sway_back_time: float  # [s] length of the returning sway cubic
+    standing: bool = False
+    grounded: bool = False  # no foot leaves the ground (standing, start)
+    end: Boundary = field(default_factory=lambda: Boundary(0.0))
+
+    @property
+    def stop_time(self) -> float:
+        return self.start + self.duration
+
+
+def build_stage(plan: StagePlan, boundary: Boundary) -> Stage:
+    """Fix a stage's trajectories from its plan and the inherited boundary state."""
+    p = plan.parameters
+    T = plan.duration
+    support = plan.support_pose
+    n = np.array([-math.sin(support.yaw), math.cos(support.yaw)])
+    toward_support = 1.0 if plan.swing != LEFT else -1.0  # support is left when the right foot swings
+    out_time, back_time = sway_times(plan)
+    half_time_scale = back_time  # [s] per unit of 2*t_bar of the returning cubic
+    v_prev = np.array(boundary.pelvis_velocity)
+    sway_prev = np.array(boundary.sway_velocity)
+    w0 = float(sway_prev @ n)  # [m/s] sway speed inherited along this stage's direction
+    if plan.stop:
+        w1 = 0.0
+        v1 = np.zeros(2)
+    else:
+        w1 = -toward_support * p.alpha1 * p.lateral_velocity / half_time_scale  # [m/s], Eq. 20
+        yaw_end = 0.5 * (support.yaw + plan.swing_end.yaw)
+        v1 = p.alpha * plan.forward / T * np.array([math.cos(yaw_end), math.sin(yaw_end)])  # Eq. 13
+    v0_base = v_prev - w0 * n
+    middle_start = 0.5 * (np.array([support.x, support.y]) + [plan.swing_start.x, plan.swing_start.y])
+    middle_end = 0.5 * (np.array([support.x, support.y]) + [plan.swing_end.x, plan.swing_end.y])
+    shift = middle_end - middle_start
+    lateral = float(shift @ n) * n
+    sagittal = shift - lateral
+    end = Boundary(
+        time=boundary.time + T,
+        pelvis_velocity=(float(v1[0] + w1 * n[0]), float(v1[1] + w1 * n[1])),
+        sway_velocity=(float(w1 * n[0]), float(w1 * n[1])),
+        at_rest=plan.stop,
+    )
+    return Stage(
+        plan=plan,
+        start=boundary.time,
+        duration=T,
+        dsp_time=p.dsp_time,
+        base_start=_pair(middle_start),
+        base_sagittal=_pair(sagittal),
+        base_lateral=_pair(lateral),
+        lateral_in_first_half=float(shift @ n) * toward_support > 0,
+        base_slope_start=_pair(v0_base * T),
+        base_slope_end=_pair(v1 * T),
+        sway_direction=_pair(n),
+        sway_amplitude=toward_support * p.beta1 * p.sway,
+        sway_slope_start=w0 * out_time,
+        sway_slope_end=w1 * back_time,
+        sway_out_time=out_time,
+        sway_back_time=back_time,
+        grounded=plan.kind in ("start", "settle"),
+        end=end,
+    )
+
+
+def sway_times(plan: StagePlan) -> tuple[float, float]:
+    """Lengths [s] of the outgoing and returning sway cubics of a stage.
+
+    A walking stage follows Eq. 18: each cubic lasts ``(1 - d1) T / 2`` and the
+    pelvis stays for ``d1 T`` in between. The sway cubic from rest (start) or
+    to rest (settle) has no inherited speed to shape it, and done in
+    ``(1 - d1) T / 2`` it throws the cart-table ZMP outside the feet; it lasts
+    one step time instead, and the other cubic keeps the regular length so
+    that the walking stage next to it meets the speed of Eq. 20.
+    """
+    d1 = plan.parameters.d1
+    if plan.kind in ("start", "settle"):
+        step_time = plan.duration / (GROUNDED_STRETCH + (1.0 - d1) / 2.0)
+        slow, regular = GROUNDED_STRETCH * step_time, (1.0 - d1) * step_time / 2.0
+        return (slow, regular) if plan.kind == "start" else (regular, slow)
+    half = (1.0 - d1) * plan.duration / 2.0
+    return half, half
+
+
+def standing_stage(plan: StagePlan, start: float) -> Stage:
+    """A stage in which nothing moves: the robot stands in double support from ``start`` on."""
+    middle = 0.5 * (np.array([plan.support_pose.x, plan.support_pose.y])
+                    + [plan.swing_start.x, plan.swing_start.y])
+    zero = (0.0, 0.0)
+    return Stage(
+        plan=plan, start=start, duration=1.0, dsp_time=0.0, base_start=_pair(middle), base_sagittal=zero,
+        base_lateral=zero, lateral_in_first_half=False, base_slope_start=zero, base_slope_end=zero,
+        sway_direction=(0.0, 1.0), sway_amplitude=0.0, sway_slope_start=0.0, sway_slope_end=0.0,
+        sway_out_time=0.5, sway_back_time=0.5,
+        standing=True, grounded=True, end=Boundary(math.inf),
+    )
+
+
+def _pair(vector: Array) -> tuple[float, float]:
+    return float(vector[0]), float(vector[1])
+
+
+class StageTable:
+    """Stages as column arrays, so that many samples evaluate in one vectorised pass."""
+
+    def __init__(self, stages: list[Stage]) -> None:
+        self.stages = stages
+        self.start = np.array([s.start for s in stages])
+        self.duration = np.array([s.duration for s in stages])
+        self.dsp = np.array([s.dsp_time for s in stages])
+        self.swing_left = np.array([s.plan.swing == LEFT for s in stages])
+        self.standing = np.array([s.standing for s in stages])
+        self.grounded = np.array([s.grounded for s in stages])
+        self.support_xy = np.array([[s.plan.support_pose.x, s.plan.support_pose.y] for s in stages])
+        self.support_yaw = np.array([s.plan.support_pose.yaw for s in stages])
+        self.swing_xy0 = np.array([[s.plan.swing_start.x, s.plan.swing_start.y] for s in stages])
+        self.swing_yaw0 = np.array([s.plan.swing_start.yaw for s in stages])
+        self.swing_dyaw = np.array([s.plan.swing_end.yaw - s.plan.swing_start.yaw for s in stages])
+        displacement = np.array([[s.plan.swing_end.x - s.plan.swing_start.x,
+                                  s.plan.swing_end.y - s.plan.swing_start.y] for s in stages])
+        heading = np.stack([np.cos(self.support_yaw), np.sin(self.support_yaw)], axis=1)
+        along = np.sum(displacement * heading, axis=1, keepdims=True) * heading
+        self.swing_along = along  # [m] cycloid part (Eq. 11)
+        self.swing_across = displacement - along  # [m] half-cosine part (Eqs. 14-17)
+        self.lift = np.array([0.0 if s.grounded else s.plan.parameters.foot_lift for s in stages])
+        self.up_ratio = np.array([s.plan.parameters.up_ratio for s in stages])
+        self.base0 = np.array([s.base_start for s in stages])
+        self.base_sag = np.array([s.base_sagittal for s in stages])
+        self.base_lat = np.array([s.base_lateral for s in stages])
+        self.lat_first = np.array([s.lateral_in_first_half for s in stages])
+        self.m0 = np.array([s.base_slope_start for s in stages])
+        self.m1 = np.array([s.base_slope_end for s in stages])
+        self.n = np.array([s.sway_direction for s in stages])
+        self.amp = np.array([s.sway_amplitude for s in stages])
+        self.w0 = np.array([s.sway_slope_start for s in stages])
+        self.w1 = np.array([s.sway_slope_end for s in stages])
+        self.out_time = np.array([s.sway_out_time for s in stages])
+        self.back_time = np.array([s.sway_back_time for s in stages])
+
+    def index_at(self, time: Array) -> NDArray[np.intp]:
+        """Index of the stage each time belongs to (a boundary time opens the next stage)."""
+        index = np.searchsorted(self.start, time, side="right") - 1
+        return np.clip(index, 0, len(self.stages) - 1)
+
+
+@dataclass
+class Samples:
+    """Evaluated pattern at given times, all in world (SI).
+
+    Shapes: ``(n,)`` for scalars, ``(n, 2)`` / ``(n, 3)`` for vectors.
+    """
+
+    time: Array  # [s]
+    support: NDArray[np.int8]  # SUPPORT_* codes
+    pelvis_xy: Array  # [m]
+    pelvis_velocity_xy: Array  # [m/s]
+    pelvis_acceleration_xy: Array  # [m/s^2]
+    pelvis_yaw: Array  # [rad]
+    pelvis_yaw_rate: Array  # [rad/s]
+    left_position: Array  # [m], ankle
+    left_velocity: Array  # [m/s]
+    left_yaw: Array  # [rad]
+    left_yaw_rate: Array  # [rad/s]
+    right_position: Array  # [m], ankle
+    right_velocity: Array  # [m/s]
+    right_yaw: Array  # [rad]
+    right_yaw_rate: Array  # [rad/s]
+    zmp_xy: Array  # [m], cart-table ZMP of Eqs. 1-2
+
+
+def evaluate(table: StageTable, time: Array, robot: RobotModel, index: NDArray[np.intp] | None = None) -> Samples:
+    """Evaluate the stages at ``time`` (each sample in stage ``index``, default: its own stage)."""
+    t = np.asarray(time, dtype=float)
+    k = table.index_at(t) if index is None else index
+    T = table.duration[k]
+    d = table.dsp[k]
+    tau = (t - table.start[k]) / T
+    # --- swing ankle: Eq. 11 (cycloid) along, Eqs. 14-17 (half cosine) across, Fig. 12 height
+    swing_span = T - d
+    raw = (t - table.start[k] - d / 2) / swing_span
+    in_swing = (raw > 0.0) & (raw < 1.0) & ~table.grounded[k]
+    s = np.clip(raw, 0.0, 1.0)
+    rate = np.where(in_swing, 1.0 / swing_span, 0.0)
+    c, c1, _ = curves.cycloid(s)
+    b, b1, _ = curves.cosine_blend(s)
+    h, h1, _ = curves.lift_profile(s, table.up_ratio[k])
+    along, across = table.swing_along[k], table.swing_across[k]
+    swing_xy = table.swing_xy0[k] + along * c[:, None] + across * b[:, None]
+    swing_vxy = (along * c1[:, None] + across * b1[:, None]) * rate[:, None]
+    lift = table.lift[k]
+    swing_z = robot.ankle_height + lift * h
+    swing_vz = lift * h1 * rate
+    swing_yaw = table.swing_yaw0[k] + table.swing_dyaw[k] * b
+    swing_yaw_rate = table.swing_dyaw[k] * b1 * rate
+    # --- pelvis base: Eqs. 12-13 cubic plus the side-walking half cosine of Eqs. 15-16
+    base0 = table.base0[k]
+    base_sag = table.base_sag[k]
+    pos, slope, curv = curves.hermite_cubic(0.0 * base0, table.m0[k], base_sag, table.m1[k], tau[:, None])
+    first = table.lat_first[k]
+    half = np.where(first, np.clip(2 * tau, 0.0, 1.0), np.clip(2 * tau - 1, 0.0, 1.0))
+    active = np.where(first, tau < 0.5, tau >= 0.5)
+    q, q1, q2 = curves.cosine_blend(half)
+    q1 = np.where(active, q1, 0.0)
+    q2 = np.where(active, q2, 0.0)
+    lat = table.base_lat[k]
+    pelvis_xy = base0 + pos + lat * q[:, None]
+    pelvis_v = (slope + lat * (2 * q1)[:, None]) / T[:, None]
+    pelvis_a = (curv + lat * (4 * q2)[:, None]) / (T * T)[:, None]
+    # --- pelvis sway: Eqs. 18-20 on the modified time t_bar (sigma = 2 t_bar, or 2 t_bar - 1)
+    amp = table.amp[k]
+    elapsed = t - table.start[k]
+    out_time, back_time = table.out_time[k], table.back_time[k]
+    back_start = T - back_time
+    first_half = elapsed < out_time
+    second_half = elapsed >= back_start
+    sigma = np.where(first_half, elapsed / out_time,
+                     np.where(second_half, (elapsed - back_start) / back_time, 0.0))
+    zero = np.zeros_like(amp)
+    p_start = np.where(first_half, zero, amp)
+    m_start = np.where(first_half, table.w0[k], zero)
+    p_end = np.where(first_half | ~second_half, amp, zero)
+    m_end = np.where(second_half, table.w1[k], zero)
+    sway, sway1, sway2 = curves.hermite_cubic(p_start, m_start, p_end, m_end, sigma)
+    moving = first_half | second_half
+    scale = np.where(first_half, 1.0 / out_time, np.where(second_half, 1.0 / back_time, 0.0))  # d sigma/dt
+    sway = np.where(moving, sway, amp)
+    n = table.n[k]
+    pelvis_xy = pelvis_xy + sway[:, None] * n
+    pelvis_v = pelvis_v + (sway1 * scale)[:, None] * n
+    pelvis_a = pelvis_a + (sway2 * scale * scale)[:, None] * n
+    # --- feet to left/right, pelvis yaw as the mean of the feet (Eq. 23)
+    left_swings = table.swing_left[k]
+    support_xyz = np.column_stack([table.support_xy[k], np.full(len(t), robot.ankle_height)])
+    swing_xyz = np.column_stack([swing_xy, swing_z])
+    swing_vel = np.column_stack([swing_vxy, swing_vz])
+    still = np.zeros_like(swing_vel)
+    ls = left_swings[:, None]
+    left_position = np.where(ls, swing_xyz, support_xyz)
+    right_position = np.where(ls, support_xyz, swing_xyz)
+    left_velocity = np.where(ls, swing_vel, still)
+    right_velocity = np.where(ls, still, swing_vel)
+    support_yaw = table.support_yaw[k]
+    left_yaw = np.where(left_swings, swing_yaw, support_yaw)
+    right_yaw = np.where(left_swings, support_yaw, swing_yaw)
+    left_rate = np.where(left_swings, swing_yaw_rate, 0.0)
+    right_rate = np.where(left_swings, 0.0, swing_yaw_rate)
+    support = np.where(in_swing, np.where(left_swings, SUPPORT_RIGHT, SUPPORT_LEFT), SUPPORT_DOUBLE)
+    zmp = pelvis_xy - (robot.pendulum_length / robot.gravity) * pelvis_a  # Eqs. 1-2
+    return Samples(
+        time=t, support=support.astype(np.int8), pelvis_xy=pelvis_xy, pelvis_velocity_xy=pelvis_v,
+        pelvis_acceleration_xy=pelvis_a, pelvis_yaw=0.5 * (left_yaw + right_yaw),
+        pelvis_yaw_rate=0.5 * (left_rate + right_rate), left_position=left_position,
+        left_velocity=left_velocity, left_yaw=left_yaw, left_yaw_rate=left_rate,
+        right_position=right_position, right_velocity=right_velocity, right_yaw=right_yaw,
+        right_yaw_rate=right_rate, zmp_xy=zmp,
+    )
+
+
+def stage_support_phases(stage: Stage) -> list[tuple[float, float, int, tuple[Pose2D, ...]]]:
+    """Support phases of a stage: (begin [s], end [s], support code, feet on the ground with their sides).
+
+    The feet are given as poses; the caller pairs them with sides for the soles.
+    """
+    plan = stage.plan
+    if stage.grounded:
+        end = math.inf if stage.standing else stage.stop_time
+        return [(stage.start, end, SUPPORT_DOUBLE, (plan.support_pose, plan.swing_start))]
+    t1 = stage.start
+    half = stage.dsp_time / 2
+    single = SUPPORT_RIGHT if plan.swing == LEFT else SUPPORT_LEFT
+    return [
+        (t1, t1 + half, SUPPORT_DOUBLE, (plan.support_pose, plan.swing_start)),
+        (t1 + half, stage.stop_time - half, single, (plan.support_pose,)),
+        (stage.stop_time - half, stage.stop_time, SUPPORT_DOUBLE, (plan.support_pose, plan.swing_end)),
+    ]
+
+
+# ---------------------------------------------------------------------------
+# Whole walks: commands -> stages -> WalkingPattern
+# ---------------------------------------------------------------------------
+
+REACH_CHECK_POINTS = 33  # samples per stage at which the leg reach is checked
+
+
+def check_stage_reach(stage: Stage, robot: RobotModel) -> None:
+    """Raise :class:`~zmpwalk.errors.UnreachableError` if a leg cannot follow the stage."""
+    times = stage.start + np.linspace(0.0, stage.duration, REACH_CHECK_POINTS)
+    samples = evaluate(StageTable([stage]), times, robot, np.zeros(len(times), dtype=np.intp))
+    pelvis = np.column_stack([samples.pelvis_xy, np.full(len(times), robot.pelvis_height)])
+    check_leg_reach(times, pelvis, samples.pelvis_yaw, samples.left_position, samples.right_position, robot)
+
+
+def plan_next(
+    robot: RobotModel, schedule: Schedule, stance: Stance, boundary: Boundary, command: StepCommand
+) -> tuple[list[Stage], Stance, Boundary]:
+    """Stages of one command from a stance and boundary state; nothing is changed on error.
+
+    From standstill a walk begins with a *start* stage: one step time in double
+    support in which the pelvis sways towards the first swinging foot and comes
+    back through the middle at the sway speed ``alpha1 V_y`` of Eq. 20, so that
+    the first swing starts like every other one. A stop command at standstill
+    does nothing.
+
+    Raises:
+        ZmpwalkError: The command is infeasible for this robot (reach, overlap, timing).
+    """
+    stages: list[Stage] = []
+    if boundary.at_rest:
+        if command.stop:
+            return [], stance, boundary
+        plans, _ = plan_command(stance, command, robot, schedule)
+        first = plans[0]
+        stage = build_stage(grounded_stage(stance, first.swing, command.duration, first.parameters, "start"),
+                            boundary)
+        stages.append(stage)
+        boundary = stage.end
+    plans, next_stance = plan_command(stance, command, robot, schedule)
+    for plan in plans:
+        stage = build_stage(plan, boundary)
+        check_stage_reach(stage, robot)
+        stages.append(stage)
+        boundary = stage.end
+    if command.stop:
+        next_stance = Stance(next_stance.left, next_stance.right, 0)
+    return stages, next_stance, boundary
+
+
+def plan_walk(
+    robot: RobotModel,
+    commands: Sequence[StepCommand],
+    schedule: Schedule | None = None,
+) -> tuple[list[Stage], Stance]:
+    """Stages of a whole walk from the ready posture, closed by a stop and a standing stage.
+
+    A walk whose last command is not a stop gets a closing stop step of the
+    last step time, so every pattern ends standing in the ready posture.
+
+    Raises:
+        ZmpwalkError: With ``step N:`` in front, for the first command that fails.
+    """
+    schedule = schedule or Schedule.hubo()
+    stance = Stance.ready(robot)
+    boundary = Boundary(0.0)
+    stages: list[Stage] = []
+    sequence = list(commands)
+    if sequence and not sequence[-1].stop:
+        sequence.append(StepCommand(duration=sequence[-1].duration, stop=True))
+    for number, command in enumerate(sequence, start=1):
+        try:
+            new, stance, boundary = plan_next(robot, schedule, stance, boundary, command)
+        except ZmpwalkError as error:
+            raise error.in_context(f"step {number}") from None
+        stages.extend(new)
+    stages.append(standing_stage(_standing_plan(stance, robot, schedule), boundary.time))
+    return stages, stance
+
+
+def _standing_plan(stance: Stance, robot: RobotModel, schedule: Schedule) -> StagePlan:
+    parameters, _ = schedule.stage_parameters(StepCommand(duration=1.0), robot)
+    return StagePlan(LEFT, stance.right, stance.left, stance.left, 0.0, 1.0, parameters, True, "stand")
+
+
+def check_rate(rate: float) -> None:
+    """Raise unless ``rate`` is a sampling rate zmpwalk supports (1 Hz .. 10 kHz)."""
+    if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not (1.0 <= rate <= 10_000.0):
+        raise InvalidParameterError("rate", rate, "a sampling rate in [1, 10000] Hz")
+
+
+def generate(
+    robot: RobotModel,
+    commands: Sequence[StepCommand],
+    rate: float = 100.0,
+    schedule: Schedule | None = None,
+) -> WalkingPattern:
+    """The HUBO walking pattern of a command sequence, sampled at ``rate`` [Hz].
+
+    Args:
+        robot: The robot.
+        commands: Step commands in order; a closing stop is added if missing.
+        rate: Samples per second (HUBO's reference rate is 100 Hz).
+        schedule: Parameter tables; Tables 2-3 of the paper by default.
+
+    Returns:
+        The pattern from the ready posture at t = 0 to standing after the last step.
+    """
+    check_rate(rate)
+    stages, _ = plan_walk(robot, commands, schedule)
+    end_time = stages[-1].start
+    count = int(math.floor(end_time * rate + 1e-9)) + 1
+    times = np.arange(count) / rate
+    if times[-1] < end_time - 1e-12:
+        times = np.append(times, end_time)
+    table = StageTable(stages)
+    return pattern_from_samples(evaluate(table, times, robot), stages, robot, rate, "polynomial")
+
+
+def pattern_from_samples(
+    samples: Samples, stages: list[Stage], robot: RobotModel, rate: float, generator: str
+) -> WalkingPattern:
+    """Wrap evaluated samples and their stages into a :class:`WalkingPattern`."""
+    n = len(samples.time)
+    height = np.full(n, robot.pelvis_height)
+    phases: list[SupportPhase] = []
+    steps: list[StepRecord] = []
+    for stage in stages:
+        for begin, end, code, poses in stage_support_phases(stage):
+            if end <= begin:
+                continue
+            feet = [(stage.plan.support_pose, -stage.plan.swing)]
+            if len(poses) == 2:
+                feet.append((poses[1], stage.plan.swing))
+            corners = np.vstack([foot_corners(pose, side, robot) for pose, side in feet])
+            phases.append(SupportPhase(begin, end, code, convex_hull(corners)))
+        if not stage.standing:
+            plan = stage.plan
+            parameters: dict[str, float | str] = dict(vars(plan.parameters))
+            steps.append(StepRecord(
+                start=stage.start, duration=stage.duration, swing="left" if plan.swing == LEFT else "right",
+                kind=plan.kind, landing=(plan.swing_end.x, plan.swing_end.y, plan.swing_end.yaw),
+                parameters=parameters,
+            ))
+    return WalkingPattern(
+        robot=robot, rate=rate, generator=generator, time=samples.time, support=samples.support,
+        position_pelvis_in_world=np.column_stack([samples.pelvis_xy, height]),
+        velocity_pelvis_in_world=np.column_stack([samples.pelvis_velocity_xy, np.zeros(n)]),
+        yaw_pelvis_in_world=samples.pelvis_yaw, yaw_rate_pelvis=samples.pelvis_yaw_rate,
+        position_left_ankle_in_world=samples.left_position, velocity_left_ankle_in_world=samples.left_velocity,
+        yaw_left_foot_in_world=samples.left_yaw, yaw_rate_left_foot=samples.left_yaw_rate,
+        position_right_ankle_in_world=samples.right_position,
+        velocity_right_ankle_in_world=samples.right_velocity,
+        yaw_right_foot_in_world=samples.right_yaw, yaw_rate_right_foot=samples.right_yaw_rate,
+        zmp_in_world=samples.zmp_xy, steps=steps, support_phases=phases,
+    )

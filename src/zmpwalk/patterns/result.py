@@ -1,0 +1,190 @@
+"""The result type shared by every pattern generator: :class:`WalkingPattern`.
+
+Inverse kinematics, the ZMP check, the simulator and the reports read only
+this type and never ask which generator made it.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zmpwalk.robots.model import RobotModel
+from zmpwalk.zmp import signed_margin
+
+Array = NDArray[np.float64]
+
+SUPPORT_NAMES = ("double", "left", "right")
+
+CSV_COLUMNS = (
+    "t", "support", "pelvis_x", "pelvis_y", "pelvis_z", "pelvis_yaw", "left_x", "left_y", "left_z",
+    "left_yaw", "right_x", "right_y", "right_z", "right_yaw", "zmp_x", "zmp_y",
+)
+
+
+@dataclass(frozen=True)
+class SupportPhase:
+    """An interval with a fixed set of feet on the ground.
+
+    Attributes:
+        begin: Start time [s].
+        end: End time [s] (``inf`` for standing at the end).
+        support: 0 double, 1 left, 2 right.
+        polygon: Support polygon in world, counter-clockwise, shape (m, 2) [m].
+    """
+
+    begin: float  # [s]
+    end: float  # [s]
+    support: int
+    polygon: Array  # [m]
+
+
+@dataclass(frozen=True)
+class StepRecord:
+    """One swing of the walk, as planned.
+
+    Attributes:
+        start: Lift-off stage start ``t1`` [s].
+        duration: Step time [s].
+        swing: ``"left"`` or ``"right"``.
+        kind: ``"step"``, ``"open"``, ``"recovery"``, ``"inserted"``, ``"stop"``, or a generator's own.
+        landing: Landing pose of the swinging ankle ``(x [m], y [m], yaw [rad])`` in world.
+        parameters: The shape parameters used, by name (SI).
+    """
+
+    start: float  # [s]
+    duration: float  # [s]
+    swing: str
+    kind: str
+    landing: tuple[float, float, float]
+    parameters: dict[str, float | str] = field(default_factory=dict)
+
+
+@dataclass
+class WalkingPattern:
+    """A walking pattern sampled at a fixed rate, in world (SI).
+
+    Attributes:
+        robot: The robot it was made for.
+        rate: Samples per second [Hz].
+        generator: Name of the generator.
+        time: Sample times [s], shape (n,).
+        support: Support phase code per sample (0 double, 1 left, 2 right), shape (n,).
+        position_pelvis_in_world: Pelvis centre [m], (n, 3).
+        velocity_pelvis_in_world: [m/s], (n, 3).
+        yaw_pelvis_in_world: [rad], (n,).
+        yaw_rate_pelvis: [rad/s], (n,).
+        position_left_ankle_in_world, position_right_ankle_in_world: [m], (n, 3).
+        velocity_left_ankle_in_world, velocity_right_ankle_in_world: [m/s], (n, 3).
+        yaw_left_foot_in_world, yaw_right_foot_in_world: [rad], (n,).
+        yaw_rate_left_foot, yaw_rate_right_foot: [rad/s], (n,).
+        zmp_in_world: Cart-table ZMP (Eqs. 1-2) [m], (n, 2).
+        steps: The swings, in order.
+        support_phases: Support polygons over time.
+    """
+
+    robot: RobotModel
+    rate: float  # [Hz]
+    generator: str
+    time: Array
+    support: NDArray[np.int8]
+    position_pelvis_in_world: Array
+    velocity_pelvis_in_world: Array
+    yaw_pelvis_in_world: Array
+    yaw_rate_pelvis: Array
+    position_left_ankle_in_world: Array
+    velocity_left_ankle_in_world: Array
+    yaw_left_foot_in_world: Array
+    yaw_rate_left_foot: Array
+    position_right_ankle_in_world: Array
+    velocity_right_ankle_in_world: Array
+    yaw_right_foot_in_world: Array
+    yaw_rate_right_foot: Array
+    zmp_in_world: Array
+    steps: list[StepRecord]
+    support_phases: list[SupportPhase]
+
+    @property
+    def duration(self) -> float:
+        """Time of the last sample [s]."""
+        return float(self.time[-1])
+
+    def _in_pelvis(self, position: Array) -> Array:
+        rel = position - self.position_pelvis_in_world
+        c, s = np.cos(self.yaw_pelvis_in_world), np.sin(self.yaw_pelvis_in_world)
+        return np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1], rel[:, 2]])
+
+    @property
+    def position_left_ankle_in_pelvis(self) -> Array:
+        """Left ankle in the pelvis frame [m], (n, 3): the paper's hat-x_A, hat-y_A."""
+        return self._in_pelvis(self.position_left_ankle_in_world)
+
+    @property
+    def position_right_ankle_in_pelvis(self) -> Array:
+        """Right ankle in the pelvis frame [m], (n, 3)."""
+        return self._in_pelvis(self.position_right_ankle_in_world)
+
+    @property
+    def yaw_left_foot_in_pelvis(self) -> Array:
+        """Left hip yaw: left foot yaw relative to the pelvis [rad] (Eqs. 21-22)."""
+        return self.yaw_left_foot_in_world - self.yaw_pelvis_in_world
+
+    @property
+    def yaw_right_foot_in_pelvis(self) -> Array:
+        """Right hip yaw [rad] (Eq. 23: minus the left one)."""
+        return self.yaw_right_foot_in_world - self.yaw_pelvis_in_world
+
+    def zmp_margin(self) -> Array:
+        """Signed distance of the ZMP to the support polygon per sample [m] (> 0 inside)."""
+        margin = np.full(len(self.time), np.nan)
+        for phase in self.support_phases:
+            mask = (self.time >= phase.begin) & (self.time < phase.end)
+            if phase is self.support_phases[-1]:
+                mask |= self.time >= phase.begin
+            if np.any(mask):
+                margin[mask] = signed_margin(self.zmp_in_world[mask], phase.polygon)
+        return margin
+
+    def min_zmp_margin(self) -> tuple[float, float]:
+        """Smallest ZMP margin [m] and the time it occurs [s]."""
+        margin = self.zmp_margin()
+        index = int(np.nanargmin(margin))
+        return float(margin[index]), float(self.time[index])
+
+    def columns(self) -> dict[str, NDArray[np.generic]]:
+        """The CSV columns of ``zmpwalk plan`` as arrays, in order."""
+        p, pl, pr = self.position_pelvis_in_world, self.position_left_ankle_in_world, self.position_right_ankle_in_world
+        return {
+            "t": self.time,
+            "support": np.array(SUPPORT_NAMES)[self.support],
+            "pelvis_x": p[:, 0], "pelvis_y": p[:, 1], "pelvis_z": p[:, 2], "pelvis_yaw": self.yaw_pelvis_in_world,
+            "left_x": pl[:, 0], "left_y": pl[:, 1], "left_z": pl[:, 2], "left_yaw": self.yaw_left_foot_in_world,
+            "right_x": pr[:, 0], "right_y": pr[:, 1], "right_z": pr[:, 2], "right_yaw": self.yaw_right_foot_in_world,
+            "zmp_x": self.zmp_in_world[:, 0], "zmp_y": self.zmp_in_world[:, 1],
+        }
+
+    def write_csv(self, path: Path, extra: dict[str, Array] | None = None) -> None:
+        """Write one row per sample with :data:`CSV_COLUMNS` (then ``extra`` columns) in SI units."""
+        columns = self.columns()
+        if extra:
+            columns.update(extra)
+        names = list(columns)
+        data = [columns[name] for name in names]
+        with Path(path).open("w", newline="", encoding="utf-8") as handle:
+            writer = csv.writer(handle)
+            writer.writerow(names)
+            for i in range(len(self.time)):
+                writer.writerow([
+                    value[i] if isinstance(value[i], str) else _fmt(float(value[i])) for value in data
+                ])
+
+
+def _fmt(value: float) -> str:
+    if math.isfinite(value) and value == 0.0:
+        return "0"
+    return f"{value:.9g}"

@@ -1,0 +1,164 @@
+"""The robot as data: lengths, foot, posture, walking defaults, joint ranges.
+
+Frames used throughout zmpwalk (documented once, here):
+
+* **world**: x forward along the robot's initial heading, y to its left, z up;
+  origin on the ground midway between the ankles of the ready posture.
+* **pelvis**: origin at the pelvis centre, x forward along the pelvis heading,
+  y left, z up (the paper's x, y frame of Figs. 4-5).
+* **foot** (left or right ankle): origin at the ankle joint, x along the foot
+  heading, y left, z up. A foot's yaw is the heading of its x axis in world.
+
+All quantities are SI: m, s, rad, kg.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from zmpwalk.errors import FileFormatError
+
+JOINT_NAMES = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll")
+
+
+@dataclass(frozen=True)
+class RobotModel:
+    """A biped's geometry and walking defaults, in SI units.
+
+    Attributes:
+        name: Short name used on the command line.
+        description: One line for humans.
+        mass: Total mass [kg].
+        height: Standing height [m].
+        hip_spacing: Lateral distance between the hip joints, also the ankle
+            spacing of the ready posture [m].
+        hip_drop: Hip joints below the pelvis centre [m].
+        thigh_length: Hip pitch axis to knee axis [m].
+        shank_length: Knee axis to ankle pitch axis [m].
+        ankle_height: Ankle axes above the sole [m].
+        foot_length: Sole length along the foot x axis [m].
+        foot_width: Sole width [m].
+        sole_center_x: Sole centre ahead of the ankle [m].
+        sole_center_y: Sole centre left of the left ankle (mirrored on the right) [m].
+        pelvis_height: Pelvis centre above the ground in the ready posture [m].
+        pendulum_length: ``l`` of Eqs. 1-2 (Park 2008), centre-of-mass height [m].
+        min_knee: Least knee bend while walking [rad].
+        dsp_time: Default double-support time ``d`` [s].
+        foot_lift: Default swing apex height [m].
+        lateral_velocity: Default ``V_y`` of Eq. 20 [m per unit of ``2 t_bar``].
+        joint_limits: Joint name -> (lower, upper) [rad].
+        gravity: Gravitational acceleration [m/s^2].
+    """
+
+    name: str
+    description: str
+    mass: float  # [kg]
+    height: float  # [m]
+    hip_spacing: float  # [m]
+    hip_drop: float  # [m]
+    thigh_length: float  # [m]
+    shank_length: float  # [m]
+    ankle_height: float  # [m]
+    foot_length: float  # [m]
+    foot_width: float  # [m]
+    sole_center_x: float  # [m]
+    sole_center_y: float  # [m]
+    pelvis_height: float  # [m]
+    pendulum_length: float  # [m]
+    min_knee: float  # [rad]
+    dsp_time: float  # [s]
+    foot_lift: float  # [m]
+    lateral_velocity: float  # [m per unit 2*t_bar]
+    joint_limits: dict[str, tuple[float, float]] = field(default_factory=dict)  # [rad]
+    gravity: float = 9.81  # [m/s^2]
+
+    @property
+    def max_leg_reach(self) -> float:
+        """Largest hip-to-ankle distance, at the least knee bend [m]."""
+        a, b = self.thigh_length, self.shank_length
+        return math.sqrt(a * a + b * b + 2 * a * b * math.cos(self.min_knee))
+
+    @property
+    def hip_height(self) -> float:
+        """Hip joints above the ground in the ready posture [m]."""
+        return self.pelvis_height - self.hip_drop
+
+
+_SECTIONS: dict[str, dict[str, str]] = {
+    "": {"name": "name", "description": "description", "mass": "mass", "height": "height",
+         "gravity": "gravity"},
+    "legs": {"hip_spacing": "hip_spacing", "hip_drop": "hip_drop", "thigh_length": "thigh_length",
+             "shank_length": "shank_length", "ankle_height": "ankle_height"},
+    "foot": {"length": "foot_length", "width": "foot_width", "sole_center_x": "sole_center_x",
+             "sole_center_y": "sole_center_y"},
+    "posture": {"pelvis_height": "pelvis_height", "pendulum_length": "pendulum_length",
+                "min_knee": "min_knee"},
+    "walking": {"dsp_time": "dsp_time", "foot_lift": "foot_lift",
+                "lateral_velocity": "lateral_velocity"},
+}
+_OPTIONAL = {"gravity"}
+_POSITIVE = {"mass", "height", "hip_spacing", "thigh_length", "shank_length", "ankle_height",
+             "foot_length", "foot_width", "pelvis_height", "pendulum_length", "gravity",
+             "dsp_time", "lateral_velocity"}
+# Sections a later part of zmpwalk reads (bodies, servos); kept as raw tables.
+_EXTRA_SECTIONS = {"limits", "bodies", "servos", "contact"}
+
+
+def robot_from_toml(path: Path) -> RobotModel:
+    """Read a robot data file.
+
+    Raises:
+        FileFormatError: Missing, unknown or out-of-range fields (names the field).
+    """
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, tomllib.TOMLDecodeError) as error:
+        raise FileFormatError(str(path), str(error)) from None
+    return robot_from_dict(data, str(path))
+
+
+def robot_from_dict(data: dict[str, Any], source: str = "<robot>") -> RobotModel:
+    """Build a :class:`RobotModel` from the tables of a robot file."""
+    values: dict[str, Any] = {}
+    for section, fields in _SECTIONS.items():
+        table = data if section == "" else data.get(section)
+        if not isinstance(table, dict):
+            raise FileFormatError(source, f"missing table [{section}]")
+        known = set(fields) | (set(_SECTIONS) - {""}) | _EXTRA_SECTIONS if section == "" else set(fields)
+        for key in table:
+            if key not in known:
+                where = f"[{section}] " if section else ""
+                raise FileFormatError(source, f"{where}unknown field {key!r}; known: {', '.join(sorted(fields))}")
+        for key, attribute in fields.items():
+            if key not in table:
+                if attribute in _OPTIONAL:
+                    continue
+                raise FileFormatError(source, f"[{section}] missing field {key!r}")
+            value = table[key]
+            if attribute in ("name", "description"):
+                if not isinstance(value, str):
+                    raise FileFormatError(source, f"{key} must be a string")
+            else:
+                if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                    raise FileFormatError(source, f"[{section}] {key} = {value!r} must be a finite number")
+                value = float(value)
+                if attribute in _POSITIVE and value <= 0:
+                    raise FileFormatError(source, f"[{section}] {key} = {value:g} must be > 0")
+            values[attribute] = value
+    limits: dict[str, tuple[float, float]] = {}
+    for joint, bounds in data.get("limits", {}).items():
+        if joint not in JOINT_NAMES:
+            raise FileFormatError(source, f"[limits] unknown joint {joint!r}; known: {', '.join(JOINT_NAMES)}")
+        if (not isinstance(bounds, list) or len(bounds) != 2
+                or not all(isinstance(b, (int, float)) for b in bounds) or bounds[0] >= bounds[1]):
+            raise FileFormatError(source, f"[limits] {joint} must be [lower, upper] with lower < upper")
+        limits[joint] = (float(bounds[0]), float(bounds[1]))
+    values["joint_limits"] = limits
+    robot = RobotModel(**values)
+    if robot.hip_height - robot.ankle_height >= robot.max_leg_reach:
+        raise FileFormatError(source, "[posture] pelvis_height leaves the legs straighter than min_knee allows")
+    return robot

@@ -1,0 +1,232 @@
+"""Parameter scheduling: Tables 2 and 3 of Park et al. (2008) and interpolation between them.
+
+The paper tunes the shape factors for a few (step time, stride) conditions and
+names the scheduling of untested conditions as future work. zmpwalk looks a
+step up as follows:
+
+1. Within one tabulated step time, each value is interpolated linearly in the
+   stride between the neighbouring rows. ``alpha`` is undefined ('x') at
+   stride 0 because it multiplies the stride; there the nearest defined row
+   is used.
+2. Between two tabulated step times, the two results are interpolated
+   linearly in the step time.
+3. Side steps use Table 3. Below the smallest tabulated side step (5 cm) the
+   values are interpolated towards stepping on the spot, whose values are
+   Table 2's stride-0 row with ``alpha1 = beta1 = 1`` and ``d1`` of Table 2.
+4. Outside the tabulated range (a step time below 0.7 s or above 0.95 s, a
+   stride beyond the longest row) the nearest edge value is held and the
+   lookup is marked ``extrapolated``; the pattern reports it per step.
+5. Any value given in the :class:`~zmpwalk.commands.StepCommand` replaces the
+   scheduled one.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from zmpwalk.commands import StepCommand
+from zmpwalk.errors import FileFormatError
+from zmpwalk.robots.model import RobotModel
+
+
+@dataclass(frozen=True)
+class ShapeParameters:
+    """Parameters and shape factors of one stage (one swing) of the HUBO pattern.
+
+    Attributes:
+        alpha: Pelvis X velocity factor of Eq. 13 [-].
+        alpha1: Multiplier of ``V_y`` at the step change (Eq. 20) [-].
+        beta1: Multiplier of ``S_y`` at mid-step (Eq. 20) [-].
+        d1: Staying ratio of Eq. 18 [-].
+        up_ratio: ``u`` of Fig. 12, lift time over swing time [-].
+        sway: ``S_y`` of Eq. 20 [m].
+        lateral_velocity: ``V_y`` of Eq. 20 [m per unit ``2 t_bar``].
+        dsp_time: Double-support time ``d`` of Eq. 11 [s].
+        foot_lift: Swing apex height [m].
+        source: ``"table"``, ``"interpolated"``, ``"extrapolated"``; with
+            ``"+override"`` when the command replaced a value.
+    """
+
+    alpha: float  # [-]
+    alpha1: float  # [-]
+    beta1: float  # [-]
+    d1: float  # [-]
+    up_ratio: float  # [-]
+    sway: float  # [m]
+    lateral_velocity: float  # [m per unit 2*t_bar]
+    dsp_time: float  # [s]
+    foot_lift: float  # [m]
+    source: str = "table"
+
+
+class _Grid:
+    """Rows of one table, grouped by step time, for 2-D piecewise-linear lookup."""
+
+    def __init__(self, rows: list[list[float]], columns: list[str], key: str, source: str) -> None:
+        data = np.asarray(rows, dtype=float)
+        if data.ndim != 2 or data.shape[1] != len(columns):
+            raise FileFormatError(source, f"every row needs {len(columns)} values: {', '.join(columns)}")
+        self.columns = columns
+        self.durations = np.unique(data[:, 0])
+        self.by_duration: dict[float, np.ndarray] = {}
+        key_index = columns.index(key)
+        for duration in self.durations:
+            block = data[data[:, 0] == duration]
+            self.by_duration[float(duration)] = block[np.argsort(block[:, key_index])]
+        self.key_index = key_index
+
+    def lookup(
+        self, duration: float, key: float, prepend: Callable[[float], np.ndarray] | None = None
+    ) -> tuple[dict[str, float], str]:
+        """Interpolated row at (duration, key), and how it was obtained."""
+        source = "table"
+        durations = self.durations
+        if duration <= durations[0] or duration >= durations[-1]:
+            nearest = durations[0] if duration <= durations[0] else durations[-1]
+            if not math.isclose(duration, nearest, abs_tol=1e-12):
+                source = "extrapolated"
+            pairs = [(float(nearest), 1.0)]
+        else:
+            upper = int(np.searchsorted(durations, duration))
+            t_low, t_high = float(durations[upper - 1]), float(durations[upper])
+            weight = (duration - t_low) / (t_high - t_low)
+            pairs = [(t_low, 1.0 - weight), (t_high, weight)]
+            source = "interpolated"
+        result = dict.fromkeys(self.columns, 0.0)
+        for tabulated, weight in pairs:
+            block = self.by_duration[tabulated]
+            if prepend is not None:
+                block = np.vstack([prepend(tabulated)[None, :], block])
+            row, row_source = _interpolate_rows(block, self.key_index, key)
+            if row_source != "table" and source != "extrapolated":
+                source = row_source
+            for index, name in enumerate(self.columns):
+                result[name] += weight * row[index]
+        return result, source
+
+
+def _interpolate_rows(block: np.ndarray, key_index: int, key: float) -> tuple[np.ndarray, str]:
+    """Linear interpolation along ``key`` in one step time's rows, column by column.
+
+    NaN cells ('x') are skipped: the column uses its defined rows only.
+    """
+    out = np.empty(block.shape[1])
+    keys = block[:, key_index]
+    source = "table"
+    if key < keys[0] - 1e-12 or key > keys[-1] + 1e-12:
+        source = "extrapolated"
+    elif not np.any(np.isclose(keys, key, atol=1e-12)):
+        source = "interpolated"
+    for column in range(block.shape[1]):
+        values = block[:, column]
+        defined = ~np.isnan(values)
+        out[column] = float(np.interp(key, keys[defined], values[defined]))
+    return out, source
+
+
+class Schedule:
+    """Shape parameters for any (step time, stride, side step) from tuned tables.
+
+    Args:
+        data: The parsed schedule file (see ``data/schedule_hubo.toml``).
+        source: Name of the file, for error messages.
+    """
+
+    def __init__(self, data: dict[str, Any], source: str = "<schedule>") -> None:
+        try:
+            forward = data["forward"]
+            side = data["side"]
+            self._forward = _Grid(forward["rows"], forward["columns"], "stride", source)
+            self._side = _Grid(side["rows"], side["columns"], "side", source)
+            self._forward_d1 = float(forward["d1"])
+            self._forward_alpha1 = float(forward["alpha1"])
+            self._forward_beta1 = float(forward["beta1"])
+            self._recovery_alpha1 = float(side["recovery_alpha1"])
+            self._recovery_beta1 = float(side["recovery_beta1"])
+        except (KeyError, TypeError, ValueError) as error:
+            raise FileFormatError(source, f"malformed schedule: {error}") from None
+
+    def _on_spot_row(self, duration: float) -> np.ndarray:
+        """Stepping on the spot as a Table 3 row (side step 0) at a tabulated step time."""
+        on_spot, _ = self._forward.lookup(duration, 0.0)
+        return np.array([
+            duration, 0.0, on_spot["sway"], on_spot["up_ratio"], self._forward_alpha1,
+            self._forward_beta1, self._forward_d1, self._forward_d1,
+        ])
+
+    @classmethod
+    def from_file(cls, path: Path) -> Schedule:
+        """Read a schedule file (TOML)."""
+        try:
+            data = tomllib.loads(path.read_text(encoding="utf-8"))
+        except (OSError, tomllib.TOMLDecodeError) as error:
+            raise FileFormatError(str(path), str(error)) from None
+        return cls(data, str(path))
+
+    @classmethod
+    def hubo(cls) -> Schedule:
+        """Tables 2 and 3 of Park et al. (2008)."""
+        path = Path(str(resources.files("zmpwalk") / "data" / "schedule_hubo.toml"))
+        return cls.from_file(path)
+
+    def stage_parameters(
+        self, command: StepCommand, robot: RobotModel
+    ) -> tuple[ShapeParameters, ShapeParameters]:
+        """Parameters of the open-stance (or only) stage and of the recovery stage.
+
+        Overrides in ``command`` replace the scheduled values; the robot gives
+        the values the tables do not hold (``d``, foot lift, ``V_y``).
+        """
+        stride = abs(command.forward)
+        row, source = self._forward.lookup(command.duration, stride)
+        alpha = row["alpha"]
+        sway = row["sway"]
+        up_ratio = row["up_ratio"]
+        open_alpha1 = recovery_alpha1 = self._forward_alpha1
+        open_beta1 = recovery_beta1 = self._forward_beta1
+        open_d1 = recovery_d1 = self._forward_d1
+        if command.side != 0.0:
+            side_row, side_source = self._side.lookup(command.duration, abs(command.side), self._on_spot_row)
+            sway = side_row["sway"]
+            up_ratio = side_row["up_ratio"]
+            open_alpha1, open_beta1 = side_row["alpha1"], side_row["beta1"]
+            open_d1, recovery_d1 = side_row["d1_open"], side_row["d1_recovery"]
+            recovery_alpha1, recovery_beta1 = self._recovery_alpha1, self._recovery_beta1
+            source = _worse(source, side_source)
+        common = {
+            "alpha": alpha, "up_ratio": up_ratio, "sway": sway,
+            "lateral_velocity": robot.lateral_velocity, "dsp_time": robot.dsp_time,
+            "foot_lift": robot.foot_lift,
+        }
+        first = ShapeParameters(alpha1=open_alpha1, beta1=open_beta1, d1=open_d1, source=source, **common)
+        second = ShapeParameters(
+            alpha1=recovery_alpha1, beta1=recovery_beta1, d1=recovery_d1, source=source, **common
+        )
+        overrides = {
+            name: getattr(command, name)
+            for name in ("alpha", "up_ratio", "sway", "lateral_velocity", "dsp_time", "foot_lift",
+                         "alpha1", "beta1", "d1")
+            if getattr(command, name) is not None
+        }
+        if overrides:
+            first = replace(first, source=first.source + "+override", **overrides)
+            second_overrides = {k: v for k, v in overrides.items() if k not in ("alpha1", "beta1", "d1")}
+            if not command.is_two_stage:
+                second_overrides = overrides
+            second = replace(second, source=second.source + "+override", **second_overrides)
+        if command.d1_recovery is not None:
+            second = replace(second, d1=command.d1_recovery, source=second.source.split("+")[0] + "+override")
+        return first, second
+
+
+def _worse(first: str, second: str) -> str:
+    order = ("table", "interpolated", "extrapolated")
+    return order[max(order.index(first), order.index(second))]

@@ -1,0 +1,140 @@
+"""ZMP of the cart-table (inverted pendulum) model, its boundary maps, and support polygons.
+
+Section 2 of Park et al. (2008). With the pelvis at constant height ``l`` the
+ZMP is (Eqs. 1-2)
+
+.. math:: x_{zmp} = x - \\frac{l}{g} \\ddot x .
+
+A cubic pelvis therefore has a cubic ZMP, and the boundary values (position,
+velocity at both ends) of the two map linearly onto each other (Eq. 7 for one
+interval, Eq. 9 for the half intervals of the lateral sway). The paper prints
+the maps with time in units of the step time (T = 1 s). For an interval of
+``T`` seconds the acceleration of a cubic in ``s = t/T`` is ``x_ss / T^2``, so
+``l/g`` becomes ``kappa = l/(g T^2)`` in the normalised map; in physical units
+(velocities in m/s) the map is ``D^-1 M(kappa) D`` with ``D = diag(1, T, 1, T)``.
+Eq. 9 is the same map for an interval of ``T/2`` (velocities still per unit
+step time), which :func:`half_interval_zmp_map` reproduces.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zmpwalk.errors import InvalidParameterError
+
+Array = NDArray[np.float64]
+
+# Eq. 4: coefficients [b3, b2, b1, b0] of a cubic on [0, 1] from [x0, x0', x1, x1'].
+CUBIC_FROM_BOUNDARY = np.array([[2.0, 1.0, -2.0, 1.0], [-3.0, -2.0, 3.0, -1.0], [0.0, 1.0, 0.0, 0.0],
+                                [1.0, 0.0, 0.0, 0.0]])
+# Left-hand matrix of Eq. 4 (its inverse is CUBIC_FROM_BOUNDARY).
+BOUNDARY_FROM_CUBIC = np.array([[0.0, 0.0, 0.0, 1.0], [0.0, 0.0, 1.0, 0.0], [1.0, 1.0, 1.0, 1.0],
+                                [3.0, 2.0, 1.0, 0.0]])
+# Eq. 8, first interval [0, 1/2]: coefficients from [y0, y0', y_1/2, y_1/2'].
+CUBIC_FROM_HALF_BOUNDARY_FIRST = np.array([[16.0, 4.0, -16.0, 4.0], [-12.0, -4.0, 12.0, -2.0],
+                                           [0.0, 1.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]])
+# Eq. 8, second interval [1/2, 1]: coefficients from [y_1/2, y_1/2', y1, y1'].
+CUBIC_FROM_HALF_BOUNDARY_SECOND = np.array([[16.0, 4.0, -16.0, 4.0], [-36.0, -10.0, 36.0, -8.0],
+                                            [24.0, 8.0, -24.0, 5.0], [-4.0, -2.0, 5.0, -1.0]])
+
+
+def normalized_zmp_map(kappa: float) -> Array:
+    """Eq. 7 with ``l/g`` replaced by ``kappa``: ZMP boundary from pelvis boundary, unit-time interval.
+
+    .. math::
+        M(\\kappa) = \\begin{bmatrix} 1+6\\kappa & 4\\kappa & -6\\kappa & 2\\kappa \\\\
+        -12\\kappa & 1-6\\kappa & 12\\kappa & -6\\kappa \\\\
+        -6\\kappa & -2\\kappa & 1+6\\kappa & -4\\kappa \\\\
+        -12\\kappa & -6\\kappa & 12\\kappa & 1-6\\kappa \\end{bmatrix}
+    """
+    k = kappa
+    return np.array([
+        [1 + 6 * k, 4 * k, -6 * k, 2 * k],
+        [-12 * k, 1 - 6 * k, 12 * k, -6 * k],
+        [-6 * k, -2 * k, 1 + 6 * k, -4 * k],
+        [-12 * k, -6 * k, 12 * k, 1 - 6 * k],
+    ])
+
+
+def zmp_from_pelvis_boundary(duration: float, pendulum_length: float, gravity: float = 9.81) -> Array:
+    """Map pelvis boundary values to ZMP boundary values for an interval of ``duration`` seconds.
+
+    Both vectors are ``[x(0) [m], x'(0) [m/s], x(T) [m], x'(T) [m/s]]``. At
+    ``duration = 1`` s this is the printed Eq. 7.
+
+    Raises:
+        InvalidParameterError: A non-positive duration, length or gravity.
+    """
+    for name, value in (("duration", duration), ("pendulum_length", pendulum_length), ("gravity", gravity)):
+        if not np.isfinite(value) or value <= 0:
+            raise InvalidParameterError(name, value, "a finite value > 0")
+    kappa = pendulum_length / (gravity * duration**2)  # l/(g T^2), the time-scaled l/g of Eq. 7
+    scale = np.diag([1.0, duration, 1.0, duration])  # physical -> per unit normalised time
+    return np.linalg.solve(scale, normalized_zmp_map(kappa) @ scale)
+
+
+def pelvis_from_zmp_boundary(duration: float, pendulum_length: float, gravity: float = 9.81) -> Array:
+    """Inverse of :func:`zmp_from_pelvis_boundary`: pelvis boundary values from a designed ZMP."""
+    return np.linalg.inv(zmp_from_pelvis_boundary(duration, pendulum_length, gravity))
+
+
+def half_interval_zmp_map(pendulum_length_over_gravity: float) -> Array:
+    """Eq. 9: the ZMP map of a half step, velocities per unit (whole) step time.
+
+    Derived as Eq. 7 on an interval of length 1/2: ``kappa = 4 l/g`` and the
+    velocities rescaled by 2; the result is the printed matrix with entries
+    ``24 l/g``, ``8 l/g``, ``96 l/g``, ``4 l/g``.
+    """
+    kappa = 4.0 * pendulum_length_over_gravity
+    scale = np.diag([1.0, 0.5, 1.0, 0.5])  # per unit step time -> per unit half-step time
+    return np.linalg.solve(scale, normalized_zmp_map(kappa) @ scale)
+
+
+def cart_table_zmp(position: Array, acceleration: Array, pendulum_length: float, gravity: float = 9.81) -> Array:
+    """Eqs. 1-2: ZMP of a point mass at constant height ``l`` [m], from position [m] and acceleration [m/s^2]."""
+    return np.asarray(position) - (pendulum_length / gravity) * np.asarray(acceleration)
+
+
+def convex_hull(points: Array) -> Array:
+    """Convex hull of 2-D points, counter-clockwise, without repeated points (monotone chain)."""
+    pts = np.unique(np.round(np.asarray(points, dtype=float), 12), axis=0)
+    if len(pts) <= 2:
+        return pts
+
+    def half(sequence: Array) -> list[Array]:
+        chain: list[Array] = []
+        for p in sequence:
+            while len(chain) >= 2:
+                a, b = chain[-2], chain[-1]
+                if (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) > 0:
+                    break
+                chain.pop()
+            chain.append(p)
+        return chain
+
+    lower = half(pts)
+    upper = half(pts[::-1])
+    return np.array(lower[:-1] + upper[:-1])
+
+
+def signed_margin(points: Array, polygon: Array) -> Array:
+    """Signed distance of points to a convex polygon's boundary [m]: > 0 inside, < 0 outside.
+
+    Args:
+        points: Shape (n, 2).
+        polygon: Convex polygon, counter-clockwise, shape (m, 2).
+    """
+    pts = np.atleast_2d(points)
+    a = polygon
+    b = np.roll(polygon, -1, axis=0)
+    edge = b - a
+    length = np.linalg.norm(edge, axis=1)
+    normal_in = np.stack([-edge[:, 1], edge[:, 0]], axis=1) / length[:, None]  # left of a CCW edge
+    rel = pts[:, None, :] - a[None, :, :]
+    inside_distance = np.einsum("nmk,mk->nm", rel, normal_in)
+    inside = np.all(inside_distance >= 0, axis=1)
+    along = np.clip(np.einsum("nmk,mk->nm", rel, edge) / (length**2)[None, :], 0.0, 1.0)
+    nearest = a[None, :, :] + along[:, :, None] * edge[None, :, :]
+    outside_distance = np.min(np.linalg.norm(pts[:, None, :] - nearest, axis=2), axis=1)
+    return np.where(inside, np.min(inside_distance, axis=1), -outside_distance)
