@@ -219,5 +219,6 @@ def _check_clearance(stage: StagePlan, robot: RobotModel, command: StepCommand) 
         value = getattr(command, name)
         raise InvalidParameterError(
             name, value, "a step whose landing foot does not overlap the supporting foot "
-            f"(the {('left' if stage.swing == LEFT else 'right')} sole would land on the other one)",
+            f"(the {('left' if stage.swing == LEFT else 'right')} sole would land on the other one; "
+            "split a large turn into several steps, or open the stance with a side step towards it, Fig. 19)",
         )

@@ -149,8 +149,6 @@ class Schedule:
             self._forward_d1 = float(forward["d1"])
             self._forward_alpha1 = float(forward["alpha1"])
             self._forward_beta1 = float(forward["beta1"])
-            self._recovery_alpha1 = float(side["recovery_alpha1"])
-            self._recovery_beta1 = float(side["recovery_beta1"])
         except (KeyError, TypeError, ValueError) as error:
             raise FileFormatError(source, f"malformed schedule: {error}") from None
 
@@ -199,7 +197,7 @@ class Schedule:
             up_ratio = side_row["up_ratio"]
             open_alpha1, open_beta1 = side_row["alpha1"], side_row["beta1"]
             open_d1, recovery_d1 = side_row["d1_open"], side_row["d1_recovery"]
-            recovery_alpha1, recovery_beta1 = self._recovery_alpha1, self._recovery_beta1
+            recovery_alpha1, recovery_beta1 = open_alpha1, open_beta1
             source = _worse(source, side_source)
         common = {
             "alpha": alpha, "up_ratio": up_ratio, "sway": sway,

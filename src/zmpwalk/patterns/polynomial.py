@@ -56,6 +56,39 @@ from zmpwalk.zmp import convex_hull
 
 Array = NDArray[np.float64]
 
+SHIFT_NONE = 0
+SHIFT_OPEN = 1
+SHIFT_RECOVERY = 2
+SHIFT_PROFILES = {"open": SHIFT_OPEN, "recovery": SHIFT_RECOVERY}
+
+
+def side_shift_profile(tau: Array, profile: NDArray[np.integer]) -> curves.Curve:
+    """Pelvis shift of side walking (Eqs. 15-16) as a fraction of a stage's shift, per unit ``tau``.
+
+    The paper moves the pelvis sideways from the middle of the open-stance
+    stage ``t0`` to the end of it and from the start of the recovery to its
+    ``t0``, each a half cosine that stops at the step change. zmpwalk joins the
+    two into one cosine from ``t0`` of the open stance to ``t0`` of the
+    recovery, so the pelvis keeps its sideways speed through the step change
+    instead of stopping and restarting there: same timing and amplitude, the
+    acceleration (and so the cart-table ZMP) no longer jumps at the step change.
+
+    * open: ``0`` for ``tau < 1/2``, then ``1 - cos(pi (tau - 1/2))``;
+    * recovery: ``sin(pi tau)`` for ``tau < 1/2``, then ``1``;
+    * other stages: ``0``.
+    """
+    opening = profile == SHIFT_OPEN
+    recovering = profile == SHIFT_RECOVERY
+    late = np.clip(tau - 0.5, 0.0, 0.5)
+    early = np.clip(tau, 0.0, 0.5)
+    value = np.where(opening, 1.0 - np.cos(np.pi * late), np.where(recovering, np.sin(np.pi * early), 0.0))
+    rate = np.where(opening & (tau >= 0.5), np.pi * np.sin(np.pi * late),
+                    np.where(recovering & (tau < 0.5), np.pi * np.cos(np.pi * early), 0.0))
+    curvature = np.where(opening & (tau >= 0.5), np.pi**2 * np.cos(np.pi * late),
+                         np.where(recovering & (tau < 0.5), -np.pi**2 * np.sin(np.pi * early), 0.0))
+    return value, rate, curvature
+
+
 SUPPORT_DOUBLE = 0
 SUPPORT_LEFT = 1
 SUPPORT_RIGHT = 2
@@ -92,8 +125,8 @@ class Stage:
     dsp_time: float  # [s] d
     base_start: tuple[float, float]  # [m] ankles' middle at t1
     base_sagittal: tuple[float, float]  # [m] part of the middle's motion done by the cubic
-    base_lateral: tuple[float, float]  # [m] part done by the half cosine (side walking)
-    lateral_in_first_half: bool
+    base_lateral: tuple[float, float]  # [m] part done by the side-walking shift (Eqs. 15-16)
+    lateral_profile: int  # SHIFT_* code
     base_slope_start: tuple[float, float]  # [m] per unit tau
     base_slope_end: tuple[float, float]  # [m] per unit tau
     sway_direction: tuple[float, float]  # unit vector, left of the supporting foot
@@ -130,15 +163,19 @@ def build_stage(plan: StagePlan, boundary: Boundary) -> Stage:
         w1 = -toward_support * p.alpha1 * p.lateral_velocity / half_time_scale  # [m/s], Eq. 20
         yaw_end = 0.5 * (support.yaw + plan.swing_end.yaw)
         v1 = p.alpha * plan.forward / T * np.array([math.cos(yaw_end), math.sin(yaw_end)])  # Eq. 13
-    v0_base = v_prev - w0 * n
     middle_start = 0.5 * (np.array([support.x, support.y]) + [plan.swing_start.x, plan.swing_start.y])
     middle_end = 0.5 * (np.array([support.x, support.y]) + [plan.swing_end.x, plan.swing_end.y])
     shift = middle_end - middle_start
-    lateral = float(shift @ n) * n
+    profile = SHIFT_PROFILES.get(plan.kind, SHIFT_NONE)
+    lateral = float(shift @ n) * n if profile != SHIFT_NONE else np.zeros(2)
     sagittal = shift - lateral
+    _, lateral_rate_start, _ = side_shift_profile(np.array([0.0]), np.array([profile]))
+    _, lateral_rate_end, _ = side_shift_profile(np.array([1.0]), np.array([profile]))
+    v0_base = v_prev - w0 * n - lateral * float(lateral_rate_start[0]) / T
+    v_end = v1 + lateral * float(lateral_rate_end[0]) / T + w1 * n  # total pelvis velocity at t2
     end = Boundary(
         time=boundary.time + T,
-        pelvis_velocity=(float(v1[0] + w1 * n[0]), float(v1[1] + w1 * n[1])),
+        pelvis_velocity=_pair(v_end),
         sway_velocity=(float(w1 * n[0]), float(w1 * n[1])),
         at_rest=plan.stop,
     )
@@ -150,7 +187,7 @@ def build_stage(plan: StagePlan, boundary: Boundary) -> Stage:
         base_start=_pair(middle_start),
         base_sagittal=_pair(sagittal),
         base_lateral=_pair(lateral),
-        lateral_in_first_half=float(shift @ n) * toward_support > 0,
+        lateral_profile=profile,
         base_slope_start=_pair(v0_base * T),
         base_slope_end=_pair(v1 * T),
         sway_direction=_pair(n),
@@ -190,7 +227,7 @@ def standing_stage(plan: StagePlan, start: float) -> Stage:
     zero = (0.0, 0.0)
     return Stage(
         plan=plan, start=start, duration=1.0, dsp_time=0.0, base_start=_pair(middle), base_sagittal=zero,
-        base_lateral=zero, lateral_in_first_half=False, base_slope_start=zero, base_slope_end=zero,
+        base_lateral=zero, lateral_profile=SHIFT_NONE, base_slope_start=zero, base_slope_end=zero,
         sway_direction=(0.0, 1.0), sway_amplitude=0.0, sway_slope_start=0.0, sway_slope_end=0.0,
         sway_out_time=0.5, sway_back_time=0.5,
         standing=True, grounded=True, end=Boundary(math.inf),
@@ -228,7 +265,7 @@ class StageTable:
         self.base0 = np.array([s.base_start for s in stages])
         self.base_sag = np.array([s.base_sagittal for s in stages])
         self.base_lat = np.array([s.base_lateral for s in stages])
-        self.lat_first = np.array([s.lateral_in_first_half for s in stages])
+        self.lat_profile = np.array([s.lateral_profile for s in stages])
         self.m0 = np.array([s.base_slope_start for s in stages])
         self.m1 = np.array([s.base_slope_end for s in stages])
         self.n = np.array([s.sway_direction for s in stages])
@@ -297,16 +334,11 @@ def evaluate(table: StageTable, time: Array, robot: RobotModel, index: NDArray[n
     base0 = table.base0[k]
     base_sag = table.base_sag[k]
     pos, slope, curv = curves.hermite_cubic(0.0 * base0, table.m0[k], base_sag, table.m1[k], tau[:, None])
-    first = table.lat_first[k]
-    half = np.where(first, np.clip(2 * tau, 0.0, 1.0), np.clip(2 * tau - 1, 0.0, 1.0))
-    active = np.where(first, tau < 0.5, tau >= 0.5)
-    q, q1, q2 = curves.cosine_blend(half)
-    q1 = np.where(active, q1, 0.0)
-    q2 = np.where(active, q2, 0.0)
+    q, q1, q2 = side_shift_profile(tau, table.lat_profile[k])
     lat = table.base_lat[k]
     pelvis_xy = base0 + pos + lat * q[:, None]
-    pelvis_v = (slope + lat * (2 * q1)[:, None]) / T[:, None]
-    pelvis_a = (curv + lat * (4 * q2)[:, None]) / (T * T)[:, None]
+    pelvis_v = (slope + lat * q1[:, None]) / T[:, None]
+    pelvis_a = (curv + lat * q2[:, None]) / (T * T)[:, None]
     # --- pelvis sway: Eqs. 18-20 on the modified time t_bar (sigma = 2 t_bar, or 2 t_bar - 1)
     amp = table.amp[k]
     elapsed = t - table.start[k]
