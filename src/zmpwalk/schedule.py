@@ -152,6 +152,15 @@ class Schedule:
         except (KeyError, TypeError, ValueError) as error:
             raise FileFormatError(source, f"malformed schedule: {error}") from None
 
+    def conditions(self) -> list[tuple[str, float, float]]:
+        """The tabulated conditions: ``("forward", step time [s], stride [m])`` and ``("side", ..., side step [m])``."""
+        result = []
+        for mode, grid in (("forward", self._forward), ("side", self._side)):
+            for duration in sorted(grid.by_duration, reverse=True):
+                for row in grid.by_duration[duration]:
+                    result.append((mode, float(duration), float(row[grid.key_index])))
+        return result
+
     def _on_spot_row(self, duration: float) -> np.ndarray:
         """Stepping on the spot as a Table 3 row (side step 0) at a tabulated step time."""
         on_spot, _ = self._forward.lookup(duration, 0.0)

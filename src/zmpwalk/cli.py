@@ -1,0 +1,153 @@
+"""The ``zmpwalk`` command.
+
+Errors print one line, ``zmpwalk: error: ...``, and exit with status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from zmpwalk.commands import StepCommand
+from zmpwalk.errors import ZmpwalkError
+from zmpwalk.patterns.polynomial import generate
+from zmpwalk.patterns.result import WalkingPattern
+from zmpwalk.robots import list_robots, load_robot
+from zmpwalk.scenarios import list_scenarios, load_scenario, load_steps_file
+from zmpwalk.tables import condition_margins, margins_markdown
+
+EXIT_ERROR = 2
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # one line, no usage dump
+        raise _UsageError(message)
+
+
+class _UsageError(Exception):
+    pass
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="zmpwalk",
+        description="Online ZMP walking patterns for biped humanoids (HUBO polynomial pattern).",
+        epilog="example: zmpwalk plan --scenario fig28 --rate 1000 --out fig28.csv",
+    )
+    commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    scenarios = commands.add_parser(
+        "scenarios", help="list the built-in scenarios",
+        description="List the built-in scenarios (the paper's experiments).", epilog="example: zmpwalk scenarios",
+    )
+    scenarios.add_argument("--json", action="store_true", help="print a JSON object name -> description")
+
+    plan = commands.add_parser(
+        "plan", help="generate a walking pattern and write it as CSV",
+        description="Generate the walking pattern of a steps file or a scenario, write one CSV row per "
+        "sample (world frame, SI units) and print the smallest ZMP margin.",
+        epilog="example: zmpwalk plan --scenario fig30 --out fig30.csv   |   zmpwalk plan my_steps.toml",
+    )
+    plan.add_argument("steps", nargs="?", help="steps file (TOML, [[steps]] tables)")
+    plan.add_argument("--scenario", help="a built-in scenario instead of a steps file (see 'zmpwalk scenarios')")
+    plan.add_argument("--robot", default="hubo", help=f"built-in robot ({', '.join(list_robots())}) or a robot "
+                      "file (default: hubo)")
+    plan.add_argument("--rate", type=float, default=100.0, help="samples per second [Hz] (default: 100)")
+    plan.add_argument("--out", type=Path, help="CSV file to write")
+    plan.add_argument("--json", action="store_true", help="print a JSON summary")
+
+    tables = commands.add_parser(
+        "tables", help="walk every condition of Tables 2-3 and print the ZMP margins",
+        description="Walk each tuned condition of the parameter tables (Tables 2 and 3) for a number of "
+        "steps at 1 kHz and print the smallest cart-table ZMP margin of each as a Markdown table.",
+        epilog="example: zmpwalk tables --steps 10",
+    )
+    tables.add_argument("--robot", default="hubo", help="robot name or file (default: hubo)")
+    tables.add_argument("--steps", type=int, default=10, help="steps walked per condition (default: 10)")
+    tables.add_argument("--json", action="store_true", help="print JSON instead of Markdown")
+    return parser
+
+
+def _commands(args: argparse.Namespace) -> list[StepCommand]:
+    if args.scenario and args.steps:
+        raise _UsageError("give either a steps file or --scenario, not both")
+    if args.scenario:
+        return load_scenario(args.scenario)
+    if args.steps:
+        return load_steps_file(args.steps)
+    raise _UsageError("give a steps file or --scenario NAME (see 'zmpwalk scenarios')")
+
+
+def _summary(pattern: WalkingPattern) -> dict[str, object]:
+    margin, at = pattern.min_zmp_margin()
+    left, right = pattern.position_left_ankle_in_world[-1], pattern.position_right_ankle_in_world[-1]
+    return {
+        "generator": pattern.generator,
+        "robot": pattern.robot.name,
+        "rate": pattern.rate,
+        "duration": pattern.duration,
+        "samples": len(pattern.time),
+        "swings": len([s for s in pattern.steps if s.kind not in ("start", "settle")]),
+        "min_zmp_margin": margin,
+        "min_zmp_margin_time": at,
+        "final_left_ankle": [float(v) for v in left],
+        "final_right_ankle": [float(v) for v in right],
+    }
+
+
+def _run(args: argparse.Namespace) -> int:
+    if args.command == "scenarios":
+        scenarios = list_scenarios()
+        if args.json:
+            print(json.dumps(scenarios, indent=2))
+        else:
+            width = max(len(name) for name in scenarios)
+            for name, description in scenarios.items():
+                print(f"{name:<{width}}  {description}")
+        return 0
+    if args.command == "plan":
+        commands = _commands(args)
+        robot = load_robot(args.robot)
+        pattern = generate(robot, commands, rate=args.rate)
+        if args.out:
+            pattern.write_csv(args.out)
+        summary = _summary(pattern)
+        if args.json:
+            print(json.dumps(summary, indent=2))
+        else:
+            margin = float(summary["min_zmp_margin"])  # type: ignore[arg-type]
+            verdict = "inside the support polygon" if margin >= 0 else "OUTSIDE the support polygon"
+            print(f"{summary['swings']} swings, {pattern.duration:.3f} s, {len(pattern.time)} samples at "
+                  f"{args.rate:g} Hz" + (f" -> {args.out}" if args.out else ""))
+            print(f"min ZMP margin: {margin * 1e3:+.1f} mm at t = {summary['min_zmp_margin_time']:.3f} s "
+                  f"({verdict})")
+        return 0
+    if args.command == "tables":
+        if args.steps < 1:
+            raise _UsageError(f"--steps = {args.steps} must be >= 1")
+        results = condition_margins(load_robot(args.robot), steps=args.steps)
+        if args.json:
+            print(json.dumps([vars(r) for r in results], indent=2))
+        else:
+            print(margins_markdown(results))
+        return 0
+    raise _UsageError(f"unknown command {args.command!r}")  # pragma: no cover
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``zmpwalk`` command; returns the exit status."""
+    try:
+        args = _parser().parse_args(argv)
+        return _run(args)
+    except (ZmpwalkError, _UsageError) as error:
+        print(f"zmpwalk: error: {error}", file=sys.stderr)
+        return EXIT_ERROR
+    except KeyboardInterrupt:
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,230 @@
+"""Online use: :class:`OnlineWalker` takes step commands and returns samples at the control rate.
+
+.. code-block:: python
+
+    walker = OnlineWalker(load_robot("hubo"), rate=1000)
+    walker.command(StepCommand(duration=0.8, forward=0.2))
+    while running:
+        sample = walker.tick()          # one sample per control period
+        send(sample.position_pelvis_in_world, ...)
+        if operator_has_new_step:
+            walker.command(next_step)   # queues or replaces the next step's command
+
+Behaviour:
+
+* The walker starts standing in the ready posture. The first command starts a
+  walk (with the start stage of :func:`zmpwalk.patterns.polynomial.plan_next`).
+* :meth:`OnlineWalker.command` queues the command that runs after the step
+  now under way, or replaces the one queued before it started. The command is
+  planned and checked at once: a rejected command raises and leaves the walker
+  exactly as it was (the queued command, if any, stays).
+* If no command is queued when the step under way ends, the walker stops
+  safely: a closing step of the last step time (the swinging foot lands beside
+  the other one) and a settle stage, after which it stands still in the ready
+  posture until the next command. :meth:`OnlineWalker.stop` asks for the same
+  explicitly.
+* The trajectories of a command are sampled when the command is queued, so a
+  :meth:`~OnlineWalker.tick` only reads a row; the tick that begins an
+  automatic stop also samples the stop.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zmpwalk.commands import StepCommand
+from zmpwalk.errors import InvalidParameterError
+from zmpwalk.footsteps import Stance
+from zmpwalk.patterns.polynomial import (
+    Boundary,
+    Stage,
+    StageTable,
+    check_rate,
+    evaluate,
+    plan_next,
+)
+from zmpwalk.patterns.result import SUPPORT_NAMES
+from zmpwalk.robots.model import RobotModel
+from zmpwalk.schedule import Schedule
+
+Array = NDArray[np.float64]
+
+# Columns of a sampled row.
+_PELVIS, _PELVIS_YAW = slice(0, 3), 3
+_LEFT, _LEFT_YAW = slice(4, 7), 7
+_RIGHT, _RIGHT_YAW = slice(8, 11), 11
+_ZMP, _SUPPORT = slice(12, 14), 14
+_WIDTH = 15
+_EPS = 1e-9
+
+
+@dataclass(frozen=True, slots=True)
+class WalkingSample:
+    """The pattern at one control tick, in world (SI).
+
+    Attributes:
+        time: [s].
+        support: ``"double"``, ``"left"`` or ``"right"``.
+        position_pelvis_in_world: Pelvis centre [m], shape (3,).
+        yaw_pelvis_in_world: [rad].
+        position_left_ankle_in_world, position_right_ankle_in_world: [m], shape (3,).
+        yaw_left_foot_in_world, yaw_right_foot_in_world: [rad].
+        zmp_in_world: Cart-table ZMP [m], shape (2,).
+    """
+
+    time: float
+    support: str
+    position_pelvis_in_world: Array
+    yaw_pelvis_in_world: float
+    position_left_ankle_in_world: Array
+    yaw_left_foot_in_world: float
+    position_right_ankle_in_world: Array
+    yaw_right_foot_in_world: float
+    zmp_in_world: Array
+
+
+@dataclass
+class _Plan:
+    command: StepCommand
+    stages: list[Stage]
+    stance: Stance
+    boundary: Boundary
+    rows: Array
+    first_index: int
+
+
+class OnlineWalker:
+    """Step-by-step generator of the HUBO pattern for a control loop.
+
+    Args:
+        robot: The robot.
+        rate: Control rate [Hz] (HUBO: 100 Hz; 1 kHz servo loops are common).
+        schedule: Parameter tables (Tables 2-3 of the paper by default).
+    """
+
+    def __init__(self, robot: RobotModel, rate: float = 100.0, schedule: Schedule | None = None) -> None:
+        check_rate(rate)
+        self.robot = robot
+        self.rate = float(rate)
+        self._schedule = schedule or Schedule.hubo()
+        self._index = 0
+        self._stance = Stance.ready(robot)
+        self._boundary = Boundary(0.0)
+        self._current: _Plan | None = None
+        self._pending: _Plan | None = None
+        self._last_duration = 0.8
+        self._standing = self._standing_row(self._stance)
+
+    @property
+    def time(self) -> float:
+        """Time of the next tick [s]."""
+        return self._index / self.rate
+
+    @property
+    def walking(self) -> bool:
+        """True while a walk is under way or queued (False: standing still)."""
+        return self._current is not None or self._pending is not None
+
+    @property
+    def queued(self) -> StepCommand | None:
+        """The command waiting for the step under way to end, if any."""
+        return self._pending.command if self._pending else None
+
+    def command(self, command: StepCommand) -> None:
+        """Queue ``command`` after the step under way, replacing a queued one.
+
+        Raises:
+            ZmpwalkError: The command is not feasible from where the walk will
+                be when it starts; the walker is unchanged.
+        """
+        if not isinstance(command, StepCommand):
+            raise InvalidParameterError("command", command, "a StepCommand")
+        stance, boundary = self._stance, self._boundary
+        if boundary.at_rest:
+            boundary = Boundary(max(boundary.time, self.time))
+        stages, next_stance, next_boundary = plan_next(self.robot, self._schedule, stance, boundary, command)
+        if not stages:  # a stop while standing
+            self._pending = None
+            return
+        first_index = math.ceil(stages[0].start * self.rate - _EPS)
+        rows = self._sample(stages, first_index, next_boundary.time)
+        self._pending = _Plan(command, stages, next_stance, next_boundary, rows, first_index)
+
+    def stop(self) -> None:
+        """Queue a closing step into the ready posture (nothing happens when standing)."""
+        self.command(StepCommand(duration=self._last_duration, stop=True))
+
+    def tick(self) -> WalkingSample:
+        """The sample at :attr:`time`, then advance by one control period."""
+        index = self._index
+        current = self._current
+        if current is None or index >= current.first_index + len(current.rows):
+            current = self._advance(index)
+        self._index = index + 1
+        row = self._standing if current is None else current.rows[index - current.first_index]
+        return WalkingSample(
+            time=index / self.rate,
+            support=SUPPORT_NAMES[int(row[_SUPPORT])],
+            position_pelvis_in_world=row[_PELVIS],
+            yaw_pelvis_in_world=float(row[_PELVIS_YAW]),
+            position_left_ankle_in_world=row[_LEFT],
+            yaw_left_foot_in_world=float(row[_LEFT_YAW]),
+            position_right_ankle_in_world=row[_RIGHT],
+            yaw_right_foot_in_world=float(row[_RIGHT_YAW]),
+            zmp_in_world=row[_ZMP],
+        )
+
+    def _advance(self, index: int) -> _Plan | None:
+        """Make the queued (or an automatic stop) command current; None when standing."""
+        while True:
+            if self._pending is None and not self._boundary.at_rest:
+                self.stop()
+            plan = self._pending
+            self._pending = None
+            if plan is None:
+                self._current = None
+                return None
+            self._current = plan
+            self._stance, self._boundary = plan.stance, plan.boundary
+            if not plan.command.stop:
+                self._last_duration = plan.command.duration
+            if plan.boundary.at_rest:
+                self._standing = self._standing_row(plan.stance)
+            if index < plan.first_index + len(plan.rows):
+                return plan
+
+    def _sample(self, stages: list[Stage], first_index: int, end_time: float) -> Array:
+        stop_index = math.ceil(end_time * self.rate - _EPS)
+        times = np.arange(first_index, stop_index) / self.rate
+        rows = np.empty((len(times), _WIDTH))
+        if len(times) == 0:
+            return rows
+        samples = evaluate(StageTable(stages), times, self.robot)
+        rows[:, 0:2] = samples.pelvis_xy
+        rows[:, 2] = self.robot.pelvis_height
+        rows[:, _PELVIS_YAW] = samples.pelvis_yaw
+        rows[:, _LEFT] = samples.left_position
+        rows[:, _LEFT_YAW] = samples.left_yaw
+        rows[:, _RIGHT] = samples.right_position
+        rows[:, _RIGHT_YAW] = samples.right_yaw
+        rows[:, _ZMP] = samples.zmp_xy
+        rows[:, _SUPPORT] = samples.support
+        return rows
+
+    def _standing_row(self, stance: Stance) -> Array:
+        middle = np.array([(stance.left.x + stance.right.x) / 2, (stance.left.y + stance.right.y) / 2])
+        row = np.zeros(_WIDTH)
+        row[0:2] = middle
+        row[2] = self.robot.pelvis_height
+        row[_PELVIS_YAW] = (stance.left.yaw + stance.right.yaw) / 2
+        row[_LEFT] = (stance.left.x, stance.left.y, self.robot.ankle_height)
+        row[_LEFT_YAW] = stance.left.yaw
+        row[_RIGHT] = (stance.right.x, stance.right.y, self.robot.ankle_height)
+        row[_RIGHT_YAW] = stance.right.yaw
+        row[_ZMP] = middle
+        row[_SUPPORT] = 0
+        return row
