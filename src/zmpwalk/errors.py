@@ -64,6 +64,7 @@ class UnreachableError(ZmpwalkError, ValueError):
         self.leg = leg
         self.time = time
         self.excess = excess
+        self.stage = -1  # index of the stage, where the caller knows it
         extra = f" ({detail})" if detail else ""
         super().__init__(
             f"{leg} ankle out of reach by {excess * 1e3:.1f} mm at t = {time:.3f} s{extra}"

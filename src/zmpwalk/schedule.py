@@ -151,6 +151,7 @@ class Schedule:
             self._forward_beta1 = float(forward["beta1"])
         except (KeyError, TypeError, ValueError) as error:
             raise FileFormatError(source, f"malformed schedule: {error}") from None
+        self._cache: dict[tuple[object, ...], tuple[ShapeParameters, ShapeParameters]] = {}
 
     def conditions(self) -> list[tuple[str, float, float]]:
         """The tabulated conditions: ``("forward", step time [s], stride [m])`` and ``("side", ..., side step [m])``."""
@@ -192,6 +193,17 @@ class Schedule:
         Overrides in ``command`` replace the scheduled values; the robot gives
         the values the tables do not hold (``d``, foot lift, ``V_y``).
         """
+        key = (command, robot.lateral_velocity, robot.dsp_time, robot.foot_lift)
+        cached = self._cache.get(key)
+        if cached is None:
+            if len(self._cache) > 4096:
+                self._cache.clear()
+            cached = self._cache[key] = self._stage_parameters(command, robot)
+        return cached
+
+    def _stage_parameters(
+        self, command: StepCommand, robot: RobotModel
+    ) -> tuple[ShapeParameters, ShapeParameters]:
         stride = abs(command.forward)
         row, source = self._forward.lookup(command.duration, stride)
         alpha = row["alpha"]

@@ -97,24 +97,24 @@ def cart_table_zmp(position: Array, acceleration: Array, pendulum_length: float,
 
 
 def convex_hull(points: Array) -> Array:
-    """Convex hull of 2-D points, counter-clockwise, without repeated points (monotone chain)."""
-    pts = np.unique(np.round(np.asarray(points, dtype=float), 12), axis=0)
+    """Convex hull of 2-D points, counter-clockwise, without repeated or collinear points (monotone chain)."""
+    pts = sorted({(float(x), float(y)) for x, y in np.asarray(points, dtype=float)})
     if len(pts) <= 2:
-        return pts
+        return np.array(pts)
 
-    def half(sequence: Array) -> list[Array]:
-        chain: list[Array] = []
-        for p in sequence:
-            while len(chain) >= 2:
-                a, b = chain[-2], chain[-1]
-                if (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) > 0:
-                    break
-                chain.pop()
-            chain.append(p)
-        return chain
+    def cross(o: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
 
-    lower = half(pts)
-    upper = half(pts[::-1])
+    lower: list[tuple[float, float]] = []
+    for p in pts:
+        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
+            lower.pop()
+        lower.append(p)
+    upper: list[tuple[float, float]] = []
+    for p in reversed(pts):
+        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
+            upper.pop()
+        upper.append(p)
     return np.array(lower[:-1] + upper[:-1])
 
 

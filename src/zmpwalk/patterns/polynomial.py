@@ -40,19 +40,19 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk import curves
 from zmpwalk.commands import StepCommand
-from zmpwalk.errors import InvalidParameterError, ZmpwalkError
-from zmpwalk.footsteps import GROUNDED_STRETCH, LEFT, Pose2D, Stance, StagePlan, foot_corners, grounded_stage, plan_command
+from zmpwalk.errors import InvalidParameterError, UnreachableError, ZmpwalkError
+from zmpwalk.footsteps import GROUNDED_STRETCH, LEFT, Pose2D, Stance, StagePlan, grounded_stage, plan_command
 from zmpwalk.kinematics import check_leg_reach
 from zmpwalk.patterns.result import StepRecord, SupportPhase, WalkingPattern
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
-from zmpwalk.zmp import convex_hull
 
 Array = NDArray[np.float64]
 
@@ -60,6 +60,8 @@ SHIFT_NONE = 0
 SHIFT_OPEN = 1
 SHIFT_RECOVERY = 2
 SHIFT_PROFILES = {"open": SHIFT_OPEN, "recovery": SHIFT_RECOVERY}
+# d(profile)/d(tau) at tau = 0 and tau = 1 of side_shift_profile
+SHIFT_END_RATES = {SHIFT_NONE: (0.0, 0.0), SHIFT_OPEN: (0.0, math.pi), SHIFT_RECOVERY: (math.pi, 0.0)}
 
 
 def side_shift_profile(tau: Array, profile: NDArray[np.integer]) -> curves.Curve:
@@ -169,10 +171,9 @@ def build_stage(plan: StagePlan, boundary: Boundary) -> Stage:
     profile = SHIFT_PROFILES.get(plan.kind, SHIFT_NONE)
     lateral = float(shift @ n) * n if profile != SHIFT_NONE else np.zeros(2)
     sagittal = shift - lateral
-    _, lateral_rate_start, _ = side_shift_profile(np.array([0.0]), np.array([profile]))
-    _, lateral_rate_end, _ = side_shift_profile(np.array([1.0]), np.array([profile]))
-    v0_base = v_prev - w0 * n - lateral * float(lateral_rate_start[0]) / T
-    v_end = v1 + lateral * float(lateral_rate_end[0]) / T + w1 * n  # total pelvis velocity at t2
+    lateral_rate_start, lateral_rate_end = SHIFT_END_RATES[profile]
+    v0_base = v_prev - w0 * n - lateral * lateral_rate_start / T
+    v_end = v1 + lateral * lateral_rate_end / T + w1 * n  # total pelvis velocity at t2
     end = Boundary(
         time=boundary.time + T,
         pelvis_velocity=_pair(v_end),
@@ -239,41 +240,54 @@ def _pair(vector: Array) -> tuple[float, float]:
 
 
 class StageTable:
-    """Stages as column arrays, so that many samples evaluate in one vectorised pass."""
+    """Stages as one-dimensional column arrays, so that many samples evaluate in one vectorised pass."""
 
     def __init__(self, stages: list[Stage]) -> None:
         self.stages = stages
-        self.start = np.array([s.start for s in stages])
-        self.duration = np.array([s.duration for s in stages])
-        self.dsp = np.array([s.dsp_time for s in stages])
-        self.swing_left = np.array([s.plan.swing == LEFT for s in stages])
-        self.standing = np.array([s.standing for s in stages])
-        self.grounded = np.array([s.grounded for s in stages])
-        self.support_xy = np.array([[s.plan.support_pose.x, s.plan.support_pose.y] for s in stages])
-        self.support_yaw = np.array([s.plan.support_pose.yaw for s in stages])
-        self.swing_xy0 = np.array([[s.plan.swing_start.x, s.plan.swing_start.y] for s in stages])
-        self.swing_yaw0 = np.array([s.plan.swing_start.yaw for s in stages])
-        self.swing_dyaw = np.array([s.plan.swing_end.yaw - s.plan.swing_start.yaw for s in stages])
-        displacement = np.array([[s.plan.swing_end.x - s.plan.swing_start.x,
-                                  s.plan.swing_end.y - s.plan.swing_start.y] for s in stages])
-        heading = np.stack([np.cos(self.support_yaw), np.sin(self.support_yaw)], axis=1)
-        along = np.sum(displacement * heading, axis=1, keepdims=True) * heading
-        self.swing_along = along  # [m] cycloid part (Eq. 11)
-        self.swing_across = displacement - along  # [m] half-cosine part (Eqs. 14-17)
-        self.lift = np.array([0.0 if s.grounded else s.plan.parameters.foot_lift for s in stages])
-        self.up_ratio = np.array([s.plan.parameters.up_ratio for s in stages])
-        self.base0 = np.array([s.base_start for s in stages])
-        self.base_sag = np.array([s.base_sagittal for s in stages])
-        self.base_lat = np.array([s.base_lateral for s in stages])
-        self.lat_profile = np.array([s.lateral_profile for s in stages])
-        self.m0 = np.array([s.base_slope_start for s in stages])
-        self.m1 = np.array([s.base_slope_end for s in stages])
-        self.n = np.array([s.sway_direction for s in stages])
-        self.amp = np.array([s.sway_amplitude for s in stages])
-        self.w0 = np.array([s.sway_slope_start for s in stages])
-        self.w1 = np.array([s.sway_slope_end for s in stages])
-        self.out_time = np.array([s.sway_out_time for s in stages])
-        self.back_time = np.array([s.sway_back_time for s in stages])
+
+        def column(values: list[float] | list[bool] | list[int]) -> NDArray[Any]:
+            return np.array(values)
+
+        plans = [s.plan for s in stages]
+        self.start = column([s.start for s in stages])
+        self.duration = column([s.duration for s in stages])
+        self.dsp = column([s.dsp_time for s in stages])
+        self.swing_left = column([p.swing == LEFT for p in plans])
+        self.standing = column([s.standing for s in stages])
+        self.grounded = column([s.grounded for s in stages])
+        self.support_x = column([p.support_pose.x for p in plans])
+        self.support_y = column([p.support_pose.y for p in plans])
+        self.support_yaw = column([p.support_pose.yaw for p in plans])
+        self.swing_x0 = column([p.swing_start.x for p in plans])
+        self.swing_y0 = column([p.swing_start.y for p in plans])
+        self.swing_yaw0 = column([p.swing_start.yaw for p in plans])
+        self.swing_dyaw = column([p.swing_end.yaw - p.swing_start.yaw for p in plans])
+        dx = column([p.swing_end.x - p.swing_start.x for p in plans])
+        dy = column([p.swing_end.y - p.swing_start.y for p in plans])
+        hx, hy = np.cos(self.support_yaw), np.sin(self.support_yaw)
+        along = dx * hx + dy * hy
+        self.along_x, self.along_y = along * hx, along * hy  # [m] cycloid part (Eq. 11)
+        self.across_x, self.across_y = dx - self.along_x, dy - self.along_y  # [m] half-cosine part (Eqs. 14-17)
+        self.lift = column([0.0 if s.grounded else s.plan.parameters.foot_lift for s in stages])
+        self.up_ratio = column([p.parameters.up_ratio for p in plans])
+        self.base0_x = column([s.base_start[0] for s in stages])
+        self.base0_y = column([s.base_start[1] for s in stages])
+        self.sag_x = column([s.base_sagittal[0] for s in stages])
+        self.sag_y = column([s.base_sagittal[1] for s in stages])
+        self.lat_x = column([s.base_lateral[0] for s in stages])
+        self.lat_y = column([s.base_lateral[1] for s in stages])
+        self.lat_profile = column([s.lateral_profile for s in stages])
+        self.m0_x = column([s.base_slope_start[0] for s in stages])
+        self.m0_y = column([s.base_slope_start[1] for s in stages])
+        self.m1_x = column([s.base_slope_end[0] for s in stages])
+        self.m1_y = column([s.base_slope_end[1] for s in stages])
+        self.n_x = column([s.sway_direction[0] for s in stages])
+        self.n_y = column([s.sway_direction[1] for s in stages])
+        self.amp = column([s.sway_amplitude for s in stages])
+        self.w0 = column([s.sway_slope_start for s in stages])
+        self.w1 = column([s.sway_slope_end for s in stages])
+        self.out_time = column([s.sway_out_time for s in stages])
+        self.back_time = column([s.sway_back_time for s in stages])
 
     def index_at(self, time: Array) -> NDArray[np.intp]:
         """Index of the stage each time belongs to (a boundary time opens the next stage)."""
@@ -307,86 +321,136 @@ class Samples:
 
 
 def evaluate(table: StageTable, time: Array, robot: RobotModel, index: NDArray[np.intp] | None = None) -> Samples:
-    """Evaluate the stages at ``time`` (each sample in stage ``index``, default: its own stage)."""
+    """Evaluate the stages at ``time`` (each sample in stage ``index``, default: its own stage).
+
+    Works on one-dimensional component arrays throughout (numpy broadcasting
+    over a trailing axis of 2 or 3 is many times slower than plain vector ops).
+    """
     t = np.asarray(time, dtype=float)
     k = table.index_at(t) if index is None else index
+    n = len(t)
     T = table.duration[k]
     d = table.dsp[k]
-    tau = (t - table.start[k]) / T
+    elapsed = t - table.start[k]
+    tau = elapsed / T
     # --- swing ankle: Eq. 11 (cycloid) along, Eqs. 14-17 (half cosine) across, Fig. 12 height
     swing_span = T - d
-    raw = (t - table.start[k] - d / 2) / swing_span
+    raw = (elapsed - 0.5 * d) / swing_span
     in_swing = (raw > 0.0) & (raw < 1.0) & ~table.grounded[k]
     s = np.clip(raw, 0.0, 1.0)
-    rate = np.where(in_swing, 1.0 / swing_span, 0.0)
-    c, c1, _ = curves.cycloid(s)
-    b, b1, _ = curves.cosine_blend(s)
+    rate = in_swing / swing_span
+    b, b1, c, c1 = _blend_and_cycloid(s)
     h, h1, _ = curves.lift_profile(s, table.up_ratio[k])
-    along, across = table.swing_along[k], table.swing_across[k]
-    swing_xy = table.swing_xy0[k] + along * c[:, None] + across * b[:, None]
-    swing_vxy = (along * c1[:, None] + across * b1[:, None]) * rate[:, None]
+    b1 *= rate
+    c1 *= rate
+    ax, ay = table.along_x[k], table.along_y[k]
+    cx, cy = table.across_x[k], table.across_y[k]
+    swing_x = table.swing_x0[k] + ax * c + cx * b
+    swing_y = table.swing_y0[k] + ay * c + cy * b
+    swing_vx = ax * c1 + cx * b1
+    swing_vy = ay * c1 + cy * b1
     lift = table.lift[k]
     swing_z = robot.ankle_height + lift * h
     swing_vz = lift * h1 * rate
-    swing_yaw = table.swing_yaw0[k] + table.swing_dyaw[k] * b
-    swing_yaw_rate = table.swing_dyaw[k] * b1 * rate
-    # --- pelvis base: Eqs. 12-13 cubic plus the side-walking half cosine of Eqs. 15-16
-    base0 = table.base0[k]
-    base_sag = table.base_sag[k]
-    pos, slope, curv = curves.hermite_cubic(0.0 * base0, table.m0[k], base_sag, table.m1[k], tau[:, None])
-    q, q1, q2 = side_shift_profile(tau, table.lat_profile[k])
-    lat = table.base_lat[k]
-    pelvis_xy = base0 + pos + lat * q[:, None]
-    pelvis_v = (slope + lat * q1[:, None]) / T[:, None]
-    pelvis_a = (curv + lat * q2[:, None]) / (T * T)[:, None]
+    dyaw = table.swing_dyaw[k]
+    swing_yaw = table.swing_yaw0[k] + dyaw * b
+    swing_yaw_rate = dyaw * b1
+    # --- pelvis base: Eqs. 12-13 cubic (Hermite form of Eq. 4) plus the side-walking shift of Eqs. 15-16
+    s2 = tau * tau
+    s3 = s2 * tau
+    h10 = s3 - 2 * s2 + tau
+    h01 = 3 * s2 - 2 * s3
+    h11 = s3 - s2
+    g10 = 3 * s2 - 4 * tau + 1
+    g01 = 6 * tau - 6 * s2
+    g11 = 3 * s2 - 2 * tau
+    k10 = 6 * tau - 4
+    k01 = 6 - 12 * tau
+    k11 = 6 * tau - 2
+    components = []
+    for base0, sag, m0, m1, lat in (
+        (table.base0_x, table.sag_x, table.m0_x, table.m1_x, table.lat_x),
+        (table.base0_y, table.sag_y, table.m0_y, table.m1_y, table.lat_y),
+    ):
+        m0k, m1k, sagk = m0[k], m1[k], sag[k]
+        position = base0[k] + h10 * m0k + h01 * sagk + h11 * m1k
+        slope = g10 * m0k + g01 * sagk + g11 * m1k
+        curvature = k10 * m0k + k01 * sagk + k11 * m1k
+        components.append([position, slope, curvature, lat])
+    if np.any(table.lat_profile != SHIFT_NONE):
+        q, q1, q2 = side_shift_profile(tau, table.lat_profile[k])
+        for component in components:
+            lat_k = component[3][k]
+            component[0] = component[0] + lat_k * q
+            component[1] = component[1] + lat_k * q1
+            component[2] = component[2] + lat_k * q2
     # --- pelvis sway: Eqs. 18-20 on the modified time t_bar (sigma = 2 t_bar, or 2 t_bar - 1)
     amp = table.amp[k]
-    elapsed = t - table.start[k]
     out_time, back_time = table.out_time[k], table.back_time[k]
     back_start = T - back_time
     first_half = elapsed < out_time
     second_half = elapsed >= back_start
-    sigma = np.where(first_half, elapsed / out_time,
-                     np.where(second_half, (elapsed - back_start) / back_time, 0.0))
-    zero = np.zeros_like(amp)
-    p_start = np.where(first_half, zero, amp)
-    m_start = np.where(first_half, table.w0[k], zero)
-    p_end = np.where(first_half | ~second_half, amp, zero)
-    m_end = np.where(second_half, table.w1[k], zero)
+    sigma = np.where(first_half, elapsed / out_time, np.where(second_half, (elapsed - back_start) / back_time, 0.0))
+    p_start = np.where(first_half, 0.0, amp)
+    m_start = np.where(first_half, table.w0[k], 0.0)
+    p_end = np.where(second_half, 0.0, amp)
+    m_end = np.where(second_half, table.w1[k], 0.0)
     sway, sway1, sway2 = curves.hermite_cubic(p_start, m_start, p_end, m_end, sigma)
-    moving = first_half | second_half
     scale = np.where(first_half, 1.0 / out_time, np.where(second_half, 1.0 / back_time, 0.0))  # d sigma/dt
-    sway = np.where(moving, sway, amp)
-    n = table.n[k]
-    pelvis_xy = pelvis_xy + sway[:, None] * n
-    pelvis_v = pelvis_v + (sway1 * scale)[:, None] * n
-    pelvis_a = pelvis_a + (sway2 * scale * scale)[:, None] * n
+    sway = np.where(first_half | second_half, sway, amp)
+    sway1 = sway1 * scale
+    sway2 = sway2 * scale * scale
+    inv_T = 1.0 / T
+    inv_T2 = inv_T * inv_T
+    nx, ny = table.n_x[k], table.n_y[k]
+    (px, vx, accx, _), (py, vy, accy, _) = components
+    pelvis_x = px + sway * nx
+    pelvis_y = py + sway * ny
+    pelvis_vx = vx * inv_T + sway1 * nx
+    pelvis_vy = vy * inv_T + sway1 * ny
+    pelvis_ax = accx * inv_T2 + sway2 * nx
+    pelvis_ay = accy * inv_T2 + sway2 * ny
     # --- feet to left/right, pelvis yaw as the mean of the feet (Eq. 23)
     left_swings = table.swing_left[k]
-    support_xyz = np.column_stack([table.support_xy[k], np.full(len(t), robot.ankle_height)])
-    swing_xyz = np.column_stack([swing_xy, swing_z])
-    swing_vel = np.column_stack([swing_vxy, swing_vz])
-    still = np.zeros_like(swing_vel)
-    ls = left_swings[:, None]
-    left_position = np.where(ls, swing_xyz, support_xyz)
-    right_position = np.where(ls, support_xyz, swing_xyz)
-    left_velocity = np.where(ls, swing_vel, still)
-    right_velocity = np.where(ls, still, swing_vel)
+    right_swings = ~left_swings
+    support_x, support_y = table.support_x[k], table.support_y[k]
+    ankle = np.full(n, robot.ankle_height)
+    left_position = np.column_stack([
+        np.where(left_swings, swing_x, support_x), np.where(left_swings, swing_y, support_y),
+        np.where(left_swings, swing_z, ankle)])
+    right_position = np.column_stack([
+        np.where(left_swings, support_x, swing_x), np.where(left_swings, support_y, swing_y),
+        np.where(left_swings, ankle, swing_z)])
+    left_velocity = np.column_stack([swing_vx * left_swings, swing_vy * left_swings, swing_vz * left_swings])
+    right_velocity = np.column_stack([swing_vx * right_swings, swing_vy * right_swings, swing_vz * right_swings])
     support_yaw = table.support_yaw[k]
     left_yaw = np.where(left_swings, swing_yaw, support_yaw)
     right_yaw = np.where(left_swings, support_yaw, swing_yaw)
-    left_rate = np.where(left_swings, swing_yaw_rate, 0.0)
-    right_rate = np.where(left_swings, 0.0, swing_yaw_rate)
+    left_rate = swing_yaw_rate * left_swings
+    right_rate = swing_yaw_rate * right_swings
     support = np.where(in_swing, np.where(left_swings, SUPPORT_RIGHT, SUPPORT_LEFT), SUPPORT_DOUBLE)
-    zmp = pelvis_xy - (robot.pendulum_length / robot.gravity) * pelvis_a  # Eqs. 1-2
+    l_over_g = robot.pendulum_length / robot.gravity
+    zmp = np.column_stack([pelvis_x - l_over_g * pelvis_ax, pelvis_y - l_over_g * pelvis_ay])  # Eqs. 1-2
     return Samples(
-        time=t, support=support.astype(np.int8), pelvis_xy=pelvis_xy, pelvis_velocity_xy=pelvis_v,
-        pelvis_acceleration_xy=pelvis_a, pelvis_yaw=0.5 * (left_yaw + right_yaw),
+        time=t, support=support.astype(np.int8), pelvis_xy=np.column_stack([pelvis_x, pelvis_y]),
+        pelvis_velocity_xy=np.column_stack([pelvis_vx, pelvis_vy]),
+        pelvis_acceleration_xy=np.column_stack([pelvis_ax, pelvis_ay]), pelvis_yaw=0.5 * (left_yaw + right_yaw),
         pelvis_yaw_rate=0.5 * (left_rate + right_rate), left_position=left_position,
         left_velocity=left_velocity, left_yaw=left_yaw, left_yaw_rate=left_rate,
         right_position=right_position, right_velocity=right_velocity, right_yaw=right_yaw,
         right_yaw_rate=right_rate, zmp_xy=zmp,
     )
+
+
+def _blend_and_cycloid(s: Array) -> tuple[Array, Array, Array, Array]:
+    """Half cosine (Eqs. 14-17, 21-22) and cycloid (Eq. 11) with their slopes, sharing one sin/cos pair."""
+    angle = np.pi * s
+    sine, cosine = np.sin(angle), np.cos(angle)
+    blend = 0.5 * (1.0 - cosine)
+    blend_slope = 0.5 * np.pi * sine
+    sin2 = 2.0 * sine * cosine  # sin(2 pi s)
+    cos2 = 1.0 - 2.0 * sine * sine  # cos(2 pi s)
+    return blend, blend_slope, s - sin2 / curves.TWO_PI, 1.0 - cos2
 
 
 def stage_support_phases(stage: Stage) -> list[tuple[float, float, int, tuple[Pose2D, ...]]]:
@@ -412,19 +476,34 @@ def stage_support_phases(stage: Stage) -> list[tuple[float, float, int, tuple[Po
 # Whole walks: commands -> stages -> WalkingPattern
 # ---------------------------------------------------------------------------
 
-REACH_CHECK_POINTS = 33  # samples per stage at which the leg reach is checked
+REACH_CHECK_POINTS = 25  # samples per stage at which the leg reach is checked
 
 
-def check_stage_reach(stage: Stage, robot: RobotModel) -> None:
-    """Raise :class:`~zmpwalk.errors.UnreachableError` if a leg cannot follow the stage."""
-    times = stage.start + np.linspace(0.0, stage.duration, REACH_CHECK_POINTS)
-    samples = evaluate(StageTable([stage]), times, robot, np.zeros(len(times), dtype=np.intp))
+def check_reach(stages: Sequence[Stage], robot: RobotModel) -> None:
+    """Raise :class:`~zmpwalk.errors.UnreachableError` if a leg cannot follow the stages.
+
+    The hip-to-ankle distance is checked at :data:`REACH_CHECK_POINTS` times of
+    every stage (both ends included), in one vectorised pass. The error has the
+    attribute ``stage`` (index into ``stages``).
+    """
+    if not stages:
+        return
+    fraction = np.linspace(0.0, 1.0, REACH_CHECK_POINTS)
+    table = StageTable(list(stages))
+    index = np.repeat(np.arange(len(stages)), REACH_CHECK_POINTS)
+    times = table.start[index] + np.tile(fraction, len(stages)) * table.duration[index]
+    samples = evaluate(table, times, robot, index)
     pelvis = np.column_stack([samples.pelvis_xy, np.full(len(times), robot.pelvis_height)])
-    check_leg_reach(times, pelvis, samples.pelvis_yaw, samples.left_position, samples.right_position, robot)
+    try:
+        check_leg_reach(times, pelvis, samples.pelvis_yaw, samples.left_position, samples.right_position, robot)
+    except UnreachableError as error:
+        error.stage = int(np.searchsorted(table.start, error.time, side="right") - 1)
+        raise
 
 
 def plan_next(
-    robot: RobotModel, schedule: Schedule, stance: Stance, boundary: Boundary, command: StepCommand
+    robot: RobotModel, schedule: Schedule, stance: Stance, boundary: Boundary, command: StepCommand,
+    reach: bool = True,
 ) -> tuple[list[Stage], Stance, Boundary]:
     """Stages of one command from a stance and boundary state; nothing is changed on error.
 
@@ -433,6 +512,10 @@ def plan_next(
     back through the middle at the sway speed ``alpha1 V_y`` of Eq. 20, so that
     the first swing starts like every other one. A stop command at standstill
     does nothing.
+
+    Args:
+        reach: Check the legs' reach here (a caller that checks many commands at
+            once with :func:`check_reach` passes False).
 
     Raises:
         ZmpwalkError: The command is infeasible for this robot (reach, overlap, timing).
@@ -450,9 +533,10 @@ def plan_next(
     plans, next_stance = plan_command(stance, command, robot, schedule)
     for plan in plans:
         stage = build_stage(plan, boundary)
-        check_stage_reach(stage, robot)
         stages.append(stage)
         boundary = stage.end
+    if reach:
+        check_reach(stages, robot)
     if command.stop:
         next_stance = Stance(next_stance.left, next_stance.right, 0)
     return stages, next_stance, boundary
@@ -478,12 +562,18 @@ def plan_walk(
     sequence = list(commands)
     if sequence and not sequence[-1].stop:
         sequence.append(StepCommand(duration=sequence[-1].duration, stop=True))
+    numbers: list[int] = []
     for number, command in enumerate(sequence, start=1):
         try:
-            new, stance, boundary = plan_next(robot, schedule, stance, boundary, command)
+            new, stance, boundary = plan_next(robot, schedule, stance, boundary, command, reach=False)
         except ZmpwalkError as error:
             raise error.in_context(f"step {number}") from None
         stages.extend(new)
+        numbers.extend([number] * len(new))
+    try:
+        check_reach(stages, robot)
+    except UnreachableError as error:
+        raise error.in_context(f"step {numbers[error.stage]}") from None
     stages.append(standing_stage(_standing_plan(stance, robot, schedule), boundary.time))
     return stages, stance
 
@@ -542,8 +632,7 @@ def pattern_from_samples(
             feet = [(stage.plan.support_pose, -stage.plan.swing)]
             if len(poses) == 2:
                 feet.append((poses[1], stage.plan.swing))
-            corners = np.vstack([foot_corners(pose, side, robot) for pose, side in feet])
-            phases.append(SupportPhase(begin, end, code, convex_hull(corners)))
+            phases.append(SupportPhase(begin, end, code, tuple(feet)))
         if not stage.standing:
             plan = stage.plan
             parameters: dict[str, float | str] = dict(vars(plan.parameters))

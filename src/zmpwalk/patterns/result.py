@@ -14,8 +14,9 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from zmpwalk.footsteps import Pose2D, foot_corners
 from zmpwalk.robots.model import RobotModel
-from zmpwalk.zmp import signed_margin
+from zmpwalk.zmp import convex_hull, signed_margin
 
 Array = NDArray[np.float64]
 
@@ -35,13 +36,20 @@ class SupportPhase:
         begin: Start time [s].
         end: End time [s] (``inf`` for standing at the end).
         support: 0 double, 1 left, 2 right.
-        polygon: Support polygon in world, counter-clockwise, shape (m, 2) [m].
+        feet: The feet on the ground: ``(pose, side)`` with ``side`` +1 left, -1 right.
     """
 
     begin: float  # [s]
     end: float  # [s]
     support: int
-    polygon: Array  # [m]
+    feet: tuple[tuple[Pose2D, int], ...]
+
+    def polygon(self, robot: RobotModel) -> Array:
+        """Support polygon in world, counter-clockwise, shape (m, 2) [m]: one sole or the hull of two."""
+        corners = [foot_corners(pose, side, robot) for pose, side in self.feet]
+        if len(corners) == 1:
+            return corners[0]
+        return convex_hull(np.vstack(corners))
 
 
 @dataclass(frozen=True)
@@ -108,6 +116,7 @@ class WalkingPattern:
     zmp_in_world: Array
     steps: list[StepRecord]
     support_phases: list[SupportPhase]
+    _polygons: list[Array] | None = field(default=None, init=False, repr=False, compare=False)
 
     @property
     def duration(self) -> float:
@@ -139,15 +148,21 @@ class WalkingPattern:
         """Right hip yaw [rad] (Eq. 23: minus the left one)."""
         return self.yaw_right_foot_in_world - self.yaw_pelvis_in_world
 
+    def support_polygons(self) -> list[Array]:
+        """The support polygon of each support phase, in world [m] (computed once)."""
+        if self._polygons is None:
+            self._polygons = [phase.polygon(self.robot) for phase in self.support_phases]
+        return self._polygons
+
     def zmp_margin(self) -> Array:
         """Signed distance of the ZMP to the support polygon per sample [m] (> 0 inside)."""
         margin = np.full(len(self.time), np.nan)
-        for phase in self.support_phases:
-            mask = (self.time >= phase.begin) & (self.time < phase.end)
-            if phase is self.support_phases[-1]:
-                mask |= self.time >= phase.begin
-            if np.any(mask):
-                margin[mask] = signed_margin(self.zmp_in_world[mask], phase.polygon)
+        begins = np.array([phase.begin for phase in self.support_phases])
+        which = np.clip(np.searchsorted(begins, self.time, side="right") - 1, 0, len(begins) - 1)
+        polygons = self.support_polygons()
+        for index in np.unique(which):
+            mask = which == index
+            margin[mask] = signed_margin(self.zmp_in_world[mask], polygons[index])
         return margin
 
     def min_zmp_margin(self) -> tuple[float, float]:

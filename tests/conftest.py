@@ -1,0 +1,17 @@
+"""Shared fixtures: the built-in robots and schedule."""
+
+from __future__ import annotations
+
+import pytest
+
+from zmpwalk import RobotModel, Schedule, load_robot
+
+
+@pytest.fixture(scope="session")
+def hubo() -> RobotModel:
+    return load_robot("hubo")
+
+
+@pytest.fixture(scope="session")
+def schedule() -> Schedule:
+    return Schedule.hubo()
