@@ -12,7 +12,7 @@ S = np.linspace(0.01, 0.99, 57)
 
 
 def _check_derivatives(function, s=S, tol=1e-6):
-    value, slope, curvature = function(s)
+    _, slope, curvature = function(s)
     numeric_slope = (function(s + H)[0] - function(s - H)[0]) / (2 * H)
     numeric_curvature = (function(s + H)[1] - function(s - H)[1]) / (2 * H)
     np.testing.assert_allclose(slope, numeric_slope, atol=tol)

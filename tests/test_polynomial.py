@@ -10,7 +10,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from zmpwalk import StepCommand, ZmpwalkError, generate
-from zmpwalk import zmp as Z
+from zmpwalk import zmp as zmp_maps
 from zmpwalk.footsteps import Stance
 from zmpwalk.patterns.polynomial import Boundary, StageTable, evaluate, plan_next, plan_walk
 
@@ -36,7 +36,7 @@ def test_fig10_step_follows_eqs_4_11_12_13(hubo, schedule):
     swing = pattern.position_right_ankle_in_world if step.swing == "right" else pattern.position_left_ankle_in_world
     x_support = support[idx[0], 0]
     # Eq. 13 boundary values (per unit normalised time), Eq. 4 coefficients, Eq. 12 cubic.
-    a3, a2, a1, a0 = Z.CUBIC_FROM_BOUNDARY @ np.array([-b / 2, alpha * b, f / 2, alpha * f])
+    a3, a2, a1, a0 = zmp_maps.CUBIC_FROM_BOUNDARY @ np.array([-b / 2, alpha * b, f / 2, alpha * f])
     expected_pelvis = a0 + a1 * tau + a2 * tau**2 + a3 * tau**3
     np.testing.assert_allclose(pattern.position_pelvis_in_world[idx, 0] - x_support, expected_pelvis, atol=1e-12)
     v = pattern.velocity_pelvis_in_world[idx, 0]
@@ -49,9 +49,9 @@ def test_fig10_step_follows_eqs_4_11_12_13(hubo, schedule):
     expected_swing = (b + f) * (s - np.sin(2 * np.pi * s) / (2 * np.pi)) - b
     np.testing.assert_allclose(swing[idx, 0] - x_support, expected_swing, atol=1e-12)
     # Relative ankle positions of Fig. 11: support -x_P, swing x_A - x_P (pelvis frame, straight walk).
-    np.testing.assert_allclose(
-        (pattern.position_right_ankle_in_pelvis if step.swing == "left" else pattern.position_left_ankle_in_pelvis)[idx, 0],
-        -expected_pelvis, atol=1e-12)
+    left_swings = step.swing == "left"
+    in_pelvis = pattern.position_right_ankle_in_pelvis if left_swings else pattern.position_left_ankle_in_pelvis
+    np.testing.assert_allclose(in_pelvis[idx, 0], -expected_pelvis, atol=1e-12)
 
 
 def test_sway_follows_eqs_18_to_20(hubo):
@@ -211,7 +211,8 @@ def test_random_sequences_are_mostly_feasible(hubo, schedule):
             elif mode == 2:
                 commands.append(StepCommand(duration, turn=float(rng.uniform(-0.25, 0.25))))
             else:
-                commands.append(StepCommand(duration, float(rng.uniform(0, 0.15)), turn=float(rng.uniform(-0.15, 0.15))))
+                forward, turn = float(rng.uniform(0, 0.15)), float(rng.uniform(-0.15, 0.15))
+                commands.append(StepCommand(duration, forward, turn=turn))
         try:
             plan_walk(hubo, commands, schedule)
             feasible += 1
@@ -264,7 +265,7 @@ def test_feet_land_where_simple_commands_say(hubo, schedule):
     reference = _Reference(hubo.hip_spacing)
     for command in commands:
         reference.apply(command)
-    stages, stance = plan_walk(hubo, commands, schedule)
+    stages, _ = plan_walk(hubo, commands, schedule)
     # The closing stop of plan_walk lands the last swing beside the other foot.
     last = [s for s in stages if s.plan.kind == "stop"][-1]
     reference.apply(StepCommand(last.duration, stop=True))

@@ -6,20 +6,20 @@ import numpy as np
 import pytest
 
 from zmpwalk import StepCommand, generate
-from zmpwalk import zmp as Z
+from zmpwalk import zmp as zmp_maps
 
 L_OVER_G = 0.063  # an arbitrary l/g [s^2] for the printed (T = 1 s) matrices
 
 
 def test_eq4_matrices_are_inverse():
-    np.testing.assert_allclose(Z.CUBIC_FROM_BOUNDARY @ Z.BOUNDARY_FROM_CUBIC, np.eye(4), atol=1e-15)
+    np.testing.assert_allclose(zmp_maps.CUBIC_FROM_BOUNDARY @ zmp_maps.BOUNDARY_FROM_CUBIC, np.eye(4), atol=1e-15)
 
 
 def test_eq8_matrices_are_the_printed_inverses():
     first = np.array([[0, 0, 0, 1], [0, 0, 1, 0], [1 / 8, 1 / 4, 1 / 2, 1], [3 / 4, 1, 1, 0]])
     second = np.array([[1 / 8, 1 / 4, 1 / 2, 1], [3 / 4, 1, 1, 0], [1, 1, 1, 1], [3, 2, 1, 0]])
-    np.testing.assert_allclose(np.linalg.inv(first), Z.CUBIC_FROM_HALF_BOUNDARY_FIRST, atol=1e-12)
-    np.testing.assert_allclose(np.linalg.inv(second), Z.CUBIC_FROM_HALF_BOUNDARY_SECOND, atol=1e-12)
+    np.testing.assert_allclose(np.linalg.inv(first), zmp_maps.CUBIC_FROM_HALF_BOUNDARY_FIRST, atol=1e-12)
+    np.testing.assert_allclose(np.linalg.inv(second), zmp_maps.CUBIC_FROM_HALF_BOUNDARY_SECOND, atol=1e-12)
 
 
 def test_eq7_at_one_second_is_the_printed_matrix():
@@ -30,16 +30,17 @@ def test_eq7_at_one_second_is_the_printed_matrix():
         [-6 * k, -2 * k, 1 + 6 * k, -4 * k],
         [-12 * k, -6 * k, 12 * k, 1 - 6 * k],
     ])
-    np.testing.assert_allclose(Z.zmp_from_pelvis_boundary(1.0, k * 9.81, 9.81), printed, atol=1e-14)
+    np.testing.assert_allclose(zmp_maps.zmp_from_pelvis_boundary(1.0, k * 9.81, 9.81), printed, atol=1e-14)
 
 
 def test_eq7_follows_from_eq6_coefficient_matching():
     """ZMP cubic b = a - (l/g)[0, 0, 6 a3, 2 a2] (Eq. 6), boundary values by Eq. 4."""
     rng = np.random.default_rng(7)
     pelvis = rng.normal(size=4)
-    a3, a2, a1, a0 = Z.CUBIC_FROM_BOUNDARY @ pelvis
+    a3, a2, a1, a0 = zmp_maps.CUBIC_FROM_BOUNDARY @ pelvis
     b = np.array([a3, a2, a1 - 6 * a3 * L_OVER_G, a0 - 2 * a2 * L_OVER_G])
-    np.testing.assert_allclose(Z.BOUNDARY_FROM_CUBIC @ b, Z.normalized_zmp_map(L_OVER_G) @ pelvis, atol=1e-14)
+    expected = zmp_maps.normalized_zmp_map(L_OVER_G) @ pelvis
+    np.testing.assert_allclose(zmp_maps.BOUNDARY_FROM_CUBIC @ b, expected, atol=1e-14)
 
 
 def test_eq9_is_the_printed_matrix():
@@ -50,12 +51,12 @@ def test_eq9_is_the_printed_matrix():
         [-24 * k, -4 * k, 1 + 24 * k, -8 * k],
         [-96 * k, -24 * k, 96 * k, 1 - 24 * k],
     ])
-    np.testing.assert_allclose(Z.half_interval_zmp_map(k), printed, atol=1e-13)
+    np.testing.assert_allclose(zmp_maps.half_interval_zmp_map(k), printed, atol=1e-13)
 
 
 def test_zmp_and_pelvis_maps_are_inverse():
-    forward = Z.zmp_from_pelvis_boundary(0.8, 0.62)
-    np.testing.assert_allclose(forward @ Z.pelvis_from_zmp_boundary(0.8, 0.62), np.eye(4), atol=1e-12)
+    forward = zmp_maps.zmp_from_pelvis_boundary(0.8, 0.62)
+    np.testing.assert_allclose(forward @ zmp_maps.pelvis_from_zmp_boundary(0.8, 0.62), np.eye(4), atol=1e-12)
 
 
 @pytest.mark.parametrize("duration", [0.6, 0.7, 0.8, 0.95, 1.3])
@@ -82,24 +83,24 @@ def test_time_scaled_eq7_matches_finite_differences_of_the_pattern(hubo, duratio
         np.polyval(coefficients, duration), np.polyval(np.polyder(coefficients), duration),
     ])
     pelvis = np.array([x[i1], v[i1], x[i2], v[i2]])  # velocity is continuous at the step ends
-    predicted = Z.zmp_from_pelvis_boundary(duration, hubo.pendulum_length, hubo.gravity) @ pelvis
+    predicted = zmp_maps.zmp_from_pelvis_boundary(duration, hubo.pendulum_length, hubo.gravity) @ pelvis
     np.testing.assert_allclose(measured[[0, 2]], predicted[[0, 2]], atol=1e-6)  # [m]
     np.testing.assert_allclose(measured[[1, 3]], predicted[[1, 3]], atol=1e-5)  # [m/s]
     # The printed T = 1 s form is wrong here unless T = 1 (READING-NOTES): check it differs.
     if abs(duration - 1.0) > 0.1:
-        unscaled = Z.normalized_zmp_map(l_over_g) @ (pelvis * [1, duration, 1, duration])
+        unscaled = zmp_maps.normalized_zmp_map(l_over_g) @ (pelvis * [1, duration, 1, duration])
         assert abs(unscaled[0] - measured[0]) > 1e-3
 
 
 def test_signed_margin_of_a_square():
     square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
     points = np.array([[0.5, 0.5], [0.9, 0.5], [1.5, 0.5], [2.0, 2.0], [0.0, 0.3]])
-    np.testing.assert_allclose(Z.signed_margin(points, square), [0.5, 0.1, -0.5, -np.sqrt(2), 0.0], atol=1e-12)
+    np.testing.assert_allclose(zmp_maps.signed_margin(points, square), [0.5, 0.1, -0.5, -np.sqrt(2), 0.0], atol=1e-12)
 
 
 def test_convex_hull_of_two_feet_is_counter_clockwise():
     points = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0.5, 0.5], [2, 0.5]], dtype=float)
-    hull = Z.convex_hull(points)
+    hull = zmp_maps.convex_hull(points)
     assert len(hull) == 5
     x, y = hull[:, 0], hull[:, 1]
     assert 0.5 * np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y) > 0  # positive area: CCW

@@ -64,10 +64,11 @@ class UnreachableError(ZmpwalkError, ValueError):
         self.leg = leg
         self.time = time
         self.excess = excess
+        self.sample = -1  # index of the first sample out of reach, where the caller knows it
         self.stage = -1  # index of the stage, where the caller knows it
         extra = f" ({detail})" if detail else ""
         super().__init__(
-            f"{leg} ankle out of reach by {excess * 1e3:.1f} mm at t = {time:.3f} s{extra}"
+            f"{leg} ankle out of reach from t = {time:.3f} s, by up to {excess * 1e3:.1f} mm{extra}"
         )
 
 

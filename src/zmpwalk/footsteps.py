@@ -195,7 +195,7 @@ def foot_corners(pose: Pose2D, foot: int, robot: RobotModel) -> np.ndarray:
     local = np.array([[cx - half_l, cy - half_w], [cx + half_l, cy - half_w],
                       [cx + half_l, cy + half_w], [cx - half_l, cy + half_w]])
     c, s = math.cos(pose.yaw), math.sin(pose.yaw)
-    return local @ np.array([[c, s], [-s, c]]) + np.array([pose.x, pose.y])
+    return np.asarray(local @ np.array([[c, s], [-s, c]]) + np.array([pose.x, pose.y]), dtype=np.float64)
 
 
 def _rectangles_overlap(a: np.ndarray, b: np.ndarray) -> bool:

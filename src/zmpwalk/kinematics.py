@@ -22,6 +22,23 @@ def hip_positions_in_world(
     return position_pelvis_in_world + offset_left, position_pelvis_in_world + offset_right
 
 
+def leg_reach_excess(
+    position_pelvis_in_world: Array,
+    yaw_pelvis_in_world: Array,
+    position_left_ankle_in_world: Array,
+    position_right_ankle_in_world: Array,
+    robot: RobotModel,
+) -> tuple[Array, Array]:
+    """Hip-to-ankle distance minus the leg's reach at its least knee bend [m], left and right, each (n,).
+
+    Positive values are out of reach.
+    """
+    hip_left, hip_right = hip_positions_in_world(position_pelvis_in_world, yaw_pelvis_in_world, robot)
+    reach = robot.max_leg_reach
+    return (np.linalg.norm(position_left_ankle_in_world - hip_left, axis=1) - reach,
+            np.linalg.norm(position_right_ankle_in_world - hip_right, axis=1) - reach)
+
+
 def check_leg_reach(
     time: Array,
     position_pelvis_in_world: Array,
@@ -33,16 +50,21 @@ def check_leg_reach(
     """Raise if a hip-to-ankle distance exceeds the leg's reach at its least knee bend.
 
     Raises:
-        UnreachableError: Names the leg, the first time and the excess [m].
+        UnreachableError: Names the leg, the first time it is out of reach and
+            the largest excess [m]; ``error.sample`` is the first sample index.
     """
-    hip_left, hip_right = hip_positions_in_world(position_pelvis_in_world, yaw_pelvis_in_world, robot)
-    reach = robot.max_leg_reach
-    for leg, hip, ankle in (("left", hip_left, position_left_ankle_in_world),
-                            ("right", hip_right, position_right_ankle_in_world)):
-        excess = np.linalg.norm(ankle - hip, axis=1) - reach
-        if np.any(excess > 0):
-            worst = int(np.argmax(excess))
-            raise UnreachableError(
-                leg, float(time[worst]), float(excess[worst]),
-                f"hip-to-ankle {float(excess[worst] + reach):.3f} m > reach {reach:.3f} m",
-            )
+    excesses = leg_reach_excess(position_pelvis_in_world, yaw_pelvis_in_world, position_left_ankle_in_world,
+                                position_right_ankle_in_world, robot)
+    firsts = [int(np.argmax(e > 0)) if np.any(e > 0) else len(time) for e in excesses]
+    if min(firsts) == len(time):
+        return
+    side = 0 if firsts[0] <= firsts[1] else 1
+    first = firsts[side]
+    excess = excesses[side]
+    error = UnreachableError(
+        ("left", "right")[side], float(time[first]), float(excess.max()),
+        f"hip-to-ankle distance up to {float(excess.max()) + robot.max_leg_reach:.3f} m, "
+        f"reach {robot.max_leg_reach:.3f} m",
+    )
+    error.sample = first
+    raise error

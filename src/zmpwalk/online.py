@@ -44,6 +44,7 @@ from zmpwalk.patterns.polynomial import (
     Stage,
     StageTable,
     check_rate,
+    closing_command,
     evaluate,
     plan_next,
 )
@@ -116,7 +117,7 @@ class OnlineWalker:
         self._boundary = Boundary(0.0)
         self._current: _Plan | None = None
         self._pending: _Plan | None = None
-        self._last_duration = 0.8
+        self._last_command = StepCommand(duration=0.8)
         self._standing = self._standing_row(self._stance)
 
     @property
@@ -155,8 +156,11 @@ class OnlineWalker:
         self._pending = _Plan(command, stages, next_stance, next_boundary, rows, first_index)
 
     def stop(self) -> None:
-        """Queue a closing step into the ready posture (nothing happens when standing)."""
-        self.command(StepCommand(duration=self._last_duration, stop=True))
+        """Queue a closing step into the ready posture (nothing happens when standing).
+
+        The closing step has the step time and shape-factor overrides of the last command.
+        """
+        self.command(closing_command(self._last_command))
 
     def tick(self) -> WalkingSample:
         """The sample at :attr:`time`, then advance by one control period."""
@@ -191,7 +195,7 @@ class OnlineWalker:
             self._current = plan
             self._stance, self._boundary = plan.stance, plan.boundary
             if not plan.command.stop:
-                self._last_duration = plan.command.duration
+                self._last_command = plan.command
             if plan.boundary.at_rest:
                 self._standing = self._standing_row(plan.stance)
             if index < plan.first_index + len(plan.rows):

@@ -22,7 +22,6 @@ step up as follows:
 
 from __future__ import annotations
 
-import math
 import tomllib
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -89,10 +88,12 @@ class _Grid:
         """Interpolated row at (duration, key), and how it was obtained."""
         source = "table"
         durations = self.durations
-        if duration <= durations[0] or duration >= durations[-1]:
+        exact = np.isclose(durations, duration, rtol=0.0, atol=1e-12)
+        if np.any(exact):
+            pairs = [(float(durations[int(np.argmax(exact))]), 1.0)]
+        elif duration <= durations[0] or duration >= durations[-1]:
             nearest = durations[0] if duration <= durations[0] else durations[-1]
-            if not math.isclose(duration, nearest, abs_tol=1e-12):
-                source = "extrapolated"
+            source = "extrapolated"
             pairs = [(float(nearest), 1.0)]
         else:
             upper = int(np.searchsorted(durations, duration))

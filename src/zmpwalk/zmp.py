@@ -71,12 +71,12 @@ def zmp_from_pelvis_boundary(duration: float, pendulum_length: float, gravity: f
             raise InvalidParameterError(name, value, "a finite value > 0")
     kappa = pendulum_length / (gravity * duration**2)  # l/(g T^2), the time-scaled l/g of Eq. 7
     scale = np.diag([1.0, duration, 1.0, duration])  # physical -> per unit normalised time
-    return np.linalg.solve(scale, normalized_zmp_map(kappa) @ scale)
+    return np.asarray(np.linalg.solve(scale, normalized_zmp_map(kappa) @ scale), dtype=np.float64)
 
 
 def pelvis_from_zmp_boundary(duration: float, pendulum_length: float, gravity: float = 9.81) -> Array:
     """Inverse of :func:`zmp_from_pelvis_boundary`: pelvis boundary values from a designed ZMP."""
-    return np.linalg.inv(zmp_from_pelvis_boundary(duration, pendulum_length, gravity))
+    return np.asarray(np.linalg.inv(zmp_from_pelvis_boundary(duration, pendulum_length, gravity)), dtype=np.float64)
 
 
 def half_interval_zmp_map(pendulum_length_over_gravity: float) -> Array:
@@ -88,7 +88,7 @@ def half_interval_zmp_map(pendulum_length_over_gravity: float) -> Array:
     """
     kappa = 4.0 * pendulum_length_over_gravity
     scale = np.diag([1.0, 0.5, 1.0, 0.5])  # per unit step time -> per unit half-step time
-    return np.linalg.solve(scale, normalized_zmp_map(kappa) @ scale)
+    return np.asarray(np.linalg.solve(scale, normalized_zmp_map(kappa) @ scale), dtype=np.float64)
 
 
 def cart_table_zmp(position: Array, acceleration: Array, pendulum_length: float, gravity: float = 9.81) -> Array:
@@ -137,4 +137,4 @@ def signed_margin(points: Array, polygon: Array) -> Array:
     along = np.clip(np.einsum("nmk,mk->nm", rel, edge) / (length**2)[None, :], 0.0, 1.0)
     nearest = a[None, :, :] + along[:, :, None] * edge[None, :, :]
     outside_distance = np.min(np.linalg.norm(pts[:, None, :] - nearest, axis=2), axis=1)
-    return np.where(inside, np.min(inside_distance, axis=1), -outside_distance)
+    return np.asarray(np.where(inside, np.min(inside_distance, axis=1), -outside_distance), dtype=np.float64)

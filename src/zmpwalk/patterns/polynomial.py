@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -48,7 +48,7 @@ from numpy.typing import NDArray
 from zmpwalk import curves
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import InvalidParameterError, UnreachableError, ZmpwalkError
-from zmpwalk.footsteps import GROUNDED_STRETCH, LEFT, Pose2D, Stance, StagePlan, grounded_stage, plan_command
+from zmpwalk.footsteps import GROUNDED_STRETCH, LEFT, Pose2D, StagePlan, Stance, grounded_stage, plan_command
 from zmpwalk.kinematics import check_leg_reach
 from zmpwalk.patterns.result import StepRecord, SupportPhase, WalkingPattern
 from zmpwalk.robots.model import RobotModel
@@ -497,7 +497,7 @@ def check_reach(stages: Sequence[Stage], robot: RobotModel) -> None:
     try:
         check_leg_reach(times, pelvis, samples.pelvis_yaw, samples.left_position, samples.right_position, robot)
     except UnreachableError as error:
-        error.stage = int(np.searchsorted(table.start, error.time, side="right") - 1)
+        error.stage = int(index[error.sample])
         raise
 
 
@@ -542,6 +542,11 @@ def plan_next(
     return stages, next_stance, boundary
 
 
+def closing_command(last: StepCommand) -> StepCommand:
+    """The stop added after ``last``: same step time and shape-factor overrides, no motion."""
+    return replace(last, forward=0.0, side=0.0, turn=0.0, stop=True)
+
+
 def plan_walk(
     robot: RobotModel,
     commands: Sequence[StepCommand],
@@ -550,7 +555,8 @@ def plan_walk(
     """Stages of a whole walk from the ready posture, closed by a stop and a standing stage.
 
     A walk whose last command is not a stop gets a closing stop step of the
-    last step time, so every pattern ends standing in the ready posture.
+    last step time and shape factors (:func:`closing_command`), so every
+    pattern ends standing in the ready posture.
 
     Raises:
         ZmpwalkError: With ``step N:`` in front, for the first command that fails.
@@ -561,7 +567,7 @@ def plan_walk(
     stages: list[Stage] = []
     sequence = list(commands)
     if sequence and not sequence[-1].stop:
-        sequence.append(StepCommand(duration=sequence[-1].duration, stop=True))
+        sequence.append(closing_command(sequence[-1]))
     numbers: list[int] = []
     for number, command in enumerate(sequence, start=1):
         try:
@@ -609,7 +615,7 @@ def generate(
     check_rate(rate)
     stages, _ = plan_walk(robot, commands, schedule)
     end_time = stages[-1].start
-    count = int(math.floor(end_time * rate + 1e-9)) + 1
+    count = math.floor(end_time * rate + 1e-9) + 1
     times = np.arange(count) / rate
     if times[-1] < end_time - 1e-12:
         times = np.append(times, end_time)

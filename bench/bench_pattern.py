@@ -1,0 +1,68 @@
+"""Speed of the HUBO pattern: OnlineWalker.tick() at 100 Hz and 1 kHz, and a 100-step walk at 1 kHz.
+
+Run: python bench/bench_pattern.py. Prints figures; asserts nothing.
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+
+import numpy as np
+
+from zmpwalk import StepCommand, generate, load_robot
+from zmpwalk.online import OnlineWalker
+from zmpwalk.patterns.polynomial import plan_walk
+
+
+def tick_times(rate: float, seconds: float) -> np.ndarray:
+    robot = load_robot("hubo")
+    walker = OnlineWalker(robot, rate=rate)
+    commands = [StepCommand(0.95, 0.0), StepCommand(0.8, 0.2), StepCommand(0.7, 0.2), StepCommand(0.8, side=0.05),
+                StepCommand(0.95, turn=0.2), StepCommand(0.8, 0.1, turn=0.1)]
+    durations = []
+    index = 0
+    for _ in range(int(seconds * rate)):
+        if walker.queued is None:
+            walker.command(commands[index % len(commands)])  # queued off the tick, as a controller would
+            index += 1
+        start = time.perf_counter_ns()
+        walker.tick()
+        durations.append(time.perf_counter_ns() - start)
+    return np.array(durations) / 1e3  # [us]
+
+
+def main() -> None:
+    print("OnlineWalker.tick() (HUBO, commands queued as each step starts)")
+    for rate in (100.0, 1000.0):
+        us = tick_times(rate, 120.0 if rate == 100.0 else 60.0)
+        print(f"  {rate:6.0f} Hz: median {np.median(us):6.2f} us, p99 {np.percentile(us, 99):7.2f} us, "
+              f"max {us.max():8.1f} us over {len(us)} ticks")
+    robot = load_robot("hubo")
+    commands = [StepCommand(0.8, 0.2)] * 100
+    generate(robot, commands, rate=1000.0)  # warm-up
+    runs = []
+    plans = []
+    for _ in range(7):
+        start = time.perf_counter()
+        pattern = generate(robot, commands, rate=1000.0)
+        runs.append(time.perf_counter() - start)
+        start = time.perf_counter()
+        plan_walk(robot, commands)
+        plans.append(time.perf_counter() - start)
+    print(f"100-step walk at 1 kHz ({len(pattern.time)} samples): median {statistics.median(runs) * 1e3:.1f} ms "
+          f"(planning alone {statistics.median(plans) * 1e3:.1f} ms)")
+    command_times = []
+    walker = OnlineWalker(robot, rate=1000.0)
+    walker.command(StepCommand(0.8, 0.2))
+    walker.tick()
+    for _ in range(200):
+        start = time.perf_counter()
+        walker.command(StepCommand(0.8, 0.2))
+        command_times.append(time.perf_counter() - start)
+    print(f"OnlineWalker.command() at 1 kHz (plan + sample one step): median "
+          f"{statistics.median(command_times) * 1e3:.2f} ms")
+
+
+if __name__ == "__main__":
+    main()

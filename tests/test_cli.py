@@ -1,0 +1,75 @@
+"""The zmpwalk command end to end."""
+
+from __future__ import annotations
+
+import csv
+import json
+import subprocess
+import sys
+
+import pytest
+
+from zmpwalk.cli import main
+from zmpwalk.patterns.result import CSV_COLUMNS
+from zmpwalk.scenarios import list_scenarios
+
+SCENARIOS = ["fig10", "fig27", "fig28", "fig29", "fig30", "fig31", "turn45"]
+
+
+def test_scenarios_lists_the_paper_experiments(capsys):
+    assert main(["scenarios"]) == 0
+    out = capsys.readouterr().out
+    for name in SCENARIOS:
+        assert name in out
+    assert set(list_scenarios()) == set(SCENARIOS)
+
+
+@pytest.mark.parametrize("name", SCENARIOS)
+def test_every_scenario_plans_with_the_exact_csv_columns(tmp_path, capsys, name):
+    out = tmp_path / f"{name}.csv"
+    assert main(["plan", "--scenario", name, "--out", str(out)]) == 0
+    assert "min ZMP margin" in capsys.readouterr().out
+    with out.open() as handle:
+        reader = csv.reader(handle)
+        header = next(reader)
+        rows = list(reader)
+    assert tuple(header) == CSV_COLUMNS
+    assert len(rows) > 100
+    assert {row[1] for row in rows} <= {"double", "left", "right"}
+    assert float(rows[0][0]) == 0.0 and float(rows[1][0]) == pytest.approx(0.01)
+
+
+def test_plan_json_and_rate(tmp_path, capsys):
+    steps = tmp_path / "walk.toml"
+    steps.write_text("[[steps]]\nduration = 0.8\nforward = 0.2\nrepeat = 4\n")
+    assert main(["plan", str(steps), "--rate", "1000", "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["rate"] == 1000.0 and summary["min_zmp_margin"] > 0
+    assert summary["final_left_ankle"][0] == pytest.approx(0.8, abs=1e-9)
+
+
+def test_tables_command_prints_every_condition(capsys):
+    assert main(["tables", "--steps", "2"]) == 0
+    out = capsys.readouterr().out
+    assert out.count("| forward |") == 12 and out.count("| side |") == 6
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["plan", "--scenario", "fig99"], "unknown scenario 'fig99'"),
+    (["plan"], "give a steps file or --scenario"),
+    (["plan", "--scenario", "fig28", "--rate", "0"], "rate = 0"),
+    (["plan", "--scenario", "fig28", "--robot", "asimo"], "unknown robot 'asimo'"),
+    (["plan", "nowhere.toml"], "nowhere.toml"),
+    (["tables", "--steps", "0"], "--steps"),
+    (["fly"], "invalid choice"),
+])
+def test_errors_print_one_line_and_exit_non_zero(capsys, argv, message):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_installed_command_runs_as_a_process(tmp_path):
+    result = subprocess.run([sys.executable, "-m", "zmpwalk.cli", "plan", "--scenario", "fig99"],
+                            capture_output=True, text=True, check=False)
+    assert result.returncode == 2 and result.stderr.startswith("zmpwalk: error:")

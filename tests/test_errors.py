@@ -1,0 +1,104 @@
+"""Bad input as a new user would try it: one clear error each, naming the parameter, value and range."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from zmpwalk import (
+    FileFormatError,
+    InvalidParameterError,
+    StepCommand,
+    UnknownNameError,
+    UnreachableError,
+    ZmpwalkError,
+    generate,
+    load_robot,
+)
+from zmpwalk.scenarios import load_scenario, load_steps_file
+
+
+@pytest.mark.parametrize("kwargs, parameter", [
+    ({"duration": 0.0}, "duration"),
+    ({"duration": -0.8}, "duration"),
+    ({"duration": math.nan}, "duration"),
+    ({"duration": 0.8, "forward": math.inf}, "forward"),
+    ({"duration": 0.8, "side": math.nan}, "side"),
+    ({"duration": 0.8, "turn": 2.0}, "turn"),
+    ({"duration": 0.8, "up_ratio": 1.2}, "up_ratio"),
+    ({"duration": 0.8, "up_ratio": 0.0}, "up_ratio"),
+    ({"duration": 0.8, "d1": 1.0}, "d1"),
+    ({"duration": 0.8, "d1": -0.1}, "d1"),
+    ({"duration": 0.8, "dsp_time": 0.9}, "dsp_time"),
+    ({"duration": 0.8, "alpha": -1.0}, "alpha"),
+    ({"duration": 0.8, "forward": 0.1, "stop": True}, "forward"),
+    ({"duration": "0.8"}, "duration"),
+])
+def test_bad_step_commands(kwargs, parameter):
+    with pytest.raises(InvalidParameterError) as info:
+        StepCommand(**kwargs)
+    assert info.value.parameter == parameter
+    assert parameter in str(info.value) and "expected" in str(info.value)
+    assert isinstance(info.value, ZmpwalkError)
+
+
+def test_duration_shorter_than_the_double_support(hubo):
+    with pytest.raises(InvalidParameterError, match=r"step 2: duration = 0.08 .*double-support time d = 0.1 s"):
+        generate(hubo, [StepCommand(0.8, 0.1), StepCommand(0.08, 0.1)])
+
+
+def test_stride_beyond_reach_names_leg_time_and_excess(hubo):
+    with pytest.raises(UnreachableError) as info:
+        generate(hubo, [StepCommand(0.8, 0.2), StepCommand(0.8, 0.9)])
+    error = info.value
+    assert "step 2" in str(error) and error.excess > 0 and error.leg in ("left", "right")
+    assert "out of reach from t =" in str(error) and "by up to" in str(error) and error.time > 0
+
+
+def test_feet_that_would_overlap(hubo):
+    with pytest.raises(InvalidParameterError, match=r"turn = 0\.7"):
+        generate(hubo, [StepCommand(0.95, turn=0.7)])
+
+
+@pytest.mark.parametrize("rate", [0.0, -1.0, 1e5, math.nan])
+def test_bad_rate(hubo, rate):
+    with pytest.raises(InvalidParameterError, match="rate"):
+        generate(hubo, [StepCommand(0.8, 0.1)], rate=rate)
+
+
+def test_unknown_names():
+    with pytest.raises(UnknownNameError, match=r"known: .*fig28"):
+        load_scenario("fig99")
+    with pytest.raises(UnknownNameError, match=r"known: .*hubo"):
+        load_robot("asimo")
+
+
+@pytest.mark.parametrize("text, message", [
+    ("[[steps]]\nduration = 0.8\nforwrd = 0.1\n", r"step 1: unknown field 'forwrd'"),
+    ("[[steps]]\nforward = 0.1\n", r"step 1: missing field 'duration'"),
+    ("[[steps]]\nduration = 0.8\n[[steps]]\nduration = -1\n", r"step 2: duration = -1"),
+    ("[[steps]]\nduration = 0.8\nrepeat = 0\n", r"step 1: repeat = 0"),
+    ("[[steps]]\nduration = 0.8\nforward = 'far'\n", r"step 1: forward = 'far'"),
+    ("steps = 3\n", r"no \[\[steps\]\]"),
+    ("[[steps]\nduration = 0.8\n", r"not valid TOML"),
+    ("", r"no \[\[steps\]\]"),
+])
+def test_malformed_steps_files(tmp_path, text, message):
+    path = tmp_path / "walk.toml"
+    path.write_text(text)
+    with pytest.raises(FileFormatError, match=message) as info:
+        load_steps_file(path)
+    assert str(path) in str(info.value)
+
+
+def test_missing_steps_file(tmp_path):
+    with pytest.raises(FileFormatError, match=r"walk\.toml"):
+        load_steps_file(tmp_path / "walk.toml")
+
+
+def test_malformed_robot_file(tmp_path):
+    path = tmp_path / "bot.toml"
+    path.write_text('name = "bot"\ndescription = "x"\nmass = 1.0\nheight = 0.5\n[legs]\nhip_spacing = -0.1\n')
+    with pytest.raises(FileFormatError, match=r"bot\.toml"):
+        load_robot(path)

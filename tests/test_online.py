@@ -1,0 +1,117 @@
+"""OnlineWalker: same pattern as the offline generator, queueing, stopping, rejected commands."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from zmpwalk import InvalidParameterError, StepCommand, UnreachableError, generate
+from zmpwalk.online import OnlineWalker
+
+TOL = 1e-12  # [m] the walker and the generator evaluate the same closed forms
+
+
+def _rows(sample):
+    return np.concatenate([sample.position_pelvis_in_world, [sample.yaw_pelvis_in_world],
+                           sample.position_left_ankle_in_world, sample.position_right_ankle_in_world,
+                           sample.zmp_in_world])
+
+
+def _pattern_rows(pattern):
+    return np.column_stack([pattern.position_pelvis_in_world, pattern.yaw_pelvis_in_world,
+                            pattern.position_left_ankle_in_world, pattern.position_right_ankle_in_world,
+                            pattern.zmp_in_world])
+
+
+def _drive(walker, commands, ticks):
+    """Queue each command as soon as the previous one has started; tick."""
+    pending = list(commands)
+    out = []
+    for _ in range(ticks):
+        if pending and walker.queued is None:
+            walker.command(pending.pop(0))
+        out.append(_rows(walker.tick()))
+    return np.array(out)
+
+
+@pytest.mark.parametrize("rate", [100.0, 1000.0])
+def test_walker_reproduces_the_offline_pattern(hubo, rate):
+    commands = [StepCommand(0.95, 0.0), StepCommand(0.8, 0.2), StepCommand(0.7, 0.1, turn=0.1),
+                StepCommand(0.8, side=0.05), StepCommand(0.95, -0.1)]
+    pattern = generate(hubo, commands, rate=rate)
+    walker = OnlineWalker(hubo, rate=rate)
+    rows = _drive(walker, commands, len(pattern.time))
+    np.testing.assert_allclose(rows, _pattern_rows(pattern), atol=TOL, rtol=0)
+    assert not walker.walking  # it stopped by itself into the ready posture
+
+
+def test_walker_stands_still_until_commanded(hubo):
+    walker = OnlineWalker(hubo, rate=100)
+    first = walker.tick()
+    for _ in range(50):
+        sample = walker.tick()
+    np.testing.assert_array_equal(_rows(sample), _rows(first))
+    assert sample.support == "double" and sample.time == pytest.approx(0.5)
+    walker.command(StepCommand(0.8, 0.2))
+    assert walker.walking
+
+
+def test_queued_command_is_replaced_before_it_starts(hubo):
+    walker = OnlineWalker(hubo, rate=100)
+    walker.command(StepCommand(0.8, 0.1))
+    walker.tick()
+    walker.command(StepCommand(0.8, 0.2))
+    walker.command(StepCommand(0.8, 0.25))  # replaces the 0.2 before it starts
+    assert walker.queued == StepCommand(0.8, 0.25)
+
+
+def test_rejected_command_leaves_the_walker_exactly_as_it_was(hubo):
+    commands = [StepCommand(0.8, 0.2)] * 3
+    reference = OnlineWalker(hubo, rate=200)
+    expected = _drive(reference, commands, 1200)
+    walker = OnlineWalker(hubo, rate=200)
+    pending = list(commands)
+    rows = []
+    for tick in range(1200):
+        if pending and walker.queued is None:
+            walker.command(pending.pop(0))
+        if tick % 97 == 0:
+            queued = walker.queued
+            for bad in (StepCommand(0.8, 0.9), StepCommand(0.08, 0.1)):
+                with pytest.raises((UnreachableError, InvalidParameterError)):
+                    walker.command(bad)
+            with pytest.raises(InvalidParameterError):
+                walker.command("forward please")  # type: ignore[arg-type]
+            assert walker.queued == queued
+        rows.append(_rows(walker.tick()))
+    np.testing.assert_array_equal(np.array(rows), expected)
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.lists(st.tuples(st.sampled_from([0.7, 0.8, 0.95]), st.floats(0.0, 0.25)), min_size=2, max_size=6),
+       st.integers(0, 40))
+def test_stop_request_ends_in_the_ready_posture(hubo, steps, stop_after):
+    walker = OnlineWalker(hubo, rate=100)
+    for duration, forward in steps:
+        walker.command(StepCommand(duration, forward))
+        while walker.queued is not None:
+            walker.tick()
+    for _ in range(stop_after):
+        walker.tick()
+    walker.stop()
+    for _ in range(2000):
+        sample = walker.tick()
+        if not walker.walking:
+            break
+    assert not walker.walking
+    left, right = sample.position_left_ankle_in_world, sample.position_right_ankle_in_world
+    np.testing.assert_allclose(left - right, [0.0, hubo.hip_spacing, 0.0], atol=1e-12)
+    np.testing.assert_allclose(sample.position_pelvis_in_world[:2], (left[:2] + right[:2]) / 2, atol=1e-12)
+
+
+def test_rate_is_checked(hubo):
+    for rate in (0.0, -100.0, float("nan"), 1e6):
+        with pytest.raises(InvalidParameterError, match="rate"):
+            OnlineWalker(hubo, rate=rate)

@@ -1,0 +1,72 @@
+"""Tables 2-3 of Park et al. (2008) as data, and the interpolation between conditions."""
+
+from __future__ import annotations
+
+import pytest
+
+from zmpwalk import StepCommand
+
+TOL = 1e-12
+
+
+@pytest.mark.parametrize("duration, stride, sway, alpha, u", [
+    (0.95, 0.10, 0.038, 1.85, 0.47), (0.95, 0.30, 0.038, 1.85, 0.47),
+    (0.80, 0.10, 0.035, 1.70, 0.47), (0.80, 0.25, 0.035, 1.60, 0.47),
+    (0.70, 0.10, 0.032, 1.70, 0.425), (0.70, 0.25, 0.032, 1.55, 0.425),
+])
+def test_table2_printed_values(hubo, schedule, duration, stride, sway, alpha, u):
+    first, second = schedule.stage_parameters(StepCommand(duration, stride), hubo)
+    assert (first.sway, first.alpha, first.up_ratio) == pytest.approx((sway, alpha, u), abs=TOL)
+    assert (first.d1, first.alpha1, first.beta1) == pytest.approx((0.2, 1.0, 1.0), abs=TOL)
+    assert first.source == "table" and second == first
+
+
+def test_table2_on_the_spot_u_at_07s(hubo, schedule):
+    first, _ = schedule.stage_parameters(StepCommand(0.7, 0.0), hubo)
+    assert first.up_ratio == pytest.approx(0.5, abs=TOL) and first.sway == pytest.approx(0.032, abs=TOL)
+
+
+@pytest.mark.parametrize("duration, side, sway, alpha1, beta1, d1_open, d1_recovery", [
+    (0.95, 0.05, 0.038, 0.87, 0.87, 0.25, 0.20),
+    (0.95, 0.07, 0.038, 0.85, 0.85, 0.25, 0.20),
+    (0.80, 0.05, 0.035, 0.80, 0.80, 0.22, 0.18),
+    (0.80, 0.07, 0.035, 0.80, 0.78, 0.23, 0.16),
+    (0.70, 0.05, 0.0315, 0.80, 0.80, 0.25, 0.12),
+])
+def test_table3_printed_values(hubo, schedule, duration, side, sway, alpha1, beta1, d1_open, d1_recovery):
+    first, second = schedule.stage_parameters(StepCommand(duration, side=side), hubo)
+    assert (first.sway, first.alpha1, first.beta1, first.d1) == pytest.approx((sway, alpha1, beta1, d1_open), abs=TOL)
+    assert (second.alpha1, second.beta1, second.d1) == pytest.approx((alpha1, beta1, d1_recovery), abs=TOL)
+
+
+def test_interpolation_between_strides_and_step_times(hubo, schedule):
+    mid_stride, _ = schedule.stage_parameters(StepCommand(0.8, 0.15), hubo)
+    assert mid_stride.alpha == pytest.approx((1.7 + 1.6) / 2, abs=TOL)
+    assert mid_stride.source == "interpolated"
+    mid_time, _ = schedule.stage_parameters(StepCommand(0.75, 0.2), hubo)
+    assert mid_time.sway == pytest.approx((0.035 + 0.032) / 2, abs=TOL)
+    assert mid_time.up_ratio == pytest.approx((0.47 + 0.425) / 2, abs=TOL)
+    # alpha is 'x' at stride 0: the nearest defined row is used
+    near_zero, _ = schedule.stage_parameters(StepCommand(0.95, 0.05), hubo)
+    assert near_zero.alpha == pytest.approx(1.85, abs=TOL)
+
+
+def test_small_side_steps_interpolate_towards_stepping_on_the_spot(hubo, schedule):
+    first, _ = schedule.stage_parameters(StepCommand(0.95, side=0.025), hubo)
+    assert first.alpha1 == pytest.approx((1.0 + 0.87) / 2, abs=TOL)
+    assert first.d1 == pytest.approx((0.2 + 0.25) / 2, abs=TOL)
+
+
+def test_outside_the_tables_is_held_and_marked_extrapolated(hubo, schedule):
+    fast, _ = schedule.stage_parameters(StepCommand(0.6, 0.2), hubo)
+    assert fast.source == "extrapolated" and fast.sway == pytest.approx(0.032, abs=TOL)
+    long, _ = schedule.stage_parameters(StepCommand(0.8, 0.35), hubo)
+    assert long.source == "extrapolated" and long.alpha == pytest.approx(1.6, abs=TOL)
+
+
+def test_overrides_replace_scheduled_values(hubo, schedule):
+    first, second = schedule.stage_parameters(
+        StepCommand(0.95, side=0.05, alpha1=1.1, d1=0.3, d1_recovery=0.1, sway=0.04), hubo)
+    assert (first.alpha1, first.d1, first.sway) == pytest.approx((1.1, 0.3, 0.04), abs=TOL)
+    assert (second.d1, second.sway) == pytest.approx((0.1, 0.04), abs=TOL)
+    assert first.source.endswith("+override")
