@@ -14,6 +14,7 @@ from typing import NoReturn
 
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import ZmpwalkError
+from zmpwalk.kinematics import pattern_joint_trajectory
 from zmpwalk.patterns.polynomial import generate
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots import list_robots, load_robot
@@ -58,6 +59,7 @@ def _parser() -> argparse.ArgumentParser:
                       "file (default: hubo)")
     plan.add_argument("--rate", type=float, default=100.0, help="samples per second [Hz] (default: 100)")
     plan.add_argument("--out", type=Path, help="CSV file to write")
+    plan.add_argument("--joints", action="store_true", help="append the 12 leg joint angles [rad] to the CSV")
     plan.add_argument("--json", action="store_true", help="print a JSON summary")
 
     tables = commands.add_parser(
@@ -113,8 +115,9 @@ def _run(args: argparse.Namespace) -> int:
         commands = _commands(args)
         robot = load_robot(args.robot)
         pattern = generate(robot, commands, rate=args.rate)
+        extra = pattern_joint_trajectory(pattern).columns() if args.joints else None
         if args.out:
-            pattern.write_csv(args.out)
+            pattern.write_csv(args.out, extra)
         summary = _summary(pattern)
         if args.json:
             print(json.dumps(summary, indent=2))

@@ -1,14 +1,256 @@
-"""Leg kinematics: hip positions and the reach check (inverse kinematics comes with the leg model)."""
+"""Leg kinematics of a yaw-roll-pitch-pitch-pitch-roll leg: forward, closed-form inverse, reach.
+
+The leg of both papers (Lim et al., Fig. 1; HUBO): hip yaw ``q1`` (about z),
+hip roll ``q2`` (x), hip pitch ``q3`` (y), knee ``q4`` (y), ankle pitch ``q5``
+(y), ankle roll ``q6`` (x). The three hip axes meet at the hip joint centre,
+the two ankle axes at the ankle joint centre. Rotations are right-handed
+about the pelvis frame's axes (x forward, y left, z up), so a positive knee
+angle bends the knee forwards, a negative hip pitch swings the thigh forwards.
+With every angle zero the leg hangs straight down. In the pelvis frame:
+
+.. math::
+    R_{foot} = R_z(q_1) R_x(q_2) R_y(q_3 + q_4 + q_5) R_x(q_6), \qquad
+    p_{ankle} = p_{hip} + R_z(q_1) R_x(q_2) \left[R_y(q_3) (0, 0, -a)^T + R_y(q_3 + q_4)(0, 0, -b)^T\right]
+
+with ``a`` the thigh and ``b`` the shank length. The hip rotation
+``R_z R_x R_y`` is the matrix printed in Lim et al. (``1/2 R``).
+
+Eq. 2 of Lim et al. solves this leg only for straight walking (``q1 = 0``,
+foot parallel to the torso). :func:`leg_ik` solves the general case: any
+ankle position and any foot orientation relative to the pelvis. Work from the
+ankle: the hip seen from the ankle in the foot frame, ``r = R^T (p_hip - p_ankle)``,
+depends on ``q4, q5, q6`` only:
+
+.. math::
+    r = R_x(-q_6) R_y(-q_5) \left[(-a \sin q_4, 0, a \cos q_4 + b)^T\right]
+
+so ``|r|`` gives the knee (law of cosines), ``atan2(r_y, r_z)`` the ankle roll,
+the angle of ``r`` in the leg plane the ankle pitch, and the remaining hip
+rotation ``R R_x(-q_6) R_y(-q_4 - q_5) = R_z(q_1) R_x(q_2) R_y(q_3)`` gives the
+three hip angles. The knee branch is ``q4 >= 0`` (forwards, default) or ``q4 <= 0``.
+"""
 
 from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
-from zmpwalk.errors import UnreachableError
-from zmpwalk.robots.model import RobotModel
+from zmpwalk.errors import UnreachableError, ZmpwalkError
+from zmpwalk.robots.model import JOINT_NAMES, RobotModel
+
+if TYPE_CHECKING:
+    from zmpwalk.patterns.result import WalkingPattern
 
 Array = NDArray[np.float64]
+
+LEG_JOINTS = JOINT_NAMES  # hip_yaw, hip_roll, hip_pitch, knee, ankle_pitch, ankle_roll
+JOINT_COLUMNS = tuple(f"{side}_{joint}" for side in ("left", "right") for joint in LEG_JOINTS)
+
+
+class JointLimitError(ZmpwalkError, ValueError):
+    """A joint angle of a trajectory leaves the robot's joint range.
+
+    Attributes:
+        joint: Column name, e.g. ``"left_knee"``.
+        angle: The angle [rad].
+        time: When [s].
+        limits: (lower, upper) [rad].
+    """
+
+    def __init__(self, joint: str, angle: float, time: float, limits: tuple[float, float]) -> None:
+        self.joint, self.angle, self.time, self.limits = joint, angle, time, limits
+        super().__init__(
+            f"{joint} = {angle:.4f} rad at t = {time:.3f} s is outside its range "
+            f"[{limits[0]:.4f}, {limits[1]:.4f}] rad"
+        )
+
+
+def rot_x(angle: Array) -> Array:
+    """Rotation matrices about x, shape (n, 3, 3)."""
+    c, s = np.cos(angle), np.sin(angle)
+    o, z = np.ones_like(c), np.zeros_like(c)
+    return np.stack([np.stack([o, z, z], -1), np.stack([z, c, -s], -1), np.stack([z, s, c], -1)], -2)
+
+
+def rot_y(angle: Array) -> Array:
+    """Rotation matrices about y, shape (n, 3, 3)."""
+    c, s = np.cos(angle), np.sin(angle)
+    o, z = np.ones_like(c), np.zeros_like(c)
+    return np.stack([np.stack([c, z, s], -1), np.stack([z, o, z], -1), np.stack([-s, z, c], -1)], -2)
+
+
+def rot_z(angle: Array) -> Array:
+    """Rotation matrices about z, shape (n, 3, 3)."""
+    c, s = np.cos(angle), np.sin(angle)
+    o, z = np.ones_like(c), np.zeros_like(c)
+    return np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1), np.stack([z, z, o], -1)], -2)
+
+
+@dataclass(frozen=True)
+class Leg:
+    """Geometry of one leg in the pelvis frame.
+
+    Attributes:
+        side: +1 left, -1 right.
+        hip: Hip joint centre in the pelvis frame [m], (3,).
+        thigh: Hip pitch axis to knee axis ``a`` [m].
+        shank: Knee axis to ankle axes ``b`` [m].
+    """
+
+    side: int
+    hip: tuple[float, float, float]  # [m]
+    thigh: float  # [m]
+    shank: float  # [m]
+
+    @classmethod
+    def of(cls, robot: RobotModel, side: int) -> Leg:
+        """The left (``side = +1``) or right (``-1``) leg of ``robot``."""
+        return cls(side, (0.0, side * robot.hip_spacing / 2, -robot.hip_drop), robot.thigh_length,
+                   robot.shank_length)
+
+
+def leg_fk(leg: Leg, q: Array) -> tuple[Array, Array]:
+    """Forward kinematics: ankle position [m] (n, 3) and foot rotation (n, 3, 3) in the pelvis frame.
+
+    Args:
+        leg: The leg.
+        q: Joint angles [rad], (n, 6) in the order of :data:`LEG_JOINTS`.
+    """
+    q = np.atleast_2d(q)
+    hip_rotation = rot_z(q[:, 0]) @ rot_x(q[:, 1])
+    pitch_thigh = q[:, 2]
+    pitch_shank = q[:, 2] + q[:, 3]
+    leg_vector = np.stack([
+        -leg.thigh * np.sin(pitch_thigh) - leg.shank * np.sin(pitch_shank),
+        np.zeros(len(q)),
+        -leg.thigh * np.cos(pitch_thigh) - leg.shank * np.cos(pitch_shank),
+    ], axis=-1)
+    ankle = np.asarray(leg.hip) + np.einsum("nij,nj->ni", hip_rotation, leg_vector)
+    foot = hip_rotation @ rot_y(q[:, 2] + q[:, 3] + q[:, 4]) @ rot_x(q[:, 5])
+    return ankle, foot
+
+
+@dataclass(frozen=True)
+class LegSolution:
+    """Closed-form IK result for many poses.
+
+    Attributes:
+        angles: (n, 6) [rad], order of :data:`LEG_JOINTS`.
+        excess: Hip-to-ankle distance beyond the leg's reach [m], (n,); > 0 where unreachable
+            (the angles there are those of the stretched leg pointing at the target).
+    """
+
+    angles: Array
+    excess: Array
+
+    @property
+    def reachable(self) -> NDArray[np.bool_]:
+        return self.excess <= 0.0
+
+
+def leg_ik(leg: Leg, position_ankle_in_pelvis: Array, rotation_foot_in_pelvis: Array,
+           knee_forward: bool = True) -> LegSolution:
+    """Closed-form inverse kinematics, vectorised (see the module docstring for the derivation).
+
+    Args:
+        leg: The leg.
+        position_ankle_in_pelvis: Ankle joint centre [m], (n, 3).
+        rotation_foot_in_pelvis: Foot orientation, (n, 3, 3).
+        knee_forward: The knee branch: ``q4 >= 0`` (True) or ``q4 <= 0``.
+
+    Returns:
+        The angles and, per pose, how far it is out of reach.
+    """
+    p = np.atleast_2d(position_ankle_in_pelvis)
+    R = rotation_foot_in_pelvis.reshape(-1, 3, 3)
+    d = np.asarray(leg.hip) - p
+    r = np.einsum("nji,nj->ni", R, d)  # R^T (hip - ankle): the hip seen from the ankle, foot frame
+    a, b = leg.thigh, leg.shank
+    distance = np.sqrt(np.einsum("ni,ni->n", r, r))
+    excess = np.maximum(distance - (a + b), (abs(a - b) - distance))
+    cos_knee = np.clip((distance**2 - a * a - b * b) / (2 * a * b), -1.0, 1.0)
+    q4 = np.arccos(cos_knee) * (1.0 if knee_forward else -1.0)
+    q6 = np.arctan2(r[:, 1], r[:, 2])
+    u_z = np.hypot(r[:, 1], r[:, 2])
+    q5 = np.arctan2(-a * np.sin(q4), a * np.cos(q4) + b) - np.arctan2(r[:, 0], u_z)
+    hip = R @ rot_x(-q6) @ rot_y(-(q4 + q5))  # = Rz(q1) Rx(q2) Ry(q3)
+    q1 = np.arctan2(-hip[:, 0, 1], hip[:, 1, 1])
+    q2 = np.arctan2(hip[:, 2, 1], np.hypot(hip[:, 0, 1], hip[:, 1, 1]))
+    q3 = np.arctan2(-hip[:, 2, 0], hip[:, 2, 2])
+    return LegSolution(np.stack([q1, q2, q3, q4, q5, q6], axis=1), excess)
+
+
+def leg_ik_yaw(leg: Leg, position_ankle_in_pelvis: Array, yaw_foot_in_pelvis: Array,
+               knee_forward: bool = True) -> LegSolution:
+    """:func:`leg_ik` for a flat foot (rotation ``Rz(yaw)``), written component-wise for speed.
+
+    Args:
+        leg: The leg.
+        position_ankle_in_pelvis: Ankle joint centre [m], (n, 3).
+        yaw_foot_in_pelvis: Foot yaw relative to the pelvis (the hip yaw of the paper's Eq. 21) [rad], (n,).
+        knee_forward: Knee branch.
+    """
+    p = np.atleast_2d(position_ankle_in_pelvis)
+    c, s = np.cos(yaw_foot_in_pelvis), np.sin(yaw_foot_in_pelvis)
+    dx, dy, dz = leg.hip[0] - p[:, 0], leg.hip[1] - p[:, 1], leg.hip[2] - p[:, 2]
+    rx, ry, rz = c * dx + s * dy, c * dy - s * dx, dz
+    a, b = leg.thigh, leg.shank
+    distance = np.sqrt(rx * rx + ry * ry + rz * rz)
+    excess = np.maximum(distance - (a + b), abs(a - b) - distance)
+    q4 = np.arccos(np.clip((distance * distance - a * a - b * b) / (2 * a * b), -1.0, 1.0))
+    if not knee_forward:
+        q4 = -q4
+    q6 = np.arctan2(ry, rz)
+    u_z = np.hypot(ry, rz)
+    q5 = np.arctan2(-a * np.sin(q4), a * np.cos(q4) + b) - np.arctan2(rx, u_z)
+    pitch = -(q4 + q5)
+    cp, sp = np.cos(pitch), np.sin(pitch)
+    c6, s6 = rz / u_z, -ry / u_z  # cos(-q6), sin(-q6) without trigonometry: q6 = atan2(ry, rz)
+    m01, m11 = -s * c6, c * c6
+    q1 = np.arctan2(-m01, m11)
+    q2 = np.arctan2(s6, np.hypot(m01, m11))
+    q3 = np.arctan2(c6 * sp, c6 * cp)
+    return LegSolution(np.stack([q1, q2, q3, q4, q5, q6], axis=1), excess)
+
+
+def leg_ik_scalar(leg: Leg, ankle: tuple[float, float, float], foot_yaw: float,
+                  knee_forward: bool = True) -> tuple[float, ...]:
+    """The same closed form for one pose with a flat foot of yaw ``foot_yaw`` [rad] (pelvis frame).
+
+    Plain ``math`` for a controller that solves one leg per tick.
+
+    Raises:
+        UnreachableError: The ankle is out of the leg's reach (``time`` is nan).
+    """
+    c, s = math.cos(foot_yaw), math.sin(foot_yaw)
+    dx, dy, dz = leg.hip[0] - ankle[0], leg.hip[1] - ankle[1], leg.hip[2] - ankle[2]
+    rx, ry, rz = c * dx + s * dy, -s * dx + c * dy, dz  # Rz(yaw)^T (hip - ankle)
+    a, b = leg.thigh, leg.shank
+    distance = math.sqrt(rx * rx + ry * ry + rz * rz)
+    if distance > a + b or distance < abs(a - b):
+        excess = max(distance - a - b, abs(a - b) - distance)
+        raise UnreachableError("left" if leg.side > 0 else "right", math.nan, excess)
+    q4 = math.acos(max(-1.0, min(1.0, (distance * distance - a * a - b * b) / (2 * a * b))))
+    if not knee_forward:
+        q4 = -q4
+    q6 = math.atan2(ry, rz)
+    q5 = math.atan2(-a * math.sin(q4), a * math.cos(q4) + b) - math.atan2(rx, math.hypot(ry, rz))
+    # hip rotation = Rz(yaw) Rx(-q6) Ry(-(q4 + q5)); only the entries needed for q1, q2, q3
+    p = -(q4 + q5)
+    cp, sp = math.cos(p), math.sin(p)
+    c6, s6 = math.cos(-q6), math.sin(-q6)
+    # Rx(-q6) Ry(p) = [[cp, 0, sp], [s6*sp, c6, -s6*cp], [-c6*sp, s6, c6*cp]]
+    m01 = -s * c6
+    m11 = c * c6
+    m20, m21, m22 = -c6 * sp, s6, c6 * cp
+    q1 = math.atan2(-m01, m11)
+    q2 = math.atan2(m21, math.hypot(m01, m11))
+    q3 = math.atan2(-m20, m22)
+    return q1, q2, q3, q4, q5, q6
 
 
 def hip_positions_in_world(
@@ -68,3 +310,126 @@ def check_leg_reach(
     )
     error.sample = first
     raise error
+
+
+def leg_jacobian(leg: Leg, q: Array) -> Array:
+    """Geometric Jacobian of the ankle in the pelvis frame, (n, 6, 6): rows (v, omega), columns joints."""
+    q = np.atleast_2d(q)
+    n = len(q)
+    hip = np.broadcast_to(np.asarray(leg.hip), (n, 3))
+    yaw = rot_z(q[:, 0])
+    yaw_roll = yaw @ rot_x(q[:, 1])
+    ex, ey, ez = np.eye(3)
+    z1 = np.broadcast_to(ez, (n, 3))
+    z2 = yaw @ ex
+    z3 = yaw_roll @ ey
+    thigh = np.stack([-leg.thigh * np.sin(q[:, 2]), np.zeros(n), -leg.thigh * np.cos(q[:, 2])], -1)
+    knee = hip + np.einsum("nij,nj->ni", yaw_roll, thigh)
+    ankle, _ = leg_fk(leg, q)
+    z6 = (yaw_roll @ rot_y(q[:, 2] + q[:, 3] + q[:, 4])) @ ex
+    axes = [z1, z2, z3, z3, z3, z6]
+    origins = [hip, hip, hip, knee, ankle, ankle]
+    jacobian = np.empty((n, 6, 6))
+    for column, (axis, origin) in enumerate(zip(axes, origins, strict=True)):
+        jacobian[:, :3, column] = np.cross(axis, ankle - origin)
+        jacobian[:, 3:, column] = axis
+    return jacobian
+
+
+@dataclass
+class JointTrajectory:
+    """The 12 leg joint angles and velocities along a walking pattern.
+
+    Attributes:
+        time: [s], (n,).
+        angles: [rad], (n, 12), columns :data:`JOINT_COLUMNS` (left leg, then right leg).
+        velocities: [rad/s], (n, 12).
+    """
+
+    time: Array
+    angles: Array
+    velocities: Array
+    names: tuple[str, ...] = JOINT_COLUMNS
+
+    def columns(self) -> dict[str, Array]:
+        """Angles by column name, for the CSV of ``zmpwalk plan --joints``."""
+        return {name: self.angles[:, i] for i, name in enumerate(self.names)}
+
+
+def joint_trajectory(
+    time: Array,
+    position_pelvis_in_world: Array,
+    yaw_pelvis_in_world: Array,
+    velocity_pelvis_in_world: Array,
+    yaw_rate_pelvis: Array,
+    feet: tuple[tuple[Array, Array, Array, Array], tuple[Array, Array, Array, Array]],
+    robot: RobotModel,
+    knee_forward: bool = True,
+    check_limits: bool = True,
+) -> JointTrajectory:
+    """Joint angles (closed-form IK) and velocities (Jacobian) of both legs with an upright pelvis.
+
+    Args:
+        time: [s], (n,).
+        position_pelvis_in_world, yaw_pelvis_in_world, velocity_pelvis_in_world, yaw_rate_pelvis:
+            the pelvis [m], [rad], [m/s], [rad/s].
+        feet: For the left then the right foot: ankle position [m] (n, 3), foot yaw [rad] (n,),
+            ankle velocity [m/s] (n, 3) and foot yaw rate [rad/s] (n,), all in world.
+        robot: The robot (leg lengths, hip positions, joint ranges).
+        knee_forward: Knee branch.
+        check_limits: Raise :class:`JointLimitError` when an angle leaves the robot's range.
+
+    Raises:
+        UnreachableError: First time an ankle is out of reach, with the largest excess.
+        JointLimitError: First joint to leave its range (when ``check_limits``).
+    """
+    n = len(time)
+    c, s = np.cos(yaw_pelvis_in_world), np.sin(yaw_pelvis_in_world)
+    angles = np.empty((n, 12))
+    velocities = np.empty((n, 12))
+    for index, (side, (position, yaw, velocity, yaw_rate)) in enumerate(zip((1, -1), feet, strict=True)):
+        leg = Leg.of(robot, side)
+        rel = position - position_pelvis_in_world
+        ankle_in_pelvis = np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1], rel[:, 2]])
+        solution = leg_ik_yaw(leg, ankle_in_pelvis, yaw - yaw_pelvis_in_world, knee_forward)
+        if np.any(solution.excess > 0):
+            first = int(np.argmax(solution.excess > 0))
+            raise UnreachableError("left" if side > 0 else "right", float(time[first]),
+                                   float(solution.excess.max()), "inverse kinematics")
+        # Relative velocity of the ankle in the (rotating) pelvis frame.
+        v = velocity - velocity_pelvis_in_world
+        v[:, 0] += yaw_rate_pelvis * rel[:, 1]
+        v[:, 1] -= yaw_rate_pelvis * rel[:, 0]
+        twist = np.column_stack([c * v[:, 0] + s * v[:, 1], -s * v[:, 0] + c * v[:, 1], v[:, 2],
+                                 np.zeros(n), np.zeros(n), yaw_rate - yaw_rate_pelvis])
+        rates = np.linalg.solve(leg_jacobian(leg, solution.angles), twist[..., None])[..., 0]
+        angles[:, 6 * index:6 * index + 6] = solution.angles
+        velocities[:, 6 * index:6 * index + 6] = rates
+    if check_limits:
+        check_joint_limits(time, angles, robot)
+    return JointTrajectory(time, angles, velocities)
+
+
+def check_joint_limits(time: Array, angles: Array, robot: RobotModel) -> None:
+    """Raise :class:`JointLimitError` for the first sample and joint outside the robot's ranges."""
+    lower = np.array([robot.joint_limits.get(j, (-np.inf, np.inf))[0] for j in LEG_JOINTS] * 2)
+    upper = np.array([robot.joint_limits.get(j, (-np.inf, np.inf))[1] for j in LEG_JOINTS] * 2)
+    outside = (angles < lower) | (angles > upper)
+    if np.any(outside):
+        sample = int(np.argmax(outside.any(axis=1)))
+        column = int(np.argmax(outside[sample]))
+        raise JointLimitError(JOINT_COLUMNS[column], float(angles[sample, column]), float(time[sample]),
+                              (float(lower[column]), float(upper[column])))
+
+
+def pattern_joint_trajectory(pattern: WalkingPattern, knee_forward: bool = True,
+                             check_limits: bool = True) -> JointTrajectory:
+    """Joint angles and velocities of a :class:`~zmpwalk.patterns.result.WalkingPattern` (any generator)."""
+    return joint_trajectory(
+        pattern.time, pattern.position_pelvis_in_world, pattern.yaw_pelvis_in_world,
+        pattern.velocity_pelvis_in_world, pattern.yaw_rate_pelvis,
+        ((pattern.position_left_ankle_in_world, pattern.yaw_left_foot_in_world,
+          pattern.velocity_left_ankle_in_world, pattern.yaw_rate_left_foot),
+         (pattern.position_right_ankle_in_world, pattern.yaw_right_foot_in_world,
+          pattern.velocity_right_ankle_in_world, pattern.yaw_rate_right_foot)),
+        pattern.robot, knee_forward, check_limits)

@@ -39,8 +39,10 @@ from numpy.typing import NDArray
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import InvalidParameterError
 from zmpwalk.footsteps import Stance
+from zmpwalk.kinematics import joint_trajectory
 from zmpwalk.patterns.polynomial import (
     Boundary,
+    Samples,
     Stage,
     StageTable,
     check_rate,
@@ -59,7 +61,9 @@ _PELVIS, _PELVIS_YAW = slice(0, 3), 3
 _LEFT, _LEFT_YAW = slice(4, 7), 7
 _RIGHT, _RIGHT_YAW = slice(8, 11), 11
 _ZMP, _SUPPORT = slice(12, 14), 14
+_JOINTS, _JOINT_RATES = slice(15, 27), slice(27, 39)
 _WIDTH = 15
+_WIDTH_WITH_JOINTS = 39
 _EPS = 1e-9
 
 
@@ -75,6 +79,9 @@ class WalkingSample:
         position_left_ankle_in_world, position_right_ankle_in_world: [m], shape (3,).
         yaw_left_foot_in_world, yaw_right_foot_in_world: [rad].
         zmp_in_world: Cart-table ZMP [m], shape (2,).
+        joint_angles: The 12 leg joint angles [rad] in the order of
+            :data:`zmpwalk.kinematics.JOINT_COLUMNS`, or None unless the walker was made with ``joints=True``.
+        joint_velocities: Their rates [rad/s], or None.
     """
 
     time: float
@@ -86,6 +93,8 @@ class WalkingSample:
     position_right_ankle_in_world: Array
     yaw_right_foot_in_world: float
     zmp_in_world: Array
+    joint_angles: Array | None = None
+    joint_velocities: Array | None = None
 
 
 @dataclass
@@ -105,12 +114,18 @@ class OnlineWalker:
         robot: The robot.
         rate: Control rate [Hz] (HUBO: 100 Hz; 1 kHz servo loops are common).
         schedule: Parameter tables (Tables 2-3 of the paper by default).
+        joints: Also return the 12 joint angles and velocities at every tick
+            (closed-form IK, computed when a command is queued; a command whose
+            pattern leaves the legs' reach or joint ranges is rejected).
     """
 
-    def __init__(self, robot: RobotModel, rate: float = 100.0, schedule: Schedule | None = None) -> None:
+    def __init__(self, robot: RobotModel, rate: float = 100.0, schedule: Schedule | None = None,
+                 joints: bool = False) -> None:
         check_rate(rate)
         self.robot = robot
         self.rate = float(rate)
+        self.joints = bool(joints)
+        self._width = _WIDTH_WITH_JOINTS if self.joints else _WIDTH
         self._schedule = schedule or Schedule.hubo()
         self._index = 0
         self._stance = Stance.ready(robot)
@@ -180,6 +195,8 @@ class OnlineWalker:
             position_right_ankle_in_world=row[_RIGHT],
             yaw_right_foot_in_world=float(row[_RIGHT_YAW]),
             zmp_in_world=row[_ZMP],
+            joint_angles=row[_JOINTS] if self.joints else None,
+            joint_velocities=row[_JOINT_RATES] if self.joints else None,
         )
 
     def _advance(self, index: int) -> _Plan | None:
@@ -204,10 +221,12 @@ class OnlineWalker:
     def _sample(self, stages: list[Stage], first_index: int, end_time: float) -> Array:
         stop_index = math.ceil(end_time * self.rate - _EPS)
         times = np.arange(first_index, stop_index) / self.rate
-        rows = np.empty((len(times), _WIDTH))
+        rows = np.empty((len(times), self._width))
         if len(times) == 0:
             return rows
         samples = evaluate(StageTable(stages), times, self.robot)
+        if self.joints:
+            self._fill_joints(rows, samples)
         rows[:, 0:2] = samples.pelvis_xy
         rows[:, 2] = self.robot.pelvis_height
         rows[:, _PELVIS_YAW] = samples.pelvis_yaw
@@ -219,9 +238,21 @@ class OnlineWalker:
         rows[:, _SUPPORT] = samples.support
         return rows
 
+    def _fill_joints(self, rows: Array, samples: Samples) -> None:
+        n = len(samples.time)
+        pelvis = np.column_stack([samples.pelvis_xy, np.full(n, self.robot.pelvis_height)])
+        trajectory = joint_trajectory(
+            samples.time, pelvis, samples.pelvis_yaw, np.column_stack([samples.pelvis_velocity_xy, np.zeros(n)]),
+            samples.pelvis_yaw_rate,
+            ((samples.left_position, samples.left_yaw, samples.left_velocity, samples.left_yaw_rate),
+             (samples.right_position, samples.right_yaw, samples.right_velocity, samples.right_yaw_rate)),
+            self.robot)
+        rows[:, _JOINTS] = trajectory.angles
+        rows[:, _JOINT_RATES] = trajectory.velocities
+
     def _standing_row(self, stance: Stance) -> Array:
         middle = np.array([(stance.left.x + stance.right.x) / 2, (stance.left.y + stance.right.y) / 2])
-        row = np.zeros(_WIDTH)
+        row = np.zeros(self._width)
         row[0:2] = middle
         row[2] = self.robot.pelvis_height
         row[_PELVIS_YAW] = (stance.left.yaw + stance.right.yaw) / 2
@@ -231,4 +262,12 @@ class OnlineWalker:
         row[_RIGHT_YAW] = stance.right.yaw
         row[_ZMP] = middle
         row[_SUPPORT] = 0
+        if self.joints:
+            z, one = np.zeros((1, 3)), np.zeros(1)
+            trajectory = joint_trajectory(
+                np.zeros(1), row[None, _PELVIS], row[None, _PELVIS_YAW], z, one,
+                ((row[None, _LEFT], row[None, _LEFT_YAW], z, one), (row[None, _RIGHT], row[None, _RIGHT_YAW], z, one)),
+                self.robot)
+            row[_JOINTS] = trajectory.angles[0]
+            row[_JOINT_RATES] = 0.0
         return row
