@@ -1,4 +1,4 @@
-"""Leg kinematics of a yaw-roll-pitch-pitch-pitch-roll leg: forward, closed-form inverse, reach.
+r"""Leg kinematics of a yaw-roll-pitch-pitch-pitch-roll leg: forward, closed-form inverse, reach.
 
 The leg of both papers (Lim et al., Fig. 1; HUBO): hip yaw ``q1`` (about z),
 hip roll ``q2`` (x), hip pitch ``q3`` (y), knee ``q4`` (y), ankle pitch ``q5``
