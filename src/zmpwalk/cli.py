@@ -15,6 +15,7 @@ from typing import NoReturn
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import ZmpwalkError
 from zmpwalk.kinematics import pattern_joint_trajectory
+from zmpwalk.patterns.hyperbolic import HyperbolicGait, generate_hyperbolic
 from zmpwalk.patterns.polynomial import generate
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots import list_robots, load_robot
@@ -22,6 +23,20 @@ from zmpwalk.scenarios import list_scenarios, load_scenario, load_steps_file
 from zmpwalk.tables import condition_margins, margins_markdown
 
 EXIT_ERROR = 2
+GENERATORS = ("polynomial", "hyperbolic")
+
+
+def paper_example() -> dict[str, object]:
+    """The walking example of Lim et al. (Section 4): Eq. 11 times, lateral sway, Eq. 15 start ZMPs (SI)."""
+    gait = HyperbolicGait()
+    step = gait.steady()
+    (xd, yd), (xs, ys) = gait.start_zmps()
+    return {
+        "t1": step.t1, "t2": step.t2, "t3": step.t3, "t4": step.t4, "t5": step.t5,
+        "y0": step.y0, "v_y": step.v_y, "v_xS": step.v_single, "x_prime": step.end,
+        "steady_period": 2 * step.period,
+        "zmp_start_double": [xd, yd], "zmp_start_single": [xs, ys],
+    }
 
 
 class _Parser(argparse.ArgumentParser):
@@ -58,9 +73,22 @@ def _parser() -> argparse.ArgumentParser:
     plan.add_argument("--robot", default="hubo", help=f"built-in robot ({', '.join(list_robots())}) or a robot "
                       "file (default: hubo)")
     plan.add_argument("--rate", type=float, default=100.0, help="samples per second [Hz] (default: 100)")
+    plan.add_argument("--generator", choices=GENERATORS, default="polynomial",
+                      help="polynomial (HUBO, Park et al. 2008; default) or hyperbolic (LIPM, Lim et al.)")
     plan.add_argument("--out", type=Path, help="CSV file to write")
     plan.add_argument("--joints", action="store_true", help="append the 12 leg joint angles [rad] to the CSV")
     plan.add_argument("--json", action="store_true", help="print a JSON summary")
+
+    hyperbolic = commands.add_parser(
+        "hyperbolic", help="the hyperbolic (LIPM) pattern of Lim et al.: the paper's example",
+        description="Solve the paper's walking example (Eqs. 11 and 15 of Lim et al.): steady-step times, "
+        "lateral sway and the ZMPs of the start from standstill. Times in s, lengths in m.",
+        epilog="example: zmpwalk hyperbolic --paper-example --json",
+    )
+    hyperbolic.add_argument("--paper-example", action="store_true", required=True,
+                            help="z_b = 395 mm, x_s = 100 mm, x_ZMP1 = x_s/8, x_ZMP2 = x_s/4, y_ZMP = 68 mm, "
+                            "v_xD = 100 mm/s, t* = 0.2 s, tau* = 0.3 s, g = 9.8 m/s^2")
+    hyperbolic.add_argument("--json", action="store_true", help="print a JSON object")
 
     tables = commands.add_parser(
         "tables", help="walk every condition of Tables 2-3 and print the ZMP margins",
@@ -114,7 +142,10 @@ def _run(args: argparse.Namespace) -> int:
     if args.command == "plan":
         commands = _commands(args)
         robot = load_robot(args.robot)
-        pattern = generate(robot, commands, rate=args.rate)
+        if args.generator == "hyperbolic":
+            pattern = generate_hyperbolic(robot, commands, rate=args.rate)
+        else:
+            pattern = generate(robot, commands, rate=args.rate)
         extra = pattern_joint_trajectory(pattern).columns() if args.joints else None
         if args.out:
             pattern.write_csv(args.out, extra)
@@ -128,6 +159,14 @@ def _run(args: argparse.Namespace) -> int:
                   f"{args.rate:g} Hz" + (f" -> {args.out}" if args.out else ""))
             print(f"min ZMP margin: {margin * 1e3:+.1f} mm at t = {summary['min_zmp_margin_time']:.3f} s "
                   f"({verdict})")
+        return 0
+    if args.command == "hyperbolic":
+        result = paper_example()
+        if args.json:
+            print(json.dumps(result, indent=2))
+        else:
+            for key, value in result.items():
+                print(f"{key:>17}: {value}")
         return 0
     if args.command == "tables":
         if args.steps < 1:
