@@ -15,3 +15,8 @@ def hubo() -> RobotModel:
 @pytest.fixture(scope="session")
 def schedule() -> Schedule:
     return Schedule.hubo()
+
+
+@pytest.fixture(scope="session")
+def mju() -> RobotModel:
+    return load_robot("mju-biped")

@@ -181,8 +181,11 @@ def assert_continuous(robot, stages):
     index_a = np.array(index, dtype=np.intp)
     left = _state(evaluate(table, times_a - EPS, robot, index_a))
     right = _state(evaluate(table, times_a + EPS, robot, index_a))
+    exact = _state(evaluate(table, times_a, robot, index_a))  # the breakpoint itself, where pieces meet
     np.testing.assert_allclose(left[0], right[0], atol=POSITION_TOL, rtol=0)
     np.testing.assert_allclose(left[1], right[1], atol=VELOCITY_TOL, rtol=0)
+    np.testing.assert_allclose(exact[0], right[0], atol=POSITION_TOL, rtol=0)
+    np.testing.assert_allclose(exact[1], right[1], atol=VELOCITY_TOL, rtol=0)
 
 
 @settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])

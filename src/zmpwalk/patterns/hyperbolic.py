@@ -181,7 +181,7 @@ def solve_step(a: float, stride: float, step_time: float, dsp_time: float, y_zmp
         raise InfeasiblePatternError(
             f"the double support must be shorter than the step: d = {dsp_time:g} s, T = {step_time:g} s")
     single = step_time - dsp_time
-    if stride == 0:
+    if abs(stride) < 1e-9:  # [m] stepping on the spot: no sagittal motion
         y0, v_y = lateral_sway(a, dsp_time, single, y_zmp)
         return SteadyStep(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, single / 2, 0.0, single / 2, dsp_time, single, y_zmp,
                           y0, v_y)
@@ -523,10 +523,8 @@ class HyperbolicWalk:
     def sample(self, rate: float, generator: str = "hyperbolic") -> WalkingPattern:
         """The walk sampled at ``rate`` [Hz] from 0 to its end, as a :class:`WalkingPattern`."""
         check_rate(rate)
-        count = math.floor(self.duration * rate + 1e-9) + 1
+        count = math.ceil(self.duration * rate - 1e-9) + 1  # up to the first sample at or after the end
         time = np.arange(count) / rate
-        if time[-1] < self.duration - 1e-12:
-            time = np.append(time, self.duration)
         x, vx, ax = self.x_axis.evaluate(time)
         y, vy, ay = self.y_axis.evaluate(time)
         n = len(time)

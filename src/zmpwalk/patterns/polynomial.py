@@ -389,7 +389,7 @@ def evaluate(table: StageTable, time: Array, robot: RobotModel, index: NDArray[n
     out_time, back_time = table.out_time[k], table.back_time[k]
     back_start = T - back_time
     first_half = elapsed < out_time
-    second_half = elapsed >= back_start
+    second_half = (elapsed >= back_start) & ~first_half  # exclusive also where rounding makes them touch
     sigma = np.where(first_half, elapsed / out_time, np.where(second_half, (elapsed - back_start) / back_time, 0.0))
     p_start = np.where(first_half, 0.0, amp)
     m_start = np.where(first_half, table.w0[k], 0.0)
@@ -615,10 +615,8 @@ def generate(
     check_rate(rate)
     stages, _ = plan_walk(robot, commands, schedule)
     end_time = stages[-1].start
-    count = math.floor(end_time * rate + 1e-9) + 1
+    count = math.ceil(end_time * rate - 1e-9) + 1  # up to the first sample at or after the end
     times = np.arange(count) / rate
-    if times[-1] < end_time - 1e-12:
-        times = np.append(times, end_time)
     table = StageTable(stages)
     return pattern_from_samples(evaluate(table, times, robot), stages, robot, rate, "polynomial")
 

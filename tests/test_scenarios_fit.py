@@ -1,0 +1,39 @@
+"""Which built-in scenario fits which robot and generator (docs/generators.md keeps the same table)."""
+
+from __future__ import annotations
+
+import pytest
+
+from zmpwalk import InfeasiblePatternError, InvalidParameterError, UnreachableError, generate, load_robot
+from zmpwalk.kinematics import pattern_joint_trajectory
+from zmpwalk.patterns.hyperbolic import generate_hyperbolic
+from zmpwalk.scenarios import load_scenario
+
+OK = None
+EXPECTED = {
+    ("hubo", "polynomial"): dict.fromkeys(["fig10", "fig27", "fig28", "fig29", "fig30", "fig31", "turn45"], OK),
+    ("hubo", "hyperbolic"): {"fig10": InfeasiblePatternError, "fig27": OK, "fig28": OK, "fig29": OK,
+                             "fig30": InvalidParameterError, "fig31": InvalidParameterError,
+                             "turn45": InvalidParameterError},
+    ("mju-biped", "polynomial"): {"fig10": UnreachableError, "fig27": UnreachableError, "fig28": UnreachableError,
+                                  "fig29": UnreachableError, "fig30": OK, "fig31": OK, "turn45": OK},
+    ("mju-biped", "hyperbolic"): {"fig10": InfeasiblePatternError, "fig27": UnreachableError,
+                                  "fig28": UnreachableError, "fig29": UnreachableError,
+                                  "fig30": InvalidParameterError, "fig31": InvalidParameterError,
+                                  "turn45": InvalidParameterError},
+}
+CASES = [(robot, generator, name, outcome) for (robot, generator), table in EXPECTED.items()
+         for name, outcome in table.items()]
+
+
+@pytest.mark.parametrize("robot_name, generator, scenario, outcome", CASES)
+def test_scenario_fits_or_fails_as_documented(robot_name, generator, scenario, outcome):
+    robot = load_robot(robot_name)
+    make = generate if generator == "polynomial" else generate_hyperbolic
+    commands = load_scenario(scenario)
+    if outcome is OK:
+        joints = pattern_joint_trajectory(make(robot, commands, rate=200.0))
+        assert joints.angles.shape[1] == 12
+    else:
+        with pytest.raises(outcome):
+            pattern_joint_trajectory(make(robot, commands, rate=200.0))
