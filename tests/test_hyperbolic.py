@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 
@@ -68,7 +69,7 @@ def test_eq15_solves_the_transient_boundary_problem():
         t_star, tau_star = rng.uniform(0.1, 0.5, 2)
         position, velocity = rng.uniform(-0.1, 0.1), rng.uniform(-0.3, 0.3)
 
-        def end(zd, zs):
+        def end(zd, zs, t_star=t_star, tau_star=tau_star):
             x1, v1 = zd * (1 - math.cosh(a * t_star)), -a * zd * math.sinh(a * t_star)  # Eq. 12
             c, s = math.cosh(a * tau_star), math.sinh(a * tau_star)
             return np.array([(x1 - zs) * c + v1 / a * s + zs, (x1 - zs) * a * s + v1 * c])  # Eq. 13
@@ -106,7 +107,7 @@ def _ode_error(walk: HyperbolicWalk) -> float:
 def _assert_continuous(walk: HyperbolicWalk) -> None:
     for axis in (walk.x_axis, walk.y_axis):
         pieces = axis.pieces
-        for previous, piece in zip(pieces, pieces[1:], strict=False):
+        for previous, piece in itertools.pairwise(pieces):
             # the closed-form end of one piece against the start the next one was built from
             if previous.hyperbolic:
                 c, s = math.cosh(walk.a * previous.duration), math.sinh(walk.a * previous.duration)
