@@ -23,6 +23,30 @@ from typing import Any
 from zmpwalk.errors import FileFormatError
 
 JOINT_NAMES = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll")
+LINK_NAMES = ("torso", "thigh", "shank", "foot")
+
+
+@dataclass(frozen=True)
+class Link:
+    """Mass properties of one rigid link, a uniform box.
+
+    Attributes:
+        mass: [kg].
+        size: Box edge lengths along the link's x, y, z [m].
+        com: Centre of mass in the link's frame [m] (torso: pelvis frame; thigh: hip frame,
+            shank: knee frame, foot: ankle frame; the leg's defaults are set by the loader).
+    """
+
+    mass: float  # [kg]
+    size: tuple[float, float, float]  # [m]
+    com: tuple[float, float, float]  # [m]
+
+    @property
+    def inertia(self) -> tuple[float, float, float]:
+        """Principal moments of inertia about the centre of mass [kg m^2] (uniform box)."""
+        x, y, z = self.size
+        m = self.mass / 12.0
+        return m * (y * y + z * z), m * (x * x + z * z), m * (x * x + y * y)
 
 
 @dataclass(frozen=True)
@@ -75,6 +99,14 @@ class RobotModel:
     lateral_velocity: float  # [m per unit 2*t_bar]
     joint_limits: dict[str, tuple[float, float]] = field(default_factory=dict)  # [rad]
     gravity: float = 9.81  # [m/s^2]
+    links: dict[str, Link] = field(default_factory=dict)  # torso, thigh, shank, foot (one leg's)
+
+    @property
+    def link_mass(self) -> float:
+        """Mass of the torso and both legs from :attr:`links` [kg] (0 without links)."""
+        if not self.links:
+            return 0.0
+        return self.links["torso"].mass + 2 * sum(self.links[n].mass for n in ("thigh", "shank", "foot"))
 
     @property
     def max_leg_reach(self) -> float:
@@ -105,7 +137,7 @@ _POSITIVE = {"mass", "height", "hip_spacing", "thigh_length", "shank_length", "a
              "foot_length", "foot_width", "pelvis_height", "pendulum_length", "gravity",
              "dsp_time", "lateral_velocity"}
 # Sections a later part of zmpwalk reads (bodies, servos); kept as raw tables.
-_EXTRA_SECTIONS = {"limits", "bodies", "servos", "contact"}
+_EXTRA_SECTIONS = {"limits", "bodies", "servos", "contact"}  # read by their own parsers
 
 
 def robot_from_toml(path: Path) -> RobotModel:
@@ -119,6 +151,35 @@ def robot_from_toml(path: Path) -> RobotModel:
     except (OSError, tomllib.TOMLDecodeError) as error:
         raise FileFormatError(str(path), str(error)) from None
     return robot_from_dict(data, str(path))
+
+
+def _links(table: object, values: dict[str, Any], source: str) -> dict[str, Link]:
+    """The [bodies] table: mass and box per link; leg centres of mass default to the segment middles."""
+    if table is None:
+        return {}
+    if not isinstance(table, dict) or set(table) != set(LINK_NAMES):
+        raise FileFormatError(source, f"[bodies] needs exactly: {', '.join(LINK_NAMES)}")
+    defaults = {
+        "torso": (0.0, 0.0, 0.0),
+        "thigh": (0.0, 0.0, -values["thigh_length"] / 2),
+        "shank": (0.0, 0.0, -values["shank_length"] / 2),
+        "foot": (values["sole_center_x"], 0.0, -values["ankle_height"]),
+    }
+    links = {}
+    for name in LINK_NAMES:
+        entry = table[name]
+        try:
+            mass = float(entry["mass"])
+            size = tuple(float(v) for v in entry["size"])
+            com = tuple(float(v) for v in entry.get("com", defaults[name]))
+        except (KeyError, TypeError, ValueError):
+            raise FileFormatError(source, f"[bodies] {name} needs mass [kg] and size [x, y, z] [m]") from None
+        if mass <= 0 or len(size) != 3 or min(size) <= 0 or len(com) != 3:
+            raise FileFormatError(source, f"[bodies] {name}: mass > 0, three sizes > 0 and a 3-vector com")
+        if name == "foot" and "com" not in entry:
+            com = (com[0], com[1], com[2] + size[2] / 2)  # the box rests on the ground
+        links[name] = Link(mass, (size[0], size[1], size[2]), (com[0], com[1], com[2]))
+    return links
 
 
 def robot_from_dict(data: dict[str, Any], source: str = "<robot>") -> RobotModel:
@@ -158,6 +219,7 @@ def robot_from_dict(data: dict[str, Any], source: str = "<robot>") -> RobotModel
             raise FileFormatError(source, f"[limits] {joint} must be [lower, upper] with lower < upper")
         limits[joint] = (float(bounds[0]), float(bounds[1]))
     values["joint_limits"] = limits
+    values["links"] = _links(data.get("bodies"), values, source)
     robot = RobotModel(**values)
     if robot.hip_height - robot.ankle_height >= robot.max_leg_reach:
         raise FileFormatError(source, "[posture] pelvis_height leaves the legs straighter than min_knee allows")
