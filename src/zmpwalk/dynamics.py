@@ -99,7 +99,7 @@ def angular_momenta(time: Array, rotations: Array, inertias: Array) -> Array:
     omega = 0.5 * np.stack([skew[..., 2, 1] - skew[..., 1, 2], skew[..., 0, 2] - skew[..., 2, 0],
                             skew[..., 1, 0] - skew[..., 0, 1]], axis=-1)
     body = np.einsum("nkji,nkj->nki", rotations, omega) * inertias[None, :, :]  # I (R^T omega)
-    return np.einsum("nkij,nkj->nki", rotations, body)
+    return np.asarray(np.einsum("nkij,nkj->nki", rotations, body), dtype=np.float64)
 
 
 def multibody_zmp(time: Array, masses: Array, positions: Array, momenta: Array, gravity: float) -> Array:
