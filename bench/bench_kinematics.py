@@ -1,0 +1,81 @@
+"""Speed of the leg IK: closed form (scalar and vectorised) against a numerical IK; tick() with joints.
+
+Run: python bench/bench_kinematics.py. Prints figures; asserts nothing.
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from zmpwalk import StepCommand, load_robot
+from zmpwalk.kinematics import Leg, leg_fk, leg_ik, leg_ik_scalar, leg_ik_yaw
+from zmpwalk.online import OnlineWalker
+
+
+def poses(leg: Leg, n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    q = np.column_stack([rng.uniform(-0.5, 0.5, n), rng.uniform(-0.3, 0.3, n), rng.uniform(-1.0, 0.4, n),
+                         rng.uniform(0.2, 1.6, n), np.zeros(n), np.zeros(n)])
+    q[:, 5] = -q[:, 1]
+    q[:, 4] = -(q[:, 2] + q[:, 3])  # flat feet, as in walking
+    position, rotation = leg_fk(leg, q)
+    return position, rotation, np.arctan2(rotation[:, 1, 0], rotation[:, 0, 0])
+
+
+def main() -> None:
+    robot = load_robot("hubo")
+    leg = Leg.of(robot, 1)
+    position, rotation, yaw = poses(leg, 200_000)
+    best = {}
+    for name, solve in (("flat-foot (yaw)", lambda: leg_ik_yaw(leg, position, yaw)),
+                        ("general rotation", lambda: leg_ik(leg, position, rotation))):
+        solve()
+        runs = []
+        for _ in range(5):
+            start = time.perf_counter()
+            solve()
+            runs.append(time.perf_counter() - start)
+        best[name] = min(runs) / len(yaw)
+        print(f"closed-form IK, vectorised, {name}: {1 / best[name] / 1e6:.2f} M leg solutions/s")
+    count = 20_000
+    start = time.perf_counter()
+    for i in range(count):
+        leg_ik_scalar(leg, (float(position[i, 0]), float(position[i, 1]), float(position[i, 2])), float(yaw[i]))
+    scalar = (time.perf_counter() - start) / count
+    print(f"closed-form IK, scalar (math): {scalar * 1e6:.2f} us per leg solution")
+    numeric = []
+    for i in range(200):
+        def residual(x: np.ndarray, i: int = i) -> np.ndarray:
+            p, r = leg_fk(leg, x[None, :])
+            return np.concatenate([p[0] - position[i], (r[0] - rotation[i]).ravel()])
+
+        start = time.perf_counter()
+        least_squares(residual, np.array([0.0, 0.0, -0.5, 1.0, -0.5, 0.0]), xtol=1e-12, ftol=1e-12)
+        numeric.append(time.perf_counter() - start)
+    numeric_time = statistics.median(numeric)
+    print(f"numerical IK (scipy least_squares on FK): {numeric_time * 1e3:.2f} ms per leg solution; "
+          f"closed form is {numeric_time / scalar:.0f}x faster scalar, "
+          f"{numeric_time / best['flat-foot (yaw)']:.0f}x vectorised")
+    for rate in (100.0, 1000.0):
+        walker = OnlineWalker(robot, rate=rate, joints=True)
+        durations = []
+        commands = [StepCommand(0.8, 0.2), StepCommand(0.95, turn=0.2), StepCommand(0.8, side=0.05)]
+        k = 0
+        for _ in range(int(60 * rate)):
+            if walker.queued is None:
+                walker.command(commands[k % 3])
+                k += 1
+            t0 = time.perf_counter_ns()
+            walker.tick()
+            durations.append(time.perf_counter_ns() - t0)
+        us = np.array(durations) / 1e3
+        print(f"OnlineWalker.tick() with joints at {rate:.0f} Hz: median {np.median(us):.2f} us, "
+              f"p99 {np.percentile(us, 99):.2f} us")
+
+
+if __name__ == "__main__":
+    main()
