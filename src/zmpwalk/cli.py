@@ -12,6 +12,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn
 
+import numpy as np
+
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import ZmpwalkError
 from zmpwalk.kinematics import pattern_joint_trajectory
@@ -90,6 +92,25 @@ def _parser() -> argparse.ArgumentParser:
                             "v_xD = 100 mm/s, t* = 0.2 s, tau* = 0.3 s, g = 9.8 m/s^2")
     hyperbolic.add_argument("--json", action="store_true", help="print a JSON object")
 
+    simulate_cmd = commands.add_parser(
+        "simulate", help="walk a pattern in MuJoCo: falls, CoP, joint torques and powers",
+        description="Generate the pattern of a steps file, a scenario or the paper example of Lim et al., "
+        "walk it in MuJoCo with the robot's servos and ground contact, and write the measurements "
+        "(simulation.csv, actuators.csv, actuators.md) to --out.",
+        epilog="example: zmpwalk simulate --paper-example --robot mju-biped --json",
+    )
+    simulate_cmd.add_argument("steps", nargs="?", help="steps file (TOML)")
+    simulate_cmd.add_argument("--scenario", help="a built-in scenario")
+    simulate_cmd.add_argument("--paper-example", action="store_true",
+                              help="the walk of Lim et al. (start, 2 steady steps, stop; hyperbolic)")
+    simulate_cmd.add_argument("--steady-steps", type=int, default=2, help="steady steps of --paper-example")
+    simulate_cmd.add_argument("--robot", default="hubo", help="robot name or file (default: hubo)")
+    simulate_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
+    simulate_cmd.add_argument("--feedback", action="store_true", help="balance feedback at the ankles")
+    simulate_cmd.add_argument("--mass-scale", type=float, default=1.0, help="multiply every mass (default 1)")
+    simulate_cmd.add_argument("--out", type=Path, help="folder for the result files")
+    simulate_cmd.add_argument("--json", action="store_true", help="print a JSON summary")
+
     tables = commands.add_parser(
         "tables", help="walk every condition of Tables 2-3 and print the ZMP margins",
         description="Walk each tuned condition of the parameter tables (Tables 2 and 3) for a number of "
@@ -110,6 +131,78 @@ def _commands(args: argparse.Namespace) -> list[StepCommand]:
     if args.steps:
         return load_steps_file(args.steps)
     raise _UsageError("give a steps file or --scenario NAME (see 'zmpwalk scenarios')")
+
+
+def _simulate(args: argparse.Namespace) -> int:
+    from zmpwalk.patterns.hyperbolic import paper_walk
+    from zmpwalk.sim import actuator_markdown, actuator_table, simulate, write_actuator_csv
+
+    robot = load_robot(args.robot)
+    if args.paper_example:
+        if args.steps or args.scenario:
+            raise _UsageError("--paper-example takes no steps file or scenario")
+        if args.steady_steps < 0:
+            raise _UsageError(f"--steady-steps = {args.steady_steps} must be >= 0")
+        pattern = paper_walk(robot, steps=args.steady_steps).sample(1000.0)
+    else:
+        commands = _commands(args)
+        make = generate_hyperbolic if args.generator == "hyperbolic" else generate
+        pattern = make(robot, commands, rate=1000.0)
+    joints = pattern_joint_trajectory(pattern, check_limits=False)
+    result = simulate(robot, joints, pattern, feedback=args.feedback, mass_scale=args.mass_scale)
+    rows = actuator_table(result)
+    rms, largest = result.cop_error_stats()
+    summary = {
+        "robot": robot.name, "fell": result.fell, "fall_time": result.fall_time, "duration": float(result.time[-1]),
+        "distance": result.distance, "average_speed": result.average_speed, "foot_slip": result.foot_slip,
+        "cop_error_rms": rms, "cop_error_max": largest, "min_cop_margin": float(np.nanmin(result.cop_margin)),
+        "feedback": result.feedback, "mass_scale": result.mass_scale,
+        "actuators": [vars(row) for row in rows],
+    }
+    if args.out:
+        args.out.mkdir(parents=True, exist_ok=True)
+        write_actuator_csv(rows, args.out / "actuators.csv")
+        (args.out / "actuators.md").write_text(actuator_markdown(rows) + "\n", encoding="utf-8")
+        result_csv(result, args.out / "simulation.csv")
+    if args.json:
+        print(json.dumps(summary, indent=2, allow_nan=False, default=_finite))
+    else:
+        state = f"FELL at t = {result.fall_time:.3f} s" if result.fell else "walked to the end without falling"
+        print(f"{robot.name}: {state}; distance {result.distance:.3f} m, average speed "
+              f"{result.average_speed * 1e3:.1f} mm/s, foot slip {result.foot_slip * 1e3:.1f} mm")
+        print(f"CoP - reference ZMP: RMS {rms * 1e3:.1f} mm, max {largest * 1e3:.1f} mm; "
+              f"min CoP margin {summary['min_cop_margin'] * 1e3:+.1f} mm")  # type: ignore[operator]
+        top = max(rows, key=lambda r: r.peak_torque)
+        power = max(rows, key=lambda r: r.peak_power)
+        print(f"largest torque {top.peak_torque:.3g} N m at {top.joint}; largest power {power.peak_power:.3g} W "
+              f"at {power.joint}")
+    return 0
+
+
+def _finite(value: object) -> object:
+    return None
+
+
+def result_csv(result: object, path: Path) -> None:
+    """The simulation's time series as CSV (SI)."""
+    from zmpwalk.sim import SimulationResult
+
+    assert isinstance(result, SimulationResult)
+    columns: dict[str, np.ndarray] = {
+        "t": result.time,
+        "torso_x": result.torso_position[:, 0], "torso_y": result.torso_position[:, 1],
+        "torso_z": result.torso_position[:, 2], "torso_roll": result.torso_rpy[:, 0],
+        "torso_pitch": result.torso_rpy[:, 1], "torso_yaw": result.torso_rpy[:, 2],
+        "cop_x": result.cop[:, 0], "cop_y": result.cop[:, 1],
+        "zmp_ref_x": result.reference_zmp[:, 0], "zmp_ref_y": result.reference_zmp[:, 1],
+        "force_left": result.force_left, "force_right": result.force_right,
+    }
+    for i, name in enumerate(result.joint_names):
+        columns[f"{name}_q"] = result.joint_angles[:, i]
+        columns[f"{name}_tau"] = result.joint_torques[:, i]
+        columns[f"{name}_power"] = result.joint_power[:, i]
+    np.savetxt(path, np.column_stack(list(columns.values())), delimiter=",", header=",".join(columns),
+               comments="", fmt="%.9g")
 
 
 def _summary(pattern: WalkingPattern) -> dict[str, object]:
@@ -160,6 +253,8 @@ def _run(args: argparse.Namespace) -> int:
             print(f"min ZMP margin: {margin * 1e3:+.1f} mm at t = {summary['min_zmp_margin_time']:.3f} s "
                   f"({verdict})")
         return 0
+    if args.command == "simulate":
+        return _simulate(args)
     if args.command == "hyperbolic":
         result = paper_example()
         if args.json:

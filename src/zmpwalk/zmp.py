@@ -138,3 +138,36 @@ def signed_margin(points: Array, polygon: Array) -> Array:
     nearest = a[None, :, :] + along[:, :, None] * edge[None, :, :]
     outside_distance = np.min(np.linalg.norm(pts[:, None, :] - nearest, axis=2), axis=1)
     return np.asarray(np.where(inside, np.min(inside_distance, axis=1), -outside_distance), dtype=np.float64)
+
+
+def batch_hull_margin(points: Array, vertices: Array) -> Array:
+    """:func:`signed_margin` of one point to the convex hull of its own vertex set, for many at once.
+
+    Args:
+        points: (n, 2) [m].
+        vertices: (n, m, 2) [m], any order, at least three not collinear.
+
+    Returns:
+        (n,) signed distances [m], > 0 inside.
+
+    A directed pair (i, j) of vertices is a counter-clockwise hull edge when every other
+    vertex lies on its left; the margin is the smallest distance to those edges' lines
+    inside, and to their segments outside.
+    """
+    m = vertices.shape[1]
+    i, j = np.where(~np.eye(m, dtype=bool))
+    a, b = vertices[:, i], vertices[:, j]  # (n, p, 2)
+    edge = b - a
+    rel = vertices[:, None, :, :] - a[:, :, None, :]  # (n, p, m, 2)
+    cross = edge[..., None, 0] * rel[..., 1] - edge[..., None, 1] * rel[..., 0]
+    length = np.linalg.norm(edge, axis=2)
+    scale = np.maximum(length, 1e-12)
+    on_hull = np.all(cross >= -1e-12 * scale[..., None], axis=2) & (length > 1e-12)
+    prel = points[:, None, :] - a
+    line = (edge[..., 0] * prel[..., 1] - edge[..., 1] * prel[..., 0]) / scale
+    along = np.clip(np.sum(prel * edge, axis=2) / scale**2, 0.0, 1.0)
+    segment = np.linalg.norm(prel - along[..., None] * edge, axis=2)
+    inside = np.all(np.where(on_hull, line >= 0, True), axis=1)
+    line_min = np.min(np.where(on_hull, line, np.inf), axis=1)
+    segment_min = np.min(np.where(on_hull, segment, np.inf), axis=1)
+    return np.asarray(np.where(inside, line_min, -segment_min), dtype=np.float64)

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
@@ -47,6 +47,40 @@ class Link:
         x, y, z = self.size
         m = self.mass / 12.0
         return m * (y * y + z * z), m * (x * x + z * z), m * (x * x + y * y)
+
+
+@dataclass(frozen=True)
+class Servos:
+    """Position servos of the simulated joints: torque ``kp (q_ref - q) - kv q'``.
+
+    Attributes:
+        kp: Stiffness [N m/rad].
+        kv: Damping [N m s/rad].
+        armature: Reflected rotor inertia [kg m^2].
+    """
+
+    kp: float  # [N m/rad]
+    kv: float  # [N m s/rad]
+    armature: float  # [kg m^2]
+
+
+@dataclass(frozen=True)
+class Contact:
+    """Ground contact of Eq. 16 (Lim et al.): normal force ``k x^e + c x'``, Coulomb friction.
+
+    Attributes:
+        stiffness: ``k`` [N/m^e].
+        exponent: ``e`` [-].
+        damping: ``c`` [N s/m].
+        friction_static: ``mu_s`` [-].
+        friction_dynamic: ``mu_d`` [-].
+    """
+
+    stiffness: float  # [N/m^e]
+    exponent: float  # [-]
+    damping: float  # [N s/m]
+    friction_static: float  # [-]
+    friction_dynamic: float  # [-]
 
 
 @dataclass(frozen=True)
@@ -100,6 +134,8 @@ class RobotModel:
     joint_limits: dict[str, tuple[float, float]] = field(default_factory=dict)  # [rad]
     gravity: float = 9.81  # [m/s^2]
     links: dict[str, Link] = field(default_factory=dict)  # torso, thigh, shank, foot (one leg's)
+    servos: Servos | None = None
+    contact: Contact | None = None
 
     @property
     def link_mass(self) -> float:
@@ -153,6 +189,22 @@ def robot_from_toml(path: Path) -> RobotModel:
     return robot_from_dict(data, str(path))
 
 
+def _table(kind: type[Any], table: object, name: str, source: str) -> Any:
+    """A table of positive numbers into the dataclass ``kind`` (None when the table is absent)."""
+    if table is None:
+        return None
+    names = [f.name for f in fields(kind)]
+    if not isinstance(table, dict) or set(table) != set(names):
+        raise FileFormatError(source, f"[{name}] needs exactly: {', '.join(names)}")
+    values = {}
+    for key in names:
+        value = table[key]
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
+            raise FileFormatError(source, f"[{name}] {key} = {value!r} must be a number > 0")
+        values[key] = float(value)
+    return kind(**values)
+
+
 def _links(table: object, values: dict[str, Any], source: str) -> dict[str, Link]:
     """The [bodies] table: mass and box per link; leg centres of mass default to the segment middles."""
     if table is None:
@@ -185,16 +237,16 @@ def _links(table: object, values: dict[str, Any], source: str) -> dict[str, Link
 def robot_from_dict(data: dict[str, Any], source: str = "<robot>") -> RobotModel:
     """Build a :class:`RobotModel` from the tables of a robot file."""
     values: dict[str, Any] = {}
-    for section, fields in _SECTIONS.items():
+    for section, section_fields in _SECTIONS.items():
         table = data if section == "" else data.get(section)
         if not isinstance(table, dict):
             raise FileFormatError(source, f"missing table [{section}]")
-        known = set(fields) | (set(_SECTIONS) - {""}) | _EXTRA_SECTIONS if section == "" else set(fields)
+        known = set(section_fields) | (set(_SECTIONS) - {""}) | _EXTRA_SECTIONS if section == "" else set(section_fields)
         for key in table:
             if key not in known:
                 where = f"[{section}] " if section else ""
-                raise FileFormatError(source, f"{where}unknown field {key!r}; known: {', '.join(sorted(fields))}")
-        for key, attribute in fields.items():
+                raise FileFormatError(source, f"{where}unknown field {key!r}; known: {', '.join(sorted(section_fields))}")
+        for key, attribute in section_fields.items():
             if key not in table:
                 if attribute in _OPTIONAL:
                     continue
@@ -220,6 +272,8 @@ def robot_from_dict(data: dict[str, Any], source: str = "<robot>") -> RobotModel
         limits[joint] = (float(bounds[0]), float(bounds[1]))
     values["joint_limits"] = limits
     values["links"] = _links(data.get("bodies"), values, source)
+    values["servos"] = _table(Servos, data.get("servos"), "servos", source)
+    values["contact"] = _table(Contact, data.get("contact"), "contact", source)
     robot = RobotModel(**values)
     if robot.hip_height - robot.ankle_height >= robot.max_leg_reach:
         raise FileFormatError(source, "[posture] pelvis_height leaves the legs straighter than min_knee allows")

@@ -1,0 +1,349 @@
+"""Walk a joint trajectory in MuJoCo and measure what a builder needs: does it walk, and which motors.
+
+:func:`simulate` drives the joint servos of the generated model with a joint
+trajectory (linearly interpolated to the 1 kHz servo rate, as HUBO's servo
+controllers do between the main computer's references) and measures, at every
+millisecond: the torso's position and attitude, the contact forces of each
+sole and their centres of pressure (the paper's foot force sensors), the
+joint angles, velocities and actuator torques, and the mechanical power.
+
+**Fall criterion**: the torso touches the ground, or tilts more than
+:data:`FALL_TILT` from upright, or its centre drops below
+:data:`FALL_HEIGHT_FRACTION` of the pelvis height. The run stops
+:data:`AFTER_FALL` seconds after a fall.
+
+The measurements come from MuJoCo sensors, as on the robot: a force-torque
+sensor at each ankle (the centre of pressure of a sole is computed from it,
+as HUBO's foot sensors do, so it includes the small inertia of the foot), the
+actuator torques, the joint encoders, the torso pose. Open-loop runs use
+:func:`mujoco.rollout.rollout` (the whole walk in C); with feedback the loop
+is in Python.
+
+**Balance feedback** (optional, ``feedback=True``): the measured centre of
+pressure of the whole robot is compared with the pattern's ZMP and the
+difference drives the ankle pitch and roll references of both feet,
+``delta' = gain * e - leak * delta`` (limited to :data:`FEEDBACK_LIMIT`),
+with ``e`` the error in the robot's heading frame and the sign that lifts the
+side of the sole the pressure has moved to (toe up when the CoP is ahead of
+the reference): the ZMP compensation of the KHR robots. With the foot flat on
+the ground the servo's torque, not the foot, moves, and the pressure goes
+back towards the reference. Off by default.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+from mujoco import rollout
+from numpy.typing import NDArray
+
+from zmpwalk.errors import InvalidParameterError
+from zmpwalk.kinematics import JOINT_COLUMNS, JointTrajectory
+from zmpwalk.patterns.result import WalkingPattern
+from zmpwalk.robots.model import RobotModel
+from zmpwalk.sim.mjcf import TIMESTEP, contact_mapping, robot_mjcf
+from zmpwalk.zmp import batch_hull_margin
+
+Array = NDArray[np.float64]
+
+CONTROL_RATE = 1000.0  # [Hz] servo reference rate and measurement rate
+FALL_TILT = 0.6  # [rad]
+FALL_HEIGHT_FRACTION = 0.6  # [-] of the pelvis height
+AFTER_FALL = 0.3  # [s] simulated after a fall
+LOADED_FRACTION = 0.15  # [-] of the weight: a sole carrying more is "loaded" (its CoP is measured)
+FEEDBACK_GAIN = 20.0  # [rad/(m s)] ankle angle rate per metre of CoP-ZMP error
+FEEDBACK_LEAK = 2.0  # [1/s] pulls the correction back to zero
+FEEDBACK_LIMIT = 0.15  # [rad]
+
+
+@dataclass
+class SimulationResult:
+    """Measurements of one simulated walk, in world (SI), one row per millisecond.
+
+    Attributes:
+        robot: The robot.
+        time: [s], (n,).
+        torso_position: Pelvis centre [m], (n, 3).
+        torso_rpy: Torso roll, pitch, yaw [rad], (n, 3).
+        fell: Whether it fell (see the module docstring for the criterion).
+        fall_time: When [s], or None.
+        distance: Horizontal distance of the pelvis from start to end [m].
+        average_speed: ``distance`` over the walk's duration [m/s].
+        foot_slip: Largest horizontal slide of a loaded sole [m].
+        cop_left, cop_right, cop: Centres of pressure [m], (n, 2); NaN where the sole is unloaded.
+        force_left, force_right: Normal force on each sole [N], (n,).
+        reference_zmp: The pattern's ZMP [m], (n, 2).
+        cop_margin: Signed distance of the CoP to the polygon of the loaded soles [m], (n,).
+        joint_names: The 12 joint column names.
+        joint_angles, joint_velocities, joint_torques, joint_power: (n, 12) [rad], [rad/s], [N m], [W].
+        feedback: Whether balance feedback was on.
+        mass_scale: Multiplier of all masses.
+    """
+
+    robot: RobotModel
+    time: Array
+    torso_position: Array
+    torso_rpy: Array
+    fell: bool
+    fall_time: float | None
+    distance: float
+    average_speed: float
+    foot_slip: float
+    cop_left: Array
+    cop_right: Array
+    cop: Array
+    force_left: Array
+    force_right: Array
+    reference_zmp: Array
+    cop_margin: Array
+    joint_angles: Array
+    joint_velocities: Array
+    joint_torques: Array
+    joint_power: Array
+    feedback: bool = False
+    mass_scale: float = 1.0
+    joint_names: tuple[str, ...] = field(default=JOINT_COLUMNS)
+
+    @property
+    def cop_error(self) -> Array:
+        """CoP minus the reference ZMP [m], (n, 2); NaN where no sole is loaded."""
+        return self.cop - self.reference_zmp
+
+    def cop_error_stats(self) -> tuple[float, float]:
+        """RMS and largest length of the CoP error [m] over the loaded samples."""
+        error = np.linalg.norm(self.cop_error, axis=1)
+        error = error[np.isfinite(error)]
+        if len(error) == 0:
+            return math.nan, math.nan
+        return float(np.sqrt(np.mean(error**2))), float(error.max())
+
+
+def _rpy(quaternion: Array) -> Array:
+    w, x, y, z = quaternion.T
+    roll = np.arctan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+    pitch = np.arcsin(np.clip(2 * (w * y - z * x), -1, 1))
+    yaw = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    return np.column_stack([roll, pitch, yaw])
+
+
+def _rotation(quaternion: Array) -> Array:
+    """Rotation matrices (n, 3, 3) from unit quaternions (n, 4) ``w, x, y, z``."""
+    w, x, y, z = quaternion.T
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+    ], -2)
+
+
+class _Sensors:
+    """Slices of ``sensordata`` by sensor name."""
+
+    def __init__(self, model: mujoco.MjModel) -> None:
+        self.slices: dict[str, slice] = {}
+        for i in range(model.nsensor):
+            name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_SENSOR, i)
+            start = int(model.sensor_adr[i])
+            self.slices[name] = slice(start, start + int(model.sensor_dim[i]))
+
+    def take(self, data: Array, name: str) -> Array:
+        return data[:, self.slices[name]]
+
+    def columns(self, data: Array, names: list[str]) -> Array:
+        return np.column_stack([data[:, self.slices[n]] for n in names])
+
+
+def _ground_reaction(sensors: _Sensors, data: Array, label: str, ankle_height: float) -> tuple[Array, Array]:
+    """Normal force [N] (n,) and centre of pressure in world [m] (n, 2) of one sole, from its ankle sensor.
+
+    The sensor gives the wrench between the foot and the leg in the foot frame; the ground's is its
+    opposite (the foot's own weight and inertia are not removed, as on the robot). With the reaction
+    ``R`` and torque ``T`` about the ankle and the sole ``ankle_height`` below it:
+    ``p_x = -(T_y + h R_x) / R_z``, ``p_y = (T_x - h R_y) / R_z``.
+    """
+    force = -sensors.take(data, f"{label}_force")
+    torque = -sensors.take(data, f"{label}_torque")
+    h = ankle_height
+    with np.errstate(invalid="ignore", divide="ignore"):
+        local = np.column_stack([-(torque[:, 1] + h * force[:, 0]) / force[:, 2],
+                                 (torque[:, 0] - h * force[:, 1]) / force[:, 2], np.full(len(force), -h)])
+    rotation = _rotation(sensors.take(data, f"{label}_ankle_quat"))
+    world = sensors.take(data, f"{label}_ankle_pos") + np.einsum("nij,nj->ni", rotation, local)
+    return force[:, 2], world[:, :2]
+
+
+def _cop_margins(cop: Array, corners: Array, loaded: NDArray[np.bool_]) -> Array:
+    """Signed distance of the CoP to the polygon of the loaded soles per sample [m] (NaN when none).
+
+    Single support is vectorised (the sole is a rectangle, already counter-clockwise); double
+    support takes the hull of the eight corners.
+    """
+    n = len(cop)
+    margin = np.full(n, np.nan)
+    single = loaded[:, 0] ^ loaded[:, 1]
+    if single.any():
+        foot = np.where(loaded[single, 0], 0, 1)
+        quad = corners[single][np.arange(int(single.sum())), foot]  # (m, 4, 2)
+        point = cop[single]
+        edge = np.roll(quad, -1, axis=1) - quad
+        length = np.linalg.norm(edge, axis=2)
+        rel = point[:, None, :] - quad
+        inside = (edge[..., 0] * rel[..., 1] - edge[..., 1] * rel[..., 0]) / length
+        along = np.clip(np.sum(rel * edge, axis=2) / length**2, 0.0, 1.0)
+        outside = np.linalg.norm(rel - along[..., None] * edge, axis=2).min(axis=1)
+        margin[single] = np.where(np.all(inside >= 0, axis=1), inside.min(axis=1), -outside)
+    both = loaded[:, 0] & loaded[:, 1]
+    if both.any():
+        margin[both] = batch_hull_margin(cop[both], corners[both].reshape(-1, 8, 2))
+    return margin
+
+
+def _initial_state(model: mujoco.MjModel, data: mujoco.MjData, pattern: WalkingPattern, angles: Array,
+                   penetration: float) -> None:
+    """The pattern's first pose with the soles on the ground at their static penetration, at rest."""
+    data.qpos[0:3] = pattern.position_pelvis_in_world[0]
+    yaw = float(pattern.yaw_pelvis_in_world[0])
+    data.qpos[3:7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
+    data.qpos[7:19] = angles
+    data.qvel[:] = 0.0
+    data.ctrl[:] = angles
+    mujoco.mj_kinematics(model, data)
+    soles = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"{s}_sole") for s in ("left", "right")]
+    bottom = min(float(data.geom_xpos[g][2] - model.geom_size[g][2]) for g in soles)
+    data.qpos[2] += -bottom - penetration
+    mujoco.mj_forward(model, data)
+
+
+def simulate(
+    robot: RobotModel,
+    joints: JointTrajectory,
+    pattern: WalkingPattern,
+    *,
+    feedback: bool = False,
+    feedback_sign: float = 1.0,
+    mass_scale: float = 1.0,
+) -> SimulationResult:
+    """Simulate ``joints`` (made from ``pattern``) on ``robot`` and measure the walk.
+
+    Args:
+        robot: A robot file with ``[bodies]``, ``[servos]``, ``[contact]``.
+        joints: The 12 joint angles over time (:func:`zmpwalk.kinematics.pattern_joint_trajectory`).
+        pattern: The pattern they come from: initial pose and reference ZMP.
+        feedback: Balance feedback at the ankles (module docstring).
+        feedback_sign: +1; -1 reverses the feedback (a test that must fall).
+        mass_scale: Multiply every mass and inertia, and the servo gains with them
+            (:func:`zmpwalk.sim.mjcf.robot_mjcf`).
+
+    Returns:
+        The measurements. The same input gives the same result.
+
+    Raises:
+        InvalidParameterError: Mismatched inputs or a robot without simulation data.
+    """
+    if len(joints.time) != len(pattern.time) or len(pattern.time) < 2:
+        raise InvalidParameterError("joints", len(joints.time), f"{len(pattern.time)} samples, as the pattern")
+    if not (0.01 <= mass_scale <= 100):
+        raise InvalidParameterError("mass_scale", mass_scale, "a value in [0.01, 100]")
+    model = mujoco.MjModel.from_xml_string(robot_mjcf(robot, mass_scale))
+    data = mujoco.MjData(model)
+    mapping = contact_mapping(RobotModel(**{**vars(robot), "mass": robot.link_mass * mass_scale}))
+    weight = float(model.body_subtreemass[1]) * robot.gravity
+    steps_per_tick = max(1, round(1.0 / (CONTROL_RATE * TIMESTEP)))
+    # References at the control rate, linearly interpolated.
+    time = np.arange(math.floor(pattern.time[-1] * CONTROL_RATE + 1e-9) + 1) / CONTROL_RATE
+    reference = np.column_stack([np.interp(time, joints.time, joints.angles[:, j]) for j in range(12)])
+    zmp_ref = np.column_stack([np.interp(time, pattern.time, pattern.zmp_in_world[:, i]) for i in range(2)])
+    _initial_state(model, data, pattern, reference[0], mapping.penetration)
+    sensors = _Sensors(model)
+    n = len(time)
+    if not feedback:
+        spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+        state = np.empty(mujoco.mj_stateSize(model, spec))
+        mujoco.mj_getState(model, data, state, spec)
+        control = np.repeat(reference, steps_per_tick, axis=0)[None]
+        _, readings = rollout.rollout(model, data, state[None], control)
+        readings = readings[0, steps_per_tick - 1::steps_per_tick]
+    else:
+        readings = np.empty((n, model.nsensordata))
+        correction = np.zeros(4)  # left pitch, left roll, right pitch, right roll
+        ankle_columns = [4, 5, 10, 11]
+        yaw = float(pattern.yaw_pelvis_in_world[0])
+        c_yaw, s_yaw = math.cos(yaw), math.sin(yaw)
+        dt = 1.0 / CONTROL_RATE
+        last = np.zeros(model.nsensordata)
+        for i in range(n):
+            control = reference[i].copy()
+            if i > 0:
+                left, cop_left = _ground_reaction(sensors, last[None], "left", robot.ankle_height)
+                right, cop_right = _ground_reaction(sensors, last[None], "right", robot.ankle_height)
+                total = left[0] + right[0]
+                if total > LOADED_FRACTION * weight:
+                    cop = (left[0] * np.nan_to_num(cop_left[0]) + right[0] * np.nan_to_num(cop_right[0])) / total
+                    ex, ey = cop[0] - zmp_ref[i - 1, 0], cop[1] - zmp_ref[i - 1, 1]
+                    forward, lateral = c_yaw * ex + s_yaw * ey, -s_yaw * ex + c_yaw * ey
+                    rate = feedback_sign * FEEDBACK_GAIN * np.array([-forward, lateral, -forward, lateral])
+                    correction = np.clip(correction + dt * (rate - FEEDBACK_LEAK * correction),
+                                         -FEEDBACK_LIMIT, FEEDBACK_LIMIT)
+                control[ankle_columns] += correction
+            data.ctrl[:] = control
+            mujoco.mj_step(model, data, nstep=steps_per_tick)
+            last = data.sensordata.copy()
+            readings[i] = last
+    # --- measurements
+    pelvis = sensors.take(readings, "pelvis_pos")
+    rpy = _rpy(sensors.take(readings, "pelvis_quat"))
+    touch = sensors.take(readings, "torso_touch")[:, 0]
+    tilt = np.arccos(np.clip(np.cos(rpy[:, 0]) * np.cos(rpy[:, 1]), -1, 1))
+    fallen = (touch > 0) | (tilt > FALL_TILT) | (pelvis[:, 2] < FALL_HEIGHT_FRACTION * robot.pelvis_height)
+    fall_index = int(np.argmax(fallen)) if fallen.any() else None
+    end = n if fall_index is None else min(n, fall_index + int(AFTER_FALL * CONTROL_RATE) + 1)
+    readings, time, zmp_ref = readings[:end], time[:end], zmp_ref[:end]
+    pelvis, rpy = pelvis[:end], rpy[:end]
+    names_q = [f"{c}_q" for c in JOINT_COLUMNS]
+    angles = sensors.columns(readings, names_q)
+    velocities = sensors.columns(readings, [f"{c}_qd" for c in JOINT_COLUMNS])
+    torque = sensors.columns(readings, [f"{c}_tau" for c in JOINT_COLUMNS])
+    reactions = [_ground_reaction(sensors, readings, label, robot.ankle_height) for label in ("left", "right")]
+    forces = np.column_stack([r[0] for r in reactions])
+    loaded = forces > LOADED_FRACTION * weight
+    cop_feet = np.stack([r[1] for r in reactions], axis=1)
+    cop_feet[~loaded] = np.nan
+    weights = np.where(loaded, forces, 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cop_total = np.nansum(cop_feet * weights[..., None], axis=1) / weights.sum(axis=1)[:, None]
+    cop_total[~loaded.any(axis=1)] = np.nan
+    # sole corners in world from the ankle frames
+    corners = np.empty((len(time), 2, 4, 2))
+    half_length, half_width = robot.foot_length / 2, robot.foot_width / 2
+    ankles = np.empty((len(time), 2, 2))
+    for foot, (label, side) in enumerate((("left", 1), ("right", -1))):
+        rotation = _rotation(sensors.take(readings, f"{label}_ankle_quat"))
+        origin = sensors.take(readings, f"{label}_ankle_pos")
+        cx, cy = robot.sole_center_x, side * robot.sole_center_y
+        local = np.array([[cx - half_length, cy - half_width, -robot.ankle_height],
+                          [cx + half_length, cy - half_width, -robot.ankle_height],
+                          [cx + half_length, cy + half_width, -robot.ankle_height],
+                          [cx - half_length, cy + half_width, -robot.ankle_height]])
+        corners[:, foot] = (origin[:, None, :] + np.einsum("nij,cj->nci", rotation, local))[..., :2]
+        ankles[:, foot] = origin[:, :2]
+    margin = _cop_margins(cop_total, corners, loaded)
+    slip = 0.0
+    for foot in range(2):
+        starts = np.flatnonzero(loaded[:, foot] & ~np.concatenate([[False], loaded[:-1, foot]]))
+        stops = np.flatnonzero(loaded[:, foot] & ~np.concatenate([loaded[1:, foot], [False]]))
+        for a, b in zip(starts, stops, strict=True):
+            drift = np.linalg.norm(ankles[a:b + 1, foot] - ankles[a, foot], axis=1)
+            slip = max(slip, float(drift.max()))
+    distance = float(np.linalg.norm(pelvis[-1, :2] - pelvis[0, :2]))
+    return SimulationResult(
+        robot=robot, time=time, torso_position=pelvis, torso_rpy=rpy,
+        fell=fall_index is not None, fall_time=None if fall_index is None else float(time[fall_index]),
+        distance=distance, average_speed=distance / float(pattern.time[-1]), foot_slip=slip,
+        cop_left=cop_feet[:, 0], cop_right=cop_feet[:, 1], cop=cop_total, force_left=forces[:, 0],
+        force_right=forces[:, 1], reference_zmp=zmp_ref, cop_margin=margin, joint_angles=angles,
+        joint_velocities=velocities, joint_torques=torque, joint_power=torque * velocities, feedback=feedback,
+        mass_scale=mass_scale,
+    )
