@@ -241,11 +241,14 @@ def robot_from_dict(data: dict[str, Any], source: str = "<robot>") -> RobotModel
         table = data if section == "" else data.get(section)
         if not isinstance(table, dict):
             raise FileFormatError(source, f"missing table [{section}]")
-        known = set(section_fields) | (set(_SECTIONS) - {""}) | _EXTRA_SECTIONS if section == "" else set(section_fields)
+        known = set(section_fields)
+        if section == "":
+            known |= (set(_SECTIONS) - {""}) | _EXTRA_SECTIONS
         for key in table:
             if key not in known:
                 where = f"[{section}] " if section else ""
-                raise FileFormatError(source, f"{where}unknown field {key!r}; known: {', '.join(sorted(section_fields))}")
+                names = ", ".join(sorted(section_fields))
+                raise FileFormatError(source, f"{where}unknown field {key!r}; known: {names}")
         for key, attribute in section_fields.items():
             if key not in table:
                 if attribute in _OPTIONAL:

@@ -181,6 +181,7 @@ def robot_mjcf(robot: RobotModel, mass_scale: float = 1.0) -> str:
             sensors += [f'    <jointpos name="{label}_{joint}_q" joint="{label}_{joint}"/>',
                         f'    <jointvel name="{label}_{joint}_qd" joint="{label}_{joint}"/>',
                         f'    <actuatorfrc name="{label}_{joint}_tau" actuator="{label}_{joint}"/>']
+    touch_size = _box((1.05 * torso.size[0], 1.05 * torso.size[1], 1.05 * torso.size[2]))
     actuators = "\n".join(
         f'    <position name="{label}_{joint}" joint="{label}_{joint}" kp="{servos.kp:.9g}" '
         f'kv="{servos.kv:.9g}"/>'
@@ -206,7 +207,7 @@ def robot_mjcf(robot: RobotModel, mass_scale: float = 1.0) -> str:
       {_inertial(torso.mass, torso.com, torso.size)}
       <geom name="torso" type="box" size="{_box(torso.size)}" pos="{_fmt(*torso.com)}" rgba="0.8 0.45 0.2 1"/>
       <site name="pelvis" pos="0 0 0" size="0.01"/>
-      <site name="torso_touch" type="box" size="{_box((1.05 * torso.size[0], 1.05 * torso.size[1], 1.05 * torso.size[2]))}" pos="{_fmt(*torso.com)}"
+      <site name="torso_touch" type="box" size="{touch_size}" pos="{_fmt(*torso.com)}"
             rgba="0 0 0 0"/>{"".join(legs)}
     </body>
   </worldbody>
