@@ -106,7 +106,6 @@ def _parser() -> argparse.ArgumentParser:
     simulate_cmd.add_argument("--steady-steps", type=int, default=2, help="steady steps of --paper-example")
     simulate_cmd.add_argument("--robot", default="hubo", help="robot name or file (default: hubo)")
     simulate_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
-    simulate_cmd.add_argument("--feedback", action="store_true", help="balance feedback at the ankles")
     simulate_cmd.add_argument("--mass-scale", type=float, default=1.0, help="multiply every mass (default 1)")
     simulate_cmd.add_argument("--out", type=Path, help="folder for the result files")
     simulate_cmd.add_argument("--json", action="store_true", help="print a JSON summary")
@@ -149,14 +148,14 @@ def _simulate(args: argparse.Namespace) -> int:
         make = generate_hyperbolic if args.generator == "hyperbolic" else generate
         pattern = make(robot, commands, rate=1000.0)
     joints = pattern_joint_trajectory(pattern, check_limits=False)
-    result = simulate(robot, joints, pattern, feedback=args.feedback, mass_scale=args.mass_scale)
+    result = simulate(robot, joints, pattern, mass_scale=args.mass_scale)
     rows = actuator_table(result)
     rms, largest = result.cop_error_stats()
     summary = {
         "robot": robot.name, "fell": result.fell, "fall_time": result.fall_time, "duration": float(result.time[-1]),
         "distance": result.distance, "average_speed": result.average_speed, "foot_slip": result.foot_slip,
         "cop_error_rms": rms, "cop_error_max": largest, "min_cop_margin": float(np.nanmin(result.cop_margin)),
-        "feedback": result.feedback, "mass_scale": result.mass_scale,
+        "mass_scale": result.mass_scale,
         "actuators": [vars(row) for row in rows],
     }
     if args.out:

@@ -14,20 +14,15 @@ joint angles, velocities and actuator torques, and the mechanical power.
 
 The measurements come from MuJoCo sensors, as on the robot: a force-torque
 sensor at each ankle (the centre of pressure of a sole is computed from it,
-as HUBO's foot sensors do, so it includes the small inertia of the foot), the
-actuator torques, the joint encoders, the torso pose. Open-loop runs use
-:func:`mujoco.rollout.rollout` (the whole walk in C); with feedback the loop
-is in Python.
+as HUBO's foot sensors do, so it includes the small inertia of the foot; a
+sole is counted as loaded, and its CoP measured, above
+:data:`LOADED_FRACTION` of the weight), the actuator torques, the joint
+encoders, the torso pose. The whole walk runs in C with
+:func:`mujoco.rollout.rollout`.
 
-**Balance feedback** (optional, ``feedback=True``): the measured centre of
-pressure of the whole robot is compared with the pattern's ZMP and the
-difference drives the ankle pitch and roll references of both feet,
-``delta' = gain * e - leak * delta`` (limited to :data:`FEEDBACK_LIMIT`),
-with ``e`` the error in the robot's heading frame and the sign that lifts the
-side of the sole the pressure has moved to (toe up when the CoP is ahead of
-the reference): the ZMP compensation of the KHR robots. With the foot flat on
-the ground the servo's torque, not the foot, moves, and the pressure goes
-back towards the reference. Off by default.
+**Balance feedback**: none. With the robot files' servos the open-loop patterns
+walk every built-in scenario to its end (docs/simulation.md), so the
+simulation measures the patterns as generated.
 """
 
 from __future__ import annotations
@@ -54,9 +49,6 @@ FALL_TILT = 0.6  # [rad]
 FALL_HEIGHT_FRACTION = 0.6  # [-] of the pelvis height
 AFTER_FALL = 0.3  # [s] simulated after a fall
 LOADED_FRACTION = 0.15  # [-] of the weight: a sole carrying more is "loaded" (its CoP is measured)
-FEEDBACK_GAIN = 20.0  # [rad/(m s)] ankle angle rate per metre of CoP-ZMP error
-FEEDBACK_LEAK = 2.0  # [1/s] pulls the correction back to zero
-FEEDBACK_LIMIT = 0.15  # [rad]
 
 
 @dataclass
@@ -79,7 +71,6 @@ class SimulationResult:
         cop_margin: Signed distance of the CoP to the polygon of the loaded soles [m], (n,).
         joint_names: The 12 joint column names.
         joint_angles, joint_velocities, joint_torques, joint_power: (n, 12) [rad], [rad/s], [N m], [W].
-        feedback: Whether balance feedback was on.
         mass_scale: Multiplier of all masses.
     """
 
@@ -103,7 +94,6 @@ class SimulationResult:
     joint_velocities: Array
     joint_torques: Array
     joint_power: Array
-    feedback: bool = False
     mass_scale: float = 1.0
     joint_names: tuple[str, ...] = field(default=JOINT_COLUMNS)
 
@@ -222,8 +212,6 @@ def simulate(
     joints: JointTrajectory,
     pattern: WalkingPattern,
     *,
-    feedback: bool = False,
-    feedback_sign: float = 1.0,
     mass_scale: float = 1.0,
 ) -> SimulationResult:
     """Simulate ``joints`` (made from ``pattern``) on ``robot`` and measure the walk.
@@ -232,8 +220,6 @@ def simulate(
         robot: A robot file with ``[bodies]``, ``[servos]``, ``[contact]``.
         joints: The 12 joint angles over time (:func:`zmpwalk.kinematics.pattern_joint_trajectory`).
         pattern: The pattern they come from: initial pose and reference ZMP.
-        feedback: Balance feedback at the ankles (module docstring).
-        feedback_sign: +1; -1 reverses the feedback (a test that must fall).
         mass_scale: Multiply every mass and inertia, and the servo gains with them
             (:func:`zmpwalk.sim.mjcf.robot_mjcf`).
 
@@ -259,39 +245,12 @@ def simulate(
     _initial_state(model, data, pattern, reference[0], mapping.penetration)
     sensors = _Sensors(model)
     n = len(time)
-    if not feedback:
-        spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
-        state = np.empty(mujoco.mj_stateSize(model, spec))
-        mujoco.mj_getState(model, data, state, spec)
-        control = np.repeat(reference, steps_per_tick, axis=0)[None]
-        _, readings = rollout.rollout(model, data, state[None], control)
-        readings = readings[0, steps_per_tick - 1::steps_per_tick]
-    else:
-        readings = np.empty((n, model.nsensordata))
-        correction = np.zeros(4)  # left pitch, left roll, right pitch, right roll
-        ankle_columns = [4, 5, 10, 11]
-        yaw = float(pattern.yaw_pelvis_in_world[0])
-        c_yaw, s_yaw = math.cos(yaw), math.sin(yaw)
-        dt = 1.0 / CONTROL_RATE
-        last = np.zeros(model.nsensordata)
-        for i in range(n):
-            control = reference[i].copy()
-            if i > 0:
-                left, cop_left = _ground_reaction(sensors, last[None], "left", robot.ankle_height)
-                right, cop_right = _ground_reaction(sensors, last[None], "right", robot.ankle_height)
-                total = left[0] + right[0]
-                if total > LOADED_FRACTION * weight:
-                    cop = (left[0] * np.nan_to_num(cop_left[0]) + right[0] * np.nan_to_num(cop_right[0])) / total
-                    ex, ey = cop[0] - zmp_ref[i - 1, 0], cop[1] - zmp_ref[i - 1, 1]
-                    forward, lateral = c_yaw * ex + s_yaw * ey, -s_yaw * ex + c_yaw * ey
-                    rate = feedback_sign * FEEDBACK_GAIN * np.array([-forward, lateral, -forward, lateral])
-                    correction = np.clip(correction + dt * (rate - FEEDBACK_LEAK * correction),
-                                         -FEEDBACK_LIMIT, FEEDBACK_LIMIT)
-                control[ankle_columns] += correction
-            data.ctrl[:] = control
-            mujoco.mj_step(model, data, nstep=steps_per_tick)
-            last = data.sensordata.copy()
-            readings[i] = last
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    state = np.empty(mujoco.mj_stateSize(model, spec))
+    mujoco.mj_getState(model, data, state, spec)
+    control = np.repeat(reference, steps_per_tick, axis=0)[None]
+    _, readings = rollout.rollout(model, data, state[None], control)
+    readings = readings[0, steps_per_tick - 1::steps_per_tick]
     # --- measurements
     pelvis = sensors.take(readings, "pelvis_pos")
     rpy = _rpy(sensors.take(readings, "pelvis_quat"))
@@ -344,6 +303,5 @@ def simulate(
         distance=distance, average_speed=distance / float(pattern.time[-1]), foot_slip=slip,
         cop_left=cop_feet[:, 0], cop_right=cop_feet[:, 1], cop=cop_total, force_left=forces[:, 0],
         force_right=forces[:, 1], reference_zmp=zmp_ref, cop_margin=margin, joint_angles=angles,
-        joint_velocities=velocities, joint_torques=torque, joint_power=torque * velocities, feedback=feedback,
-        mass_scale=mass_scale,
+        joint_velocities=velocities, joint_torques=torque, joint_power=torque * velocities, mass_scale=mass_scale,
     )

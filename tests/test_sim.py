@@ -1,0 +1,132 @@
+"""The MuJoCo simulation: model, standing, the paper's walk on the small biped, masses, falls, CLI.
+
+Short simulations only (a few seconds of simulated time each).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import mujoco
+import numpy as np
+import pytest
+
+from zmpwalk import InvalidParameterError, StepCommand, generate
+from zmpwalk.cli import main
+from zmpwalk.kinematics import pattern_joint_trajectory
+from zmpwalk.patterns.hyperbolic import paper_walk
+from zmpwalk.robots.model import Servos
+from zmpwalk.sim import actuator_table, contact_mapping, robot_mjcf, simulate
+
+
+@pytest.fixture(scope="module")
+def paper(mju):
+    pattern = paper_walk(mju, steps=2).sample(1000.0)
+    return pattern, pattern_joint_trajectory(pattern)
+
+
+@pytest.fixture(scope="module")
+def paper_result(mju, paper):
+    pattern, joints = paper
+    return simulate(mju, joints, pattern)
+
+
+@pytest.mark.parametrize("name", ["hubo", "mju"])
+def test_model_has_the_robot_file_masses(request, name):
+    robot = request.getfixturevalue(name)
+    model = mujoco.MjModel.from_xml_string(robot_mjcf(robot))
+    assert model.body_subtreemass[1] == pytest.approx(robot.link_mass, rel=1e-9)
+    assert model.nu == 12 and model.njnt == 13
+    doubled = mujoco.MjModel.from_xml_string(robot_mjcf(robot, mass_scale=2.0))
+    assert doubled.body_subtreemass[1] == pytest.approx(2 * robot.link_mass, rel=1e-9)
+
+
+def test_contact_mapping_sinks_a_foot_by_the_static_penetration_of_eq16(mju):
+    mapping = contact_mapping(mju)
+    half_weight = mju.link_mass * mju.gravity / 2
+    assert mju.contact.stiffness * mapping.penetration**1.5 == pytest.approx(half_weight, rel=1e-12)  # Eq. 16
+    assert mapping.stiffness * mapping.penetration == pytest.approx(1.5 * half_weight, rel=1e-12)
+    assert mapping.damping_ratio > 1.0  # still beyond critical after the stability cap
+
+
+def test_paper_walk_on_the_small_biped_does_not_fall(paper, paper_result):
+    pattern, _ = paper
+    result = paper_result
+    assert not result.fell and result.fall_time is None
+    planned = np.linalg.norm(pattern.position_pelvis_in_world[-1, :2] - pattern.position_pelvis_in_world[0, :2])
+    assert result.distance == pytest.approx(planned, rel=0.05)
+    assert result.foot_slip < 0.005  # [m]
+    assert np.nanmedian(result.cop_margin) > 0.005  # [m] the pressure stays inside the soles
+
+
+def test_hip_roll_needs_the_largest_torque_as_in_the_paper(paper_result):
+    rows = actuator_table(paper_result)
+    largest = max(rows, key=lambda row: row.peak_torque)
+    assert largest.joint.endswith("hip_roll")
+    assert 1.0 < largest.peak_torque < 2.5  # [N m] paper: about 1.3 N m at M2/M8
+    assert all(row.peak_power < 3.0 for row in rows)  # [W] paper: about 1 W
+
+
+def test_same_input_same_result(mju, paper, paper_result):
+    pattern, joints = paper
+    again = simulate(mju, joints, pattern)
+    np.testing.assert_array_equal(again.joint_torques, paper_result.joint_torques)
+    np.testing.assert_array_equal(again.cop, paper_result.cop)
+
+
+def test_mass_scales_torque_and_power_not_speed(mju, paper, paper_result):
+    pattern, joints = paper
+    heavy = simulate(mju, joints, pattern, mass_scale=2.0)
+    assert heavy.average_speed == pytest.approx(paper_result.average_speed, rel=0.05)
+    torque = np.abs(heavy.joint_torques).max() / np.abs(paper_result.joint_torques).max()
+    power = np.abs(heavy.joint_power).max() / np.abs(paper_result.joint_power).max()
+    assert torque == pytest.approx(2.0, rel=0.1) and power == pytest.approx(2.0, rel=0.1)
+
+
+def test_soft_servos_fall_and_it_is_reported(mju, paper):
+    pattern, joints = paper
+    soft = dataclasses.replace(mju, servos=Servos(5.0, 0.05, 1e-4))
+    result = simulate(soft, joints, pattern)
+    assert result.fell and 0.0 < result.fall_time < pattern.time[-1]
+    assert result.time[-1] < pattern.time[-1]  # stopped shortly after the fall
+
+
+def test_hubo_walks_a_few_steps(hubo):
+    pattern = generate(hubo, [StepCommand(0.95, 0.0), StepCommand(0.95, 0.2), StepCommand(0.95, 0.1)], rate=1000)
+    result = simulate(hubo, pattern_joint_trajectory(pattern), pattern)
+    assert not result.fell
+    planned = np.linalg.norm(pattern.position_pelvis_in_world[-1, :2])
+    assert result.distance == pytest.approx(planned, abs=0.02)  # [m]
+
+
+def test_bad_simulation_input(mju, paper):
+    pattern, joints = paper
+    with pytest.raises(InvalidParameterError, match="mass_scale"):
+        simulate(mju, joints, pattern, mass_scale=0.0)
+    short = dataclasses.replace(joints, time=joints.time[:10], angles=joints.angles[:10])
+    with pytest.raises(InvalidParameterError, match="joints"):
+        simulate(mju, short, pattern)
+
+
+def test_simulate_command_writes_results_and_json(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert main(["simulate", "--paper-example", "--robot", "mju-biped", "--out", str(out), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    for key in ("fell", "fall_time", "distance", "average_speed", "cop_error_rms", "cop_error_max",
+                "min_cop_margin", "actuators"):
+        assert key in summary
+    assert summary["fell"] is False and len(summary["actuators"]) == 12
+    assert set(summary["actuators"][0]) == {"joint", "peak_torque", "rms_torque", "peak_velocity", "peak_power",
+                                            "mean_power"}
+    assert {p.name for p in out.iterdir()} == {"actuators.csv", "actuators.md", "simulation.csv"}
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["simulate", "--paper-example", "--robot", "asimo"], "unknown robot"),
+    (["simulate", "--paper-example", "--robot", "mju-biped", "--mass-scale", "0"], "mass_scale"),
+    (["simulate", "--paper-example", "--scenario", "fig10"], "--paper-example takes no"),
+])
+def test_simulate_command_errors(capsys, argv, message):
+    assert main(argv) == 2
+    assert message in capsys.readouterr().err
