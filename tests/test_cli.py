@@ -13,7 +13,7 @@ from zmpwalk.cli import main
 from zmpwalk.patterns.result import CSV_COLUMNS
 from zmpwalk.scenarios import list_scenarios
 
-SCENARIOS = ["fig10", "fig27", "fig28", "fig29", "fig30", "fig31", "turn45"]
+SCENARIOS = ["demo", "fig10", "fig27", "fig28", "fig29", "fig30", "fig31", "turn45"]
 
 
 def test_scenarios_lists_the_paper_experiments(capsys):

@@ -10,17 +10,18 @@ from zmpwalk.patterns.hyperbolic import generate_hyperbolic
 from zmpwalk.scenarios import load_scenario
 
 OK = None
+ALL = ["demo", "fig10", "fig27", "fig28", "fig29", "fig30", "fig31", "turn45"]
+STRAIGHT_ONLY = {"demo": InvalidParameterError, "fig30": InvalidParameterError, "fig31": InvalidParameterError,
+                 "turn45": InvalidParameterError}
 EXPECTED = {
-    ("hubo", "polynomial"): dict.fromkeys(["fig10", "fig27", "fig28", "fig29", "fig30", "fig31", "turn45"], OK),
+    ("hubo", "polynomial"): dict.fromkeys(ALL, OK),
     ("hubo", "hyperbolic"): {"fig10": InfeasiblePatternError, "fig27": OK, "fig28": OK, "fig29": OK,
-                             "fig30": InvalidParameterError, "fig31": InvalidParameterError,
-                             "turn45": InvalidParameterError},
-    ("mju-biped", "polynomial"): {"fig10": UnreachableError, "fig27": UnreachableError, "fig28": UnreachableError,
-                                  "fig29": UnreachableError, "fig30": OK, "fig31": OK, "turn45": OK},
+                             **STRAIGHT_ONLY},
+    ("mju-biped", "polynomial"): {"demo": UnreachableError, "fig10": UnreachableError, "fig27": UnreachableError,
+                                  "fig28": UnreachableError, "fig29": UnreachableError, "fig30": OK, "fig31": OK,
+                                  "turn45": OK},
     ("mju-biped", "hyperbolic"): {"fig10": InfeasiblePatternError, "fig27": UnreachableError,
-                                  "fig28": UnreachableError, "fig29": UnreachableError,
-                                  "fig30": InvalidParameterError, "fig31": InvalidParameterError,
-                                  "turn45": InvalidParameterError},
+                                  "fig28": UnreachableError, "fig29": UnreachableError, **STRAIGHT_ONLY},
 }
 CASES = [(robot, generator, name, outcome) for (robot, generator), table in EXPECTED.items()
          for name, outcome in table.items()]

@@ -110,6 +110,30 @@ def _parser() -> argparse.ArgumentParser:
     simulate_cmd.add_argument("--out", type=Path, help="folder for the result files")
     simulate_cmd.add_argument("--json", action="store_true", help="print a JSON summary")
 
+    for name, help_text, example in (
+        ("demo", "the first thing to run: walk HUBO, check the ZMP, simulate, and write a report",
+         "example: zmpwalk demo   |   zmpwalk demo --robot mju-biped --scenario fig30 --out my-report"),
+        ("report", "generate, check, simulate and report any walk as a self-contained HTML page",
+         "example: zmpwalk report --scenario fig28 --out fig28-report"),
+    ):
+        report_cmd = commands.add_parser(
+            name, help=help_text,
+            description="Generate the pattern (1 kHz), check its ZMP, compute the joint angles, simulate the "
+            "walk in MuJoCo and write a report folder: index.html (plots, actuator table, ZMP margin per step, "
+            "an animation of the simulated walk; self-contained, opens offline), figures, CSV and JSON files.",
+            epilog=example,
+        )
+        report_cmd.add_argument("--scenario", default="demo" if name == "demo" else None,
+                                help="built-in scenario" + (" (default: demo)" if name == "demo" else ""))
+        report_cmd.add_argument("--steps", type=Path, help="steps file (TOML) instead of a scenario")
+        report_cmd.add_argument("--robot", default="hubo", help="robot name or file (default: hubo)")
+        report_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
+        default_out = Path("zmpwalk-demo" if name == "demo" else "zmpwalk-report")
+        report_cmd.add_argument("--out", type=Path, default=default_out,
+                                help="report folder (default: ./zmpwalk-demo or ./zmpwalk-report)")
+        report_cmd.add_argument("--no-animation", action="store_true", help="skip the rendered animation")
+        report_cmd.add_argument("--json", action="store_true", help="print a JSON summary")
+
     tables = commands.add_parser(
         "tables", help="walk every condition of Tables 2-3 and print the ZMP margins",
         description="Walk each tuned condition of the parameter tables (Tables 2 and 3) for a number of "
@@ -130,6 +154,39 @@ def _commands(args: argparse.Namespace) -> list[StepCommand]:
     if args.steps:
         return load_steps_file(args.steps)
     raise _UsageError("give a steps file or --scenario NAME (see 'zmpwalk scenarios')")
+
+
+def _progress(stage: str, done: int, total: int) -> None:
+    width = 24
+    filled = width * done // total
+    print(f"\r[{'#' * filled}{'.' * (width - filled)}] {done}/{total} {stage:<10}", end="" if done < total else "\n",
+          file=sys.stderr, flush=True)
+
+
+def _report(args: argparse.Namespace) -> int:
+    from zmpwalk.report import build_report
+
+    if args.steps and args.scenario and args.command == "report":
+        raise _UsageError("give either --steps or --scenario, not both")
+    if args.steps:
+        commands, name = load_steps_file(args.steps), args.steps.name
+    elif args.scenario:
+        commands, name = load_scenario(args.scenario), args.scenario
+    else:
+        raise _UsageError("give --scenario NAME or --steps FILE (see 'zmpwalk scenarios')")
+    robot = load_robot(args.robot)
+    quiet = args.json or not sys.stderr.isatty()
+    report = build_report(robot, commands, args.out, title=f"zmpwalk: {robot.name}, {name}",
+                          generator=args.generator, animate=not args.no_animation,
+                          progress=None if quiet else _progress)
+    if args.json:
+        print(json.dumps({**report.summary, "index": str(report.index), "seconds": report.seconds}, indent=2))
+    else:
+        s = report.summary
+        state = f"FELL at t = {s['fall_time']:.2f} s" if s["fell"] else "walked to the end without falling"
+        print(f"{robot.name}, {name}: {state}; min ZMP margin {float(s['min_zmp_margin']) * 1e3:+.1f} mm "
+              f"-> {report.index}")
+    return 0
 
 
 def _simulate(args: argparse.Namespace) -> int:
@@ -252,6 +309,8 @@ def _run(args: argparse.Namespace) -> int:
             print(f"min ZMP margin: {margin * 1e3:+.1f} mm at t = {summary['min_zmp_margin_time']:.3f} s "
                   f"({verdict})")
         return 0
+    if args.command in ("demo", "report"):
+        return _report(args)
     if args.command == "simulate":
         return _simulate(args)
     if args.command == "hyperbolic":

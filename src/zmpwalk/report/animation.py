@@ -1,0 +1,57 @@
+"""An animation of a simulated walk, rendered offscreen with MuJoCo (``MUJOCO_GL=egl`` on a headless machine)."""
+
+from __future__ import annotations
+
+import io
+import os
+
+import numpy as np
+
+from zmpwalk.robots.model import RobotModel
+from zmpwalk.sim.run import SimulationResult
+
+FPS = 12  # [1/s] frames of the GIF
+WIDTH, HEIGHT = 480, 320  # [px]
+
+
+def render_gif(robot: RobotModel, result: SimulationResult, fps: int = FPS) -> bytes:
+    """The walk as an animated GIF: the recorded poses replayed, a camera following the torso.
+
+    Raises:
+        RuntimeError: No OpenGL context could be made (set ``MUJOCO_GL=egl`` or ``osmesa``).
+    """
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    import mujoco
+    from PIL import Image
+
+    from zmpwalk.sim.mjcf import robot_mjcf
+
+    model = mujoco.MjModel.from_xml_string(robot_mjcf(robot, result.mass_scale))
+    data = mujoco.MjData(model)
+    renderer = mujoco.Renderer(model, HEIGHT, WIDTH)
+    camera = mujoco.MjvCamera()
+    camera.distance = 2.2 * robot.height
+    camera.elevation = -15.0
+    camera.azimuth = 135.0
+    step = max(1, round(1.0 / (fps * (result.time[1] - result.time[0]))))
+    frames = []
+    rotation = _quaternions(result.torso_rpy)
+    for i in range(0, len(result.time), step):
+        data.qpos[0:3] = result.torso_position[i]
+        data.qpos[3:7] = rotation[i]
+        data.qpos[7:19] = result.joint_angles[i]
+        mujoco.mj_kinematics(model, data)
+        camera.lookat[:] = (result.torso_position[i, 0], result.torso_position[i, 1], 0.6 * robot.pelvis_height)
+        renderer.update_scene(data, camera)
+        frames.append(Image.fromarray(renderer.render()).quantize(colors=64))
+    renderer.close()
+    buffer = io.BytesIO()
+    frames[0].save(buffer, format="GIF", save_all=True, append_images=frames[1:], duration=int(1000 / fps), loop=0)
+    return buffer.getvalue()
+
+
+def _quaternions(rpy: np.ndarray) -> np.ndarray:
+    roll, pitch, yaw = rpy.T / 2
+    cr, sr, cp, sp, cy, sy = np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch), np.cos(yaw), np.sin(yaw)
+    return np.column_stack([cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy,
+                            cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy])

@@ -1,0 +1,204 @@
+"""The report folder: generate, check, simulate, plot, animate, and write one self-contained ``index.html``.
+
+Everything the page shows is embedded (PNG and GIF as data URIs), so it opens
+offline from any folder. The page marks ``<body data-images-loaded="yes">``
+once every image has decoded, which the tests read in a headless browser.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from zmpwalk.commands import StepCommand
+from zmpwalk.kinematics import pattern_joint_trajectory
+from zmpwalk.patterns.hyperbolic import generate_hyperbolic
+from zmpwalk.patterns.polynomial import generate
+from zmpwalk.patterns.result import WalkingPattern
+from zmpwalk.robots.model import RobotModel
+from zmpwalk.sim.actuators import ActuatorRow, actuator_markdown, actuator_table, write_actuator_csv
+from zmpwalk.sim.run import simulate
+
+Progress = Callable[[str, int, int], None]
+STAGES = ("pattern", "joints", "simulation", "plots", "animation", "page")
+
+
+@dataclass
+class Report:
+    """What :func:`build_report` made.
+
+    Attributes:
+        folder: The report folder.
+        index: Its ``index.html``.
+        seconds: Wall time of each stage [s].
+        summary: The numbers on the page (SI).
+    """
+
+    folder: Path
+    index: Path
+    seconds: dict[str, float] = field(default_factory=dict)
+    summary: dict[str, Any] = field(default_factory=dict)
+
+
+def _data_uri(kind: str, payload: bytes) -> str:
+    return f"data:{kind};base64,{base64.b64encode(payload).decode('ascii')}"
+
+
+def step_margins(pattern: WalkingPattern) -> list[tuple[int, str, str, float, float, float]]:
+    """Per swing: number, kind, swing foot, start [s], duration [s], smallest ZMP margin [m]."""
+    margin = pattern.zmp_margin()
+    rows = []
+    for number, step in enumerate(pattern.steps, start=1):
+        mask = (pattern.time >= step.start) & (pattern.time <= step.start + step.duration)
+        rows.append((number, step.kind, step.swing, step.start, step.duration, float(np.nanmin(margin[mask]))))
+    return rows
+
+
+def build_report(
+    robot: RobotModel,
+    commands: Sequence[StepCommand],
+    folder: Path,
+    *,
+    title: str,
+    generator: str = "polynomial",
+    animate: bool = True,
+    progress: Progress | None = None,
+) -> Report:
+    """Generate, check, simulate and report a walk into ``folder``.
+
+    Raises:
+        ZmpwalkError: The walk cannot be generated (the message says why).
+    """
+    folder.mkdir(parents=True, exist_ok=True)
+    report = Report(folder, folder / "index.html")
+    clock = time.perf_counter()
+
+    def done(stage: str) -> None:
+        nonlocal clock
+        now = time.perf_counter()
+        report.seconds[stage] = now - clock
+        clock = now
+        if progress:
+            progress(stage, STAGES.index(stage) + 1, len(STAGES))
+
+    make = generate_hyperbolic if generator == "hyperbolic" else generate
+    pattern = make(robot, commands, rate=1000.0)
+    pattern.write_csv(folder / "pattern.csv")
+    done("pattern")
+    joints = pattern_joint_trajectory(pattern)
+    done("joints")
+    result = simulate(robot, joints, pattern)
+    rows = actuator_table(result)
+    write_actuator_csv(rows, folder / "actuators.csv")
+    done("simulation")
+    from zmpwalk.report import plots
+
+    images = {
+        "ZMP over the footprints (Figs. 20-22 of Park et al.)": plots.zmp_path(pattern, result),
+        "ZMP and measured CoP against time, with the support polygon's bounds (Figs. 21, 27-31)":
+            plots.zmp_time(pattern, result),
+        "Ankles relative to the pelvis (Figs. 10-11, 16-17)": plots.trajectories(pattern),
+        "Right leg: joint angles, torques and powers in the simulation (Figs. 12-14 of Lim et al.)":
+            plots.joints(result),
+    }
+    for index, payload in enumerate(images.values()):
+        (folder / f"figure{index + 1}.png").write_bytes(payload)
+    done("plots")
+    animation: bytes | None = None
+    animation_note = ""
+    if animate:
+        from zmpwalk.report.animation import render_gif
+
+        try:
+            animation = render_gif(robot, result)
+            (folder / "walk.gif").write_bytes(animation)
+        except Exception as error:  # no OpenGL context on this machine: say so on the page
+            animation_note = f"The animation could not be rendered here: {error}. Set MUJOCO_GL=egl or osmesa."
+    done("animation")
+    margin, at = pattern.min_zmp_margin()
+    rms, largest = result.cop_error_stats()
+    report.summary = {
+        "robot": robot.name, "generator": generator, "duration": pattern.duration, "swings": len(pattern.steps),
+        "min_zmp_margin": margin, "min_zmp_margin_time": at, "fell": result.fell, "fall_time": result.fall_time,
+        "distance": result.distance, "average_speed": result.average_speed, "foot_slip": result.foot_slip,
+        "cop_error_rms": rms, "cop_error_max": largest,
+    }
+    page = _page(title, robot, report.summary, images, animation, animation_note, step_margins(pattern), rows)
+    report.index.write_text(page, encoding="utf-8")
+    (folder / "summary.json").write_text(json.dumps(report.summary, indent=2), encoding="utf-8")
+    done("page")
+    return report
+
+
+def _page(title: str, robot: RobotModel, summary: dict[str, Any], images: dict[str, bytes],
+          animation: bytes | None, animation_note: str, margins: list[tuple[int, str, str, float, float, float]],
+          rows: list[ActuatorRow]) -> str:
+    esc = html.escape
+    fell = summary["fell"]
+    verdict = (f"<b class='bad'>fell at t = {summary['fall_time']:.2f} s</b>" if fell
+               else "<b class='good'>walked to the end without falling</b>")
+    margin_rows = "\n".join(
+        f"<tr><td>{n}</td><td>{esc(kind)}</td><td>{esc(swing)}</td><td>{start:.2f}</td><td>{duration:.2f}</td>"
+        f"<td class='{'good' if m >= 0 else 'bad'}'>{m * 1e3:+.1f}</td></tr>"
+        for n, kind, swing, start, duration, m in margins)
+    table = actuator_markdown(rows).splitlines()
+    actuator_rows = "\n".join(
+        "<tr>" + "".join(f"<td>{esc(cell.strip())}</td>" for cell in line.strip("|").split("|")) + "</tr>"
+        for line in table[2:])
+    figures = "\n".join(
+        f"<figure><img src='{_data_uri('image/png', payload)}' alt='{esc(caption)}'>"
+        f"<figcaption>{esc(caption)}</figcaption></figure>" for caption, payload in images.items())
+    movie = (f"<figure><img id='walk' src='{_data_uri('image/gif', animation)}' alt='the simulated walk'>"
+             f"<figcaption>The walk in MuJoCo, replayed from the simulation</figcaption></figure>"
+             if animation else f"<p class='bad'>{esc(animation_note)}</p>")
+    return f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>{esc(title)}</title>
+<style>
+body {{ font-family: system-ui, sans-serif; max-width: 980px; margin: 2em auto; color: #222; }}
+table {{ border-collapse: collapse; margin: 1em 0; font-size: 0.9em; }}
+td, th {{ border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: right; }}
+th {{ background: #f3f3f3; }} td:first-child {{ text-align: left; }}
+.good {{ color: #1a7f37; }} .bad {{ color: #c0392b; }}
+figure {{ margin: 1.5em 0; }} img {{ max-width: 100%; }} figcaption {{ color: #555; font-size: 0.9em; }}
+</style></head>
+<body data-images-loaded="no">
+<h1>{esc(title)}</h1>
+<p>{esc(robot.description)}. Pattern: {esc(str(summary['generator']))} generator,
+{summary['swings']} swings over {summary['duration']:.2f} s, sampled at 1 kHz.</p>
+<h2>Does it walk?</h2>
+<p>In the MuJoCo simulation it {verdict}: distance {summary['distance']:.3f} m, average speed
+{float(summary['average_speed']) * 1e3:.1f} mm/s, largest foot slip {float(summary['foot_slip']) * 1e3:.1f} mm;
+centre of pressure against the reference ZMP: RMS {float(summary['cop_error_rms']) * 1e3:.1f} mm,
+max {float(summary['cop_error_max']) * 1e3:.1f} mm.
+The pattern's cart-table ZMP stays {float(summary['min_zmp_margin']) * 1e3:+.1f} mm from the edge of the
+support polygon at its closest (t = {float(summary['min_zmp_margin_time']):.2f} s; negative is outside).</p>
+{movie}
+<h2>Which motors?</h2>
+<table><tr><th>joint</th><th>peak torque [N m]</th><th>RMS torque [N m]</th><th>peak velocity [rad/s]</th>
+<th>peak power [W]</th><th>mean power [W]</th></tr>
+{actuator_rows}
+</table>
+<h2>ZMP margin per step</h2>
+<table><tr><th>#</th><th>kind</th><th>swing</th><th>start [s]</th><th>duration [s]</th><th>min margin [mm]</th></tr>
+{margin_rows}
+</table>
+<h2>Figures</h2>
+{figures}
+<script>
+window.addEventListener("load", function () {{
+  var images = Array.prototype.slice.call(document.images);
+  var ok = images.length > 0 && images.every(function (i) {{ return i.complete && i.naturalWidth > 0; }});
+  document.body.setAttribute("data-images-loaded", ok ? "yes" : "no");
+  document.body.setAttribute("data-image-count", String(images.length));
+}});
+</script>
+</body></html>
+"""

@@ -1,0 +1,106 @@
+"""Plots in the style of the papers' figures, as PNG bytes (matplotlib, no display needed)."""
+
+from __future__ import annotations
+
+import io
+
+import matplotlib
+
+matplotlib.use("Agg")  # no display needed; before pyplot is imported
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.patches import Polygon
+
+from zmpwalk.footsteps import Pose2D, foot_corners
+from zmpwalk.patterns.result import WalkingPattern
+from zmpwalk.sim.run import SimulationResult
+
+DPI = 100
+
+
+def _png(figure: Figure) -> bytes:
+    buffer = io.BytesIO()
+    figure.tight_layout()
+    figure.savefig(buffer, format="png", dpi=DPI)
+    plt.close(figure)
+    return buffer.getvalue()
+
+
+def zmp_path(pattern: WalkingPattern, result: SimulationResult | None) -> bytes:
+    """The ZMP path over the footprints (Figs. 20-22 of Park et al.), world x-y [m]."""
+    figure, axes = plt.subplots(figsize=(9, 4.5))
+    for step in pattern.steps:
+        x, y, yaw = step.landing
+        side = 1 if step.swing == "left" else -1
+        corners = foot_corners(Pose2D(x, y, yaw), side, pattern.robot)
+        axes.add_patch(Polygon(corners, closed=True, fill=False, color="0.55", lw=1))
+    first = pattern.support_phases[0]
+    for pose, side in first.feet:
+        axes.add_patch(Polygon(foot_corners(pose, side, pattern.robot), closed=True, fill=False, color="0.55", lw=1))
+    axes.plot(pattern.zmp_in_world[:, 0], pattern.zmp_in_world[:, 1], color="C0", lw=1.2, label="reference ZMP")
+    axes.plot(pattern.position_pelvis_in_world[:, 0], pattern.position_pelvis_in_world[:, 1], color="C2", lw=1,
+              ls="--", label="pelvis")
+    if result is not None:
+        axes.plot(result.cop[:, 0], result.cop[:, 1], color="C3", lw=0.8, alpha=0.8, label="measured CoP (simulation)")
+    axes.set_aspect("equal")
+    axes.set_xlabel("x [m]")
+    axes.set_ylabel("y [m]")
+    axes.set_title("ZMP over the footprints")
+    axes.legend(loc="upper left", fontsize=8)
+    axes.autoscale_view()
+    return _png(figure)
+
+
+def zmp_time(pattern: WalkingPattern, result: SimulationResult | None) -> bytes:
+    """ZMP (and CoP) against time with the support polygon's bounds (Figs. 21, 27-31)."""
+    polygons = pattern.support_polygons()
+    begins = np.array([p.begin for p in pattern.support_phases])
+    which = np.clip(np.searchsorted(begins, pattern.time, side="right") - 1, 0, len(begins) - 1)
+    bounds = np.array([[polygons[k][:, i].min() for i in (0, 1)] + [polygons[k][:, i].max() for i in (0, 1)]
+                       for k in range(len(polygons))])[which]
+    figure, axes = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True)
+    for i, label in enumerate(("x", "y")):
+        axes[i].fill_between(pattern.time, bounds[:, i], bounds[:, i + 2], color="0.9", step="post",
+                             label="support polygon bounds")
+        axes[i].plot(pattern.time, pattern.zmp_in_world[:, i], color="C0", lw=1.2, label="reference ZMP")
+        if result is not None:
+            axes[i].plot(result.time, result.cop[:, i], color="C3", lw=0.8, alpha=0.8, label="measured CoP")
+        axes[i].set_ylabel(f"{label} [m]")
+    axes[0].legend(loc="upper left", fontsize=8)
+    axes[1].set_xlabel("t [s]")
+    axes[0].set_title("ZMP against time")
+    return _png(figure)
+
+
+def trajectories(pattern: WalkingPattern) -> bytes:
+    """Pelvis and ankles relative to the pelvis (Figs. 10-11, 16-17 of Park et al.)."""
+    figure, axes = plt.subplots(3, 1, figsize=(9, 6.5), sharex=True)
+    left, right = pattern.position_left_ankle_in_pelvis, pattern.position_right_ankle_in_pelvis
+    for i, label in enumerate(("x", "y", "z")):
+        axes[i].plot(pattern.time, left[:, i], color="C0", lw=1, label="left ankle")
+        axes[i].plot(pattern.time, right[:, i], color="C1", lw=1, label="right ankle")
+        axes[i].set_ylabel(f"{label} in pelvis [m]")
+    axes[0].legend(loc="upper right", fontsize=8)
+    axes[2].set_xlabel("t [s]")
+    axes[0].set_title("Ankles relative to the pelvis")
+    return _png(figure)
+
+
+def joints(result: SimulationResult) -> bytes:
+    """Right-leg joint angles, torques and powers (Figs. 12-14 of Lim et al.)."""
+    figure, axes = plt.subplots(3, 1, figsize=(9, 7), sharex=True)
+    names = result.joint_names[6:]
+    for j, name in enumerate(names):
+        column = 6 + j
+        short = name.replace("right_", "")
+        axes[0].plot(result.time, result.joint_angles[:, column], lw=1, label=short)
+        axes[1].plot(result.time, result.joint_torques[:, column], lw=1, label=short)
+        axes[2].plot(result.time, result.joint_power[:, column], lw=1, label=short)
+    axes[0].set_ylabel("angle [rad]")
+    axes[1].set_ylabel("torque [N m]")
+    axes[2].set_ylabel("power [W]")
+    axes[2].set_xlabel("t [s]")
+    axes[0].legend(loc="upper right", fontsize=7, ncol=3)
+    axes[0].set_title("Right leg: joint angles, torques and powers (simulation)")
+    return _png(figure)

@@ -1,0 +1,70 @@
+"""The demo: one command writes a self-contained report; a headless browser loads every image."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+
+import pytest
+
+from zmpwalk.cli import main
+
+ARTIFACTS = Path(__file__).resolve().parent.parent / "test-artifacts"
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                  "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+
+
+@pytest.fixture(scope="module")
+def demo(tmp_path_factory):
+    out = tmp_path_factory.mktemp("demo") / "report"
+    assert main(["demo", "--out", str(out), "--json"]) == 0
+    return out
+
+
+def test_demo_writes_the_report_folder(demo):
+    names = {p.name for p in demo.iterdir()}
+    assert {"index.html", "walk.gif", "figure1.png", "figure4.png", "actuators.csv", "pattern.csv",
+            "summary.json"} <= names
+    summary = json.loads((demo / "summary.json").read_text())
+    assert summary["fell"] is False and summary["min_zmp_margin"] > 0
+    page = (demo / "index.html").read_text()
+    assert "http://" not in page and "https://" not in page  # opens offline: everything is embedded
+    assert page.count("data:image/png;base64,") == 4 and page.count("data:image/gif;base64,") == 1
+    assert "right_hip_roll" in page and "ZMP margin per step" in page
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed (.ci/run installs it)")
+def test_headless_browser_loads_every_image_and_the_animation(demo):
+    profile = tempfile.mkdtemp()
+    dom = subprocess.run([CHROMIUM, *CHROMIUM_FLAGS, f"--user-data-dir={profile}", "--virtual-time-budget=10000",
+                          "--dump-dom", (demo / "index.html").as_uri()],
+                         capture_output=True, text=True, timeout=120, check=True).stdout
+    assert 'data-images-loaded="yes"' in dom and 'data-image-count="5"' in dom
+    ARTIFACTS.mkdir(exist_ok=True)
+    shot = ARTIFACTS / "demo-report.png"
+    subprocess.run([CHROMIUM, *CHROMIUM_FLAGS, f"--user-data-dir={tempfile.mkdtemp()}", "--window-size=1000,1400",
+                    f"--screenshot={shot}", (demo / "index.html").as_uri()],
+                   capture_output=True, timeout=120, check=True)
+    assert shot.stat().st_size > 10_000
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["demo", "--scenario", "nope"], "unknown scenario 'nope'"),
+    (["report", "--robot", "mju-biped", "--scenario", "fig28", "--no-animation"], "out of reach"),
+    (["report"], "give --scenario NAME or --steps FILE"),
+])
+def test_report_errors(tmp_path, capsys, argv, message):
+    assert main([*argv, "--out", str(tmp_path / "r")]) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_report_from_a_steps_file(tmp_path, capsys):
+    steps = tmp_path / "walk.toml"
+    steps.write_text("[[steps]]\nduration = 0.8\nforward = 0.1\nrepeat = 2\n")
+    assert main(["report", "--steps", str(steps), "--no-animation", "--out", str(tmp_path / "r")]) == 0
+    assert "walked to the end without falling" in capsys.readouterr().out
+    assert (tmp_path / "r" / "index.html").exists()
