@@ -62,6 +62,9 @@ def test_tables_command_prints_every_condition(capsys):
     (["plan", "nowhere.toml"], "nowhere.toml"),
     (["tables", "--steps", "0"], "--steps"),
     (["fly"], "invalid choice"),
+    (["scenarios", "--yaml"], "unrecognized arguments"),
+    (["hyperbolic", "--json"], "--paper-example"),
+    (["simulate", "--scenario", "fig28", "--generator", "lipm"], "invalid choice"),
 ])
 def test_errors_print_one_line_and_exit_non_zero(capsys, argv, message):
     assert main(argv) == 2
