@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import os
+
+os.environ.setdefault("MUJOCO_GL", "egl")  # offscreen rendering; before any test module imports mujoco
+
 import pytest
 
 from zmpwalk import RobotModel, Schedule, load_robot

@@ -1,5 +1,13 @@
 """zmpwalk: online ZMP walking patterns for biped humanoid robots."""
 
+import os
+
+# The report renders offscreen with MuJoCo, whose OpenGL backend is fixed when it is first imported;
+# EGL needs no display. A value the user set wins.
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+# ruff: noqa: E402
+
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import (
     FileFormatError,
