@@ -6,7 +6,6 @@ import os
 # EGL needs no display. A value the user set wins.
 os.environ.setdefault("MUJOCO_GL", "egl")
 
-# ruff: noqa: E402
 
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import (
