@@ -7,10 +7,11 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import NoReturn
+from typing import TYPE_CHECKING, NoReturn
 
 import numpy as np
 
@@ -23,6 +24,9 @@ from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots import list_robots, load_robot
 from zmpwalk.scenarios import list_scenarios, load_scenario, load_steps_file
 from zmpwalk.tables import condition_margins, margins_markdown
+
+if TYPE_CHECKING:
+    from zmpwalk.sim.run import SimulationResult
 
 EXIT_ERROR = 2
 GENERATORS = ("polynomial", "hyperbolic")
@@ -180,7 +184,8 @@ def _report(args: argparse.Namespace) -> int:
                           generator=args.generator, animate=not args.no_animation,
                           progress=None if quiet else _progress)
     if args.json:
-        print(json.dumps({**report.summary, "index": str(report.index), "seconds": report.seconds}, indent=2))
+        summary = {**report.summary, "index": str(report.index), "seconds": report.seconds}
+        print(json.dumps(_json_safe(summary), indent=2, allow_nan=False))
     else:
         s = report.summary
         state = f"FELL at t = {s['fall_time']:.2f} s" if s["fell"] else "walked to the end without falling"
@@ -221,7 +226,7 @@ def _simulate(args: argparse.Namespace) -> int:
         (args.out / "actuators.md").write_text(actuator_markdown(rows) + "\n", encoding="utf-8")
         result_csv(result, args.out / "simulation.csv")
     if args.json:
-        print(json.dumps(summary, indent=2, allow_nan=False, default=_finite))
+        print(json.dumps(_json_safe(summary), indent=2, allow_nan=False))
     else:
         state = f"FELL at t = {result.fall_time:.3f} s" if result.fell else "walked to the end without falling"
         print(f"{robot.name}: {state}; distance {result.distance:.3f} m, average speed "
@@ -235,15 +240,19 @@ def _simulate(args: argparse.Namespace) -> int:
     return 0
 
 
-def _finite(value: object) -> object:
-    return None
+def _json_safe(value: object) -> object:
+    """NaN and infinity (e.g. no loaded sole) become null, so the output is strict JSON."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {key: _json_safe(item) for key, item in value.items()}
+    if isinstance(value, list):
+        return [_json_safe(item) for item in value]
+    return value
 
 
-def result_csv(result: object, path: Path) -> None:
+def result_csv(result: SimulationResult, path: Path) -> None:
     """The simulation's time series as CSV (SI)."""
-    from zmpwalk.sim import SimulationResult
-
-    assert isinstance(result, SimulationResult)
     columns: dict[str, np.ndarray] = {
         "t": result.time,
         "torso_x": result.torso_position[:, 0], "torso_y": result.torso_position[:, 1],
