@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from zmpwalk import InvalidParameterError, StepCommand, UnreachableError, generate
-from zmpwalk.online import OnlineWalker
+from zmpwalk import OnlineWalker  # the public API: from zmpwalk import OnlineWalker, StepCommand, load_robot
 
 TOL = 1e-12  # [m] the walker and the generator evaluate the same closed forms
 

@@ -16,6 +16,9 @@ from zmpwalk.errors import (
     UnreachableError,
     ZmpwalkError,
 )
+from zmpwalk.kinematics import JointLimitError, JointTrajectory, pattern_joint_trajectory
+from zmpwalk.online import OnlineWalker, WalkingSample
+from zmpwalk.patterns.hyperbolic import generate_hyperbolic
 from zmpwalk.patterns.polynomial import generate
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots import RobotModel, list_robots, load_robot
@@ -25,6 +28,9 @@ __all__ = [
     "FileFormatError",
     "InfeasiblePatternError",
     "InvalidParameterError",
+    "JointLimitError",
+    "JointTrajectory",
+    "OnlineWalker",
     "RobotModel",
     "Schedule",
     "ShapeParameters",
@@ -32,8 +38,11 @@ __all__ = [
     "UnknownNameError",
     "UnreachableError",
     "WalkingPattern",
+    "WalkingSample",
     "ZmpwalkError",
     "generate",
+    "generate_hyperbolic",
     "list_robots",
     "load_robot",
+    "pattern_joint_trajectory",
 ]
