@@ -7,8 +7,13 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from zmpwalk import InvalidParameterError, StepCommand, UnreachableError, generate
-from zmpwalk import OnlineWalker  # the public API: from zmpwalk import OnlineWalker, StepCommand, load_robot
+from zmpwalk import (
+    InvalidParameterError,
+    OnlineWalker,  # the public API: from zmpwalk import OnlineWalker, StepCommand, load_robot
+    StepCommand,
+    UnreachableError,
+    generate,
+)
 
 TOL = 1e-12  # [m] the walker and the generator evaluate the same closed forms
 
