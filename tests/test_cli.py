@@ -10,6 +10,7 @@ import sys
 import pytest
 
 from zmpwalk.cli import main
+from zmpwalk.kinematics import JOINT_COLUMNS
 from zmpwalk.patterns.result import CSV_COLUMNS
 from zmpwalk.scenarios import list_scenarios
 
@@ -76,3 +77,21 @@ def test_installed_command_runs_as_a_process(tmp_path):
     result = subprocess.run([sys.executable, "-m", "zmpwalk.cli", "plan", "--scenario", "fig99"],
                             capture_output=True, text=True, check=False)
     assert result.returncode == 2 and result.stderr.startswith("zmpwalk: error:")
+
+
+def test_plan_joints_appends_the_twelve_joint_columns(tmp_path, capsys):
+    out = tmp_path / "walk.csv"
+    assert main(["plan", "--scenario", "fig10", "--joints", "--out", str(out)]) == 0
+    with out.open() as handle:
+        header = next(csv.reader(handle))
+    assert tuple(header) == CSV_COLUMNS + JOINT_COLUMNS
+    assert JOINT_COLUMNS[:3] == ("left_hip_yaw", "left_hip_roll", "left_hip_pitch")
+    assert JOINT_COLUMNS[-1] == "right_ankle_roll"
+
+
+def test_plan_with_the_hyperbolic_generator(tmp_path, capsys):
+    steps = tmp_path / "walk.toml"
+    steps.write_text("[[steps]]\nduration = 0.6\nforward = 0.03\nrepeat = 4\n")
+    assert main(["plan", str(steps), "--generator", "hyperbolic", "--robot", "mju-biped", "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["generator"] == "hyperbolic" and summary["min_zmp_margin"] > 0
