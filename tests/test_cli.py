@@ -95,3 +95,22 @@ def test_plan_with_the_hyperbolic_generator(tmp_path, capsys):
     assert main(["plan", str(steps), "--generator", "hyperbolic", "--robot", "mju-biped", "--json"]) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["generator"] == "hyperbolic" and summary["min_zmp_margin"] > 0
+
+
+@pytest.mark.parametrize("step, message", [
+    ("duration = 0", "duration = 0"),
+    ("duration = -0.8", "duration = -0.8"),
+    ("duration = 0.08\nforward = 0.1", "longer than the double-support time"),
+    ("duration = nan", "duration = nan"),
+    ("duration = 0.8\nforward = 0.9", "out of reach"),
+    ("duration = 0.8\nup_ratio = 1.5", "up_ratio = 1.5"),
+    ("duration = 0.8\nd1 = 1.0", "d1 = 1"),
+    ("duration = 0.8\nfoward = 0.1", "unknown field 'foward'"),
+])
+def test_bad_steps_files_exit_non_zero_with_one_line(tmp_path, capsys, step, message):
+    steps = tmp_path / "walk.toml"
+    steps.write_text(f"[[steps]]\nduration = 0.8\nforward = 0.1\n[[steps]]\n{step}\n")
+    assert main(["plan", str(steps)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert message in err

@@ -25,6 +25,7 @@ from __future__ import annotations
 import tomllib
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from functools import lru_cache
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -182,9 +183,8 @@ class Schedule:
 
     @classmethod
     def hubo(cls) -> Schedule:
-        """Tables 2 and 3 of Park et al. (2008)."""
-        path = Path(str(resources.files("zmpwalk") / "data" / "schedule_hubo.toml"))
-        return cls.from_file(path)
+        """Tables 2 and 3 of Park et al. (2008) (read once; a schedule is not modified after reading)."""
+        return _hubo_schedule()
 
     def stage_parameters(
         self, command: StepCommand, robot: RobotModel
@@ -250,3 +250,9 @@ class Schedule:
 def _worse(first: str, second: str) -> str:
     order = ("table", "interpolated", "extrapolated")
     return order[max(order.index(first), order.index(second))]
+
+
+@lru_cache(maxsize=1)
+def _hubo_schedule() -> Schedule:
+    path = Path(str(resources.files("zmpwalk") / "data" / "schedule_hubo.toml"))
+    return Schedule.from_file(path)
