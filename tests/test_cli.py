@@ -114,3 +114,10 @@ def test_bad_steps_files_exit_non_zero_with_one_line(tmp_path, capsys, step, mes
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err
     assert message in err
+
+
+def test_planning_errors_name_the_file_the_table_and_the_walked_step(tmp_path, capsys):
+    steps = tmp_path / "walk.toml"
+    steps.write_text("[[steps]]\nduration = 0.8\nforward = 0.1\nrepeat = 3\n[[steps]]\nduration = 0.8\nforward = 0.9\n")
+    assert main(["plan", str(steps)]) == 2
+    assert f"{steps}: step 4 ([[steps]] 2): right ankle out of reach" in capsys.readouterr().err

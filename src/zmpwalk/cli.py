@@ -9,7 +9,8 @@ import argparse
 import json
 import math
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
 
@@ -22,7 +23,7 @@ from zmpwalk.patterns.hyperbolic import HyperbolicGait, generate_hyperbolic
 from zmpwalk.patterns.polynomial import generate
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots import list_robots, load_robot
-from zmpwalk.scenarios import list_scenarios, load_scenario, load_steps_file
+from zmpwalk.scenarios import list_scenarios, load_scenario_with_labels, load_steps_file_with_labels
 from zmpwalk.tables import condition_margins, margins_markdown
 
 if TYPE_CHECKING:
@@ -150,13 +151,28 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _commands(args: argparse.Namespace) -> list[StepCommand]:
+@contextmanager
+def _source(label: str) -> Iterator[None]:
+    """Name the steps file (or scenario) in front of an error raised while walking its steps."""
+    try:
+        yield
+    except ZmpwalkError as error:
+        raise error.in_context(label) from None
+
+
+def _label(args: argparse.Namespace) -> str:
+    steps = getattr(args, "steps", None)
+    return str(steps) if steps else f"scenario {args.scenario}"
+
+
+def _commands(args: argparse.Namespace) -> tuple[list[StepCommand], list[str]]:
+    """The step commands of the arguments and how errors name each."""
     if args.scenario and args.steps:
         raise _UsageError("give either a steps file or --scenario, not both")
     if args.scenario:
-        return load_scenario(args.scenario)
+        return load_scenario_with_labels(args.scenario)
     if args.steps:
-        return load_steps_file(args.steps)
+        return load_steps_file_with_labels(args.steps)
     raise _UsageError("give a steps file or --scenario NAME (see 'zmpwalk scenarios')")
 
 
@@ -173,16 +189,17 @@ def _report(args: argparse.Namespace) -> int:
     if args.steps and args.scenario and args.command == "report":
         raise _UsageError("give either --steps or --scenario, not both")
     if args.steps:
-        commands, name = load_steps_file(args.steps), args.steps.name
+        (commands, labels), name = load_steps_file_with_labels(args.steps), args.steps.name
     elif args.scenario:
-        commands, name = load_scenario(args.scenario), args.scenario
+        (commands, labels), name = load_scenario_with_labels(args.scenario), args.scenario
     else:
         raise _UsageError("give --scenario NAME or --steps FILE (see 'zmpwalk scenarios')")
     robot = load_robot(args.robot)
     quiet = args.json or not sys.stderr.isatty()
-    report = build_report(robot, commands, args.out, title=f"zmpwalk: {robot.name}, {name}",
-                          generator=args.generator, animate=not args.no_animation,
-                          progress=None if quiet else _progress)
+    with _source(str(args.steps) if args.steps else f"scenario {args.scenario}"):
+        report = build_report(robot, commands, args.out, title=f"zmpwalk: {robot.name}, {name}",
+                              generator=args.generator, animate=not args.no_animation,
+                              progress=None if quiet else _progress, labels=labels)
     if args.json:
         summary = {**report.summary, "index": str(report.index), "seconds": report.seconds}
         print(json.dumps(_json_safe(summary), indent=2, allow_nan=False))
@@ -206,9 +223,10 @@ def _simulate(args: argparse.Namespace) -> int:
             raise _UsageError(f"--steady-steps = {args.steady_steps} must be >= 0")
         pattern = paper_walk(robot, steps=args.steady_steps).sample(1000.0)
     else:
-        commands = _commands(args)
+        commands, labels = _commands(args)
         make = generate_hyperbolic if args.generator == "hyperbolic" else generate
-        pattern = make(robot, commands, rate=1000.0)
+        with _source(_label(args)):
+            pattern = make(robot, commands, rate=1000.0, labels=labels)
     joints = pattern_joint_trajectory(pattern, check_limits=False)
     result = simulate(robot, joints, pattern, mass_scale=args.mass_scale)
     rows = actuator_table(result)
@@ -298,13 +316,12 @@ def _run(args: argparse.Namespace) -> int:
                 print(f"{name:<{width}}  {description}")
         return 0
     if args.command == "plan":
-        commands = _commands(args)
+        commands, labels = _commands(args)
         robot = load_robot(args.robot)
-        if args.generator == "hyperbolic":
-            pattern = generate_hyperbolic(robot, commands, rate=args.rate)
-        else:
-            pattern = generate(robot, commands, rate=args.rate)
-        extra = pattern_joint_trajectory(pattern).columns() if args.joints else None
+        make = generate_hyperbolic if args.generator == "hyperbolic" else generate
+        with _source(_label(args)):
+            pattern = make(robot, commands, rate=args.rate, labels=labels)
+            extra = pattern_joint_trajectory(pattern).columns() if args.joints else None
         if args.out:
             pattern.write_csv(args.out, extra)
         summary = _summary(pattern)

@@ -29,11 +29,16 @@ MAX_REPEAT = 100_000
 
 
 def parse_steps(data: dict[str, Any], source: str) -> list[StepCommand]:
-    """Step commands from a parsed steps file.
+    """Step commands from a parsed steps file (``repeat`` expanded).
 
     Raises:
         FileFormatError: Naming the file, the step (1-based, as written) and the field.
     """
+    return parse_steps_with_labels(data, source)[0]
+
+
+def parse_steps_with_labels(data: dict[str, Any], source: str) -> tuple[list[StepCommand], list[str]]:
+    """Step commands and, for each, how an error names it: ``step 7 ([[steps]] 3)`` after repeats."""
     unknown = set(data) - {"steps", "description"}
     if unknown:
         raise FileFormatError(source, f"unknown top-level key {sorted(unknown)[0]!r}; expected [[steps]]")
@@ -41,6 +46,7 @@ def parse_steps(data: dict[str, Any], source: str) -> list[StepCommand]:
     if not isinstance(steps, list) or not steps:
         raise FileFormatError(source, "no [[steps]] tables")
     commands: list[StepCommand] = []
+    labels: list[str] = []
     for number, table in enumerate(steps, start=1):
         where = f"step {number}"
         if not isinstance(table, dict):
@@ -61,8 +67,11 @@ def parse_steps(data: dict[str, Any], source: str) -> list[StepCommand]:
             raise FileFormatError(source, f"{where}: {error}") from None
         except TypeError as error:
             raise FileFormatError(source, f"{where}: {error}") from None
-        commands.extend([command] * repeat)
-    return commands
+        for _ in range(repeat):
+            commands.append(command)
+            labels.append(f"step {len(commands)} ([[steps]] {number})" if len(commands) != number
+                          else f"step {number}")
+    return commands, labels
 
 
 def load_steps_file(path: str | Path) -> list[StepCommand]:
@@ -71,6 +80,11 @@ def load_steps_file(path: str | Path) -> list[StepCommand]:
     Raises:
         FileFormatError: Unreadable, not TOML, or malformed steps.
     """
+    return load_steps_file_with_labels(path)[0]
+
+
+def load_steps_file_with_labels(path: str | Path) -> tuple[list[StepCommand], list[str]]:
+    """Read a steps file: the commands and how errors name each (see :func:`parse_steps_with_labels`)."""
     path = Path(path)
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
@@ -78,7 +92,7 @@ def load_steps_file(path: str | Path) -> list[StepCommand]:
         raise FileFormatError(str(path), error.strerror or str(error)) from None
     except tomllib.TOMLDecodeError as error:
         raise FileFormatError(str(path), f"not valid TOML: {error}") from None
-    return parse_steps(data, str(path))
+    return parse_steps_with_labels(data, str(path))
 
 
 def _scenario_dir() -> Path:
@@ -100,7 +114,12 @@ def load_scenario(name: str) -> list[StepCommand]:
     Raises:
         UnknownNameError: Lists the known scenarios.
     """
+    return load_scenario_with_labels(name)[0]
+
+
+def load_scenario_with_labels(name: str) -> tuple[list[StepCommand], list[str]]:
+    """A built-in scenario's commands and how errors name each."""
     path = _scenario_dir() / f"{name}.toml"
     if not path.is_file():
         raise UnknownNameError("scenario", name, list_scenarios())
-    return load_steps_file(path)
+    return load_steps_file_with_labels(path)

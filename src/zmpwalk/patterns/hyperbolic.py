@@ -563,7 +563,8 @@ def paper_walk(robot: RobotModel, gait: HyperbolicGait | None = None, steps: int
     return HyperbolicWalk(robot, [steady] * (steps + 1), window, window if stop else None, gait.gravity)
 
 
-def generate_hyperbolic(robot: RobotModel, commands: Sequence[StepCommand], rate: float = 100.0) -> WalkingPattern:
+def generate_hyperbolic(robot: RobotModel, commands: Sequence[StepCommand], rate: float = 100.0,
+                        labels: Sequence[str] | None = None) -> WalkingPattern:
     """Straight walking of step commands with the hyperbolic pattern, sampled at ``rate`` [Hz].
 
     Each command is a steady step of stride ``x_s = 2 * forward`` solved by :func:`solve_step` with
@@ -588,16 +589,18 @@ def generate_hyperbolic(robot: RobotModel, commands: Sequence[StepCommand], rate
             if getattr(command, name) != 0:
                 raise InvalidParameterError(name, getattr(command, name),
                                             "0: the hyperbolic pattern walks straight (use the polynomial generator)",
-                                            context=f"step {number}")
+                                            context=labels[number - 1] if labels else f"step {number}")
     a = math.sqrt(robot.gravity / robot.pendulum_length)
     y_zmp = robot.hip_spacing / 2
     steps = []
-    for number, command in enumerate(moving, start=1):
+    for number, command in enumerate(commands, start=1):
+        if command.stop:
+            continue
         dsp = command.dsp_time if command.dsp_time is not None else robot.dsp_time
         try:
             steps.append(solve_step(a, 2 * command.forward, command.duration, dsp, y_zmp))
         except InfeasiblePatternError as error:
-            raise error.in_context(f"step {number}") from None
+            raise error.in_context(labels[number - 1] if labels else f"step {number}") from None
     first, last = moving[0].duration, moving[-1].duration
     walk = HyperbolicWalk(robot, steps, (0.4 * first, 0.6 * first), (0.4 * last, 0.6 * last))
     pattern = walk.sample(rate)

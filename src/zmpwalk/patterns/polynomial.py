@@ -551,6 +551,7 @@ def plan_walk(
     robot: RobotModel,
     commands: Sequence[StepCommand],
     schedule: Schedule | None = None,
+    labels: Sequence[str] | None = None,
 ) -> tuple[list[Stage], Stance]:
     """Stages of a whole walk from the ready posture, closed by a stop and a standing stage.
 
@@ -558,8 +559,14 @@ def plan_walk(
     last step time and shape factors (:func:`closing_command`), so every
     pattern ends standing in the ready posture.
 
+    Args:
+        robot: The robot.
+        commands: The step commands.
+        schedule: Parameter tables.
+        labels: How an error names each command (default ``step N``, 1-based).
+
     Raises:
-        ZmpwalkError: With ``step N:`` in front, for the first command that fails.
+        ZmpwalkError: With the command's label in front, for the first command that fails.
     """
     schedule = schedule or Schedule.hubo()
     stance = Stance.ready(robot)
@@ -573,15 +580,22 @@ def plan_walk(
         try:
             new, stance, boundary = plan_next(robot, schedule, stance, boundary, command, reach=False)
         except ZmpwalkError as error:
-            raise error.in_context(f"step {number}") from None
+            raise error.in_context(_label(labels, number)) from None
         stages.extend(new)
         numbers.extend([number] * len(new))
     try:
         check_reach(stages, robot)
     except UnreachableError as error:
-        raise error.in_context(f"step {numbers[error.stage]}") from None
+        raise error.in_context(_label(labels, numbers[error.stage])) from None
     stages.append(standing_stage(_standing_plan(stance, robot, schedule), boundary.time))
     return stages, stance
+
+
+def _label(labels: Sequence[str] | None, number: int) -> str:
+    """The name of command ``number`` (1-based) in error messages; the closing stop is the last step."""
+    if labels is None or number > len(labels):
+        return f"step {number}"
+    return labels[number - 1]
 
 
 def _standing_plan(stance: Stance, robot: RobotModel, schedule: Schedule) -> StagePlan:
@@ -600,6 +614,7 @@ def generate(
     commands: Sequence[StepCommand],
     rate: float = 100.0,
     schedule: Schedule | None = None,
+    labels: Sequence[str] | None = None,
 ) -> WalkingPattern:
     """The HUBO walking pattern of a command sequence, sampled at ``rate`` [Hz].
 
@@ -608,12 +623,13 @@ def generate(
         commands: Step commands in order; a closing stop is added if missing.
         rate: Samples per second (HUBO's reference rate is 100 Hz).
         schedule: Parameter tables; Tables 2-3 of the paper by default.
+        labels: How an error names each command (default ``step N``).
 
     Returns:
         The pattern from the ready posture at t = 0 to standing after the last step.
     """
     check_rate(rate)
-    stages, _ = plan_walk(robot, commands, schedule)
+    stages, _ = plan_walk(robot, commands, schedule, labels)
     end_time = stages[-1].start
     count = math.ceil(end_time * rate - 1e-9) + 1  # up to the first sample at or after the end
     times = np.arange(count) / rate

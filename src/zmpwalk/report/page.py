@@ -71,6 +71,7 @@ def build_report(
     generator: str = "polynomial",
     animate: bool = True,
     progress: Progress | None = None,
+    labels: Sequence[str] | None = None,
 ) -> Report:
     """Generate, check, simulate and report a walk into ``folder``.
 
@@ -90,7 +91,7 @@ def build_report(
             progress(stage, STAGES.index(stage) + 1, len(STAGES))
 
     make = generate_hyperbolic if generator == "hyperbolic" else generate
-    pattern = make(robot, commands, rate=1000.0)
+    pattern = make(robot, commands, rate=1000.0, labels=labels)
     pattern.write_csv(folder / "pattern.csv")
     done("pattern")
     joints = pattern_joint_trajectory(pattern)
