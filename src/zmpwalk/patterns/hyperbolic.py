@@ -52,16 +52,22 @@ from numpy.typing import NDArray
 from zmpwalk import curves
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import InfeasiblePatternError, InvalidParameterError
-from zmpwalk.footsteps import Pose2D, foot_corners
+from zmpwalk.footsteps import LEFT, RIGHT, Pose2D, foot_corners
 from zmpwalk.kinematics import check_leg_reach
 from zmpwalk.patterns.polynomial import check_rate
-from zmpwalk.patterns.result import StepRecord, SupportPhase, WalkingPattern
+from zmpwalk.patterns.result import (
+    SUPPORT_DOUBLE,
+    SUPPORT_LEFT,
+    SUPPORT_RIGHT,
+    StepRecord,
+    SupportPhase,
+    WalkingPattern,
+)
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.zmp import convex_hull, signed_margin
 
 Array = NDArray[np.float64]
 
-LEFT, RIGHT = 1, -1
 
 
 # ---------------------------------------------------------------------------------------- steady step
@@ -405,12 +411,14 @@ class HyperbolicWalk:
 
     def _double(self, feet: dict[int, float], duration: float) -> None:
         t = self.x_axis.t
-        self.phases.append(SupportPhase(t, t + duration, 0, (self._pose(feet, LEFT), self._pose(feet, RIGHT))))
+        self.phases.append(SupportPhase(t, t + duration, SUPPORT_DOUBLE,
+                                        (self._pose(feet, LEFT), self._pose(feet, RIGHT))))
 
     def _single(self, feet: dict[int, float], support: int, duration: float, landing: float, kind: str) -> None:
         t = self.x_axis.t
         swing = -support
-        self.phases.append(SupportPhase(t, t + duration, 1 if support == LEFT else 2, (self._pose(feet, support),)))
+        code = SUPPORT_LEFT if support == LEFT else SUPPORT_RIGHT
+        self.phases.append(SupportPhase(t, t + duration, code, (self._pose(feet, support),)))
         self.swings.append(_Swing(t, duration, swing, feet[swing], landing))
         self.records.append(StepRecord(t, duration, "left" if swing == LEFT else "right", kind,
                                        (landing, swing * self.y_foot, 0.0), {}))
@@ -533,7 +541,7 @@ class HyperbolicWalk:
         begins = np.array([p.begin for p in self.phases])
         which = np.clip(np.searchsorted(begins, time, side="right") - 1, 0, len(begins) - 1)
         support = np.array([p.support for p in self.phases], dtype=np.int8)[which]
-        support[time >= self.duration] = 0
+        support[time >= self.duration] = SUPPORT_DOUBLE
         zeros = np.zeros(n)
         a2 = self.a * self.a
         return WalkingPattern(

@@ -50,7 +50,14 @@ from zmpwalk.commands import StepCommand
 from zmpwalk.errors import InvalidParameterError, UnreachableError, ZmpwalkError
 from zmpwalk.footsteps import GROUNDED_STRETCH, LEFT, Pose2D, StagePlan, Stance, grounded_stage, plan_command
 from zmpwalk.kinematics import check_leg_reach
-from zmpwalk.patterns.result import StepRecord, SupportPhase, WalkingPattern
+from zmpwalk.patterns.result import (
+    SUPPORT_DOUBLE,
+    SUPPORT_LEFT,
+    SUPPORT_RIGHT,
+    StepRecord,
+    SupportPhase,
+    WalkingPattern,
+)
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
 
@@ -91,10 +98,6 @@ def side_shift_profile(tau: Array, profile: NDArray[np.integer]) -> curves.Curve
     return value, rate, curvature
 
 
-SUPPORT_DOUBLE = 0
-SUPPORT_LEFT = 1
-SUPPORT_RIGHT = 2
-SUPPORT_NAMES = ("double", "left", "right")
 
 
 @dataclass(frozen=True)

@@ -20,7 +20,8 @@ from zmpwalk.zmp import convex_hull, signed_margin
 
 Array = NDArray[np.float64]
 
-SUPPORT_NAMES = ("double", "left", "right")
+SUPPORT_DOUBLE, SUPPORT_LEFT, SUPPORT_RIGHT = 0, 1, 2  # codes of WalkingPattern.support
+SUPPORT_NAMES = ("double", "left", "right")  # indexed by the codes
 
 CSV_COLUMNS = (
     "t", "support", "pelvis_x", "pelvis_y", "pelvis_z", "pelvis_yaw", "left_x", "left_y", "left_z",
