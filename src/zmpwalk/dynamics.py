@@ -59,7 +59,6 @@ def link_motion(pattern: WalkingPattern, joints: JointTrajectory) -> LinkMotion:
     robot = pattern.robot
     if not robot.links:
         raise InvalidParameterError("robot", robot.name, "a robot file with a [bodies] table (link masses)")
-    n = len(pattern.time)
     pelvis_rotation = rot_z(pattern.yaw_pelvis_in_world)
     pelvis = pattern.position_pelvis_in_world
     names = ["torso"]
@@ -84,7 +83,6 @@ def link_motion(pattern: WalkingPattern, joints: JointTrajectory) -> LinkMotion:
             rotations.append(rotation)
             masses.append(link.mass)
             inertias.append(link.inertia)
-    del n
     return LinkMotion(tuple(names), np.array(masses), np.array(inertias), np.stack(positions, axis=1),
                       np.stack(rotations, axis=1))
 

@@ -523,17 +523,13 @@ def plan_next(
     Raises:
         ZmpwalkError: The command is infeasible for this robot (reach, overlap, timing).
     """
-    stages: list[Stage] = []
-    if boundary.at_rest:
-        if command.stop:
-            return [], stance, boundary
-        plans, _ = plan_command(stance, command, robot, schedule)
-        first = plans[0]
-        stage = build_stage(grounded_stage(stance, first.swing, command.duration, first.parameters, "start"),
-                            boundary)
-        stages.append(stage)
-        boundary = stage.end
+    if boundary.at_rest and command.stop:
+        return [], stance, boundary
     plans, next_stance = plan_command(stance, command, robot, schedule)
+    if boundary.at_rest:
+        first = plans[0]
+        plans = [grounded_stage(stance, first.swing, command.duration, first.parameters, "start"), *plans]
+    stages: list[Stage] = []
     for plan in plans:
         stage = build_stage(plan, boundary)
         stages.append(stage)
