@@ -68,5 +68,5 @@ def test_overrides_replace_scheduled_values(hubo, schedule):
     first, second = schedule.stage_parameters(
         StepCommand(0.95, side=0.05, alpha1=1.1, d1=0.3, d1_recovery=0.1, sway=0.04), hubo)
     assert (first.alpha1, first.d1, first.sway) == pytest.approx((1.1, 0.3, 0.04), abs=TOL)
-    assert (second.d1, second.sway) == pytest.approx((0.1, 0.04), abs=TOL)
+    assert (second.d1, second.sway, second.alpha1) == pytest.approx((0.1, 0.04, 1.1), abs=TOL)
     assert first.source.endswith("+override")

@@ -45,8 +45,8 @@ class StepCommand:
     alpha: float | None = None  # [-] shape factor of the pelvis X velocity (Eq. 13)
     alpha1: float | None = None  # [-] multiplier of V_y (Eq. 20)
     beta1: float | None = None  # [-] multiplier of S_y (Eq. 20)
-    d1: float | None = None  # [-] staying ratio of Eq. 18, in [0, 1)
-    d1_recovery: float | None = None  # [-] staying ratio of the recovery stage, in [0, 1)
+    d1: float | None = None  # [-] staying ratio of Eq. 18, in [0, 1) (the open stance of a side or turn step)
+    d1_recovery: float | None = None  # [-] staying ratio of the recovery stage of a side or turn step, in [0, 1)
     up_ratio: float | None = None  # [-] u of Fig. 12, lift time / swing time, in (0, 1)
     sway: float | None = None  # [m] S_y of Eq. 20, >= 0
     lateral_velocity: float | None = None  # [m per unit 2*t_bar] V_y of Eq. 20, >= 0

@@ -238,9 +238,8 @@ class Schedule:
         }
         if overrides:
             first = replace(first, source=first.source + "+override", **overrides)
-            second_overrides = {k: v for k, v in overrides.items() if k not in ("alpha1", "beta1", "d1")}
-            if not command.is_two_stage:
-                second_overrides = overrides
+            # d1 is per stage (Table 3's superscripts): the recovery stage takes d1_recovery instead.
+            second_overrides = {k: v for k, v in overrides.items() if k != "d1" or not command.is_two_stage}
             second = replace(second, source=second.source + "+override", **second_overrides)
         if command.d1_recovery is not None:
             second = replace(second, d1=command.d1_recovery, source=second.source.split("+")[0] + "+override")
