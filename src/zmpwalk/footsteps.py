@@ -217,8 +217,14 @@ def _check_clearance(stage: StagePlan, robot: RobotModel, command: StepCommand) 
     if _rectangles_overlap(swing, support):
         name = "turn" if command.turn != 0 else ("side" if command.side != 0 else "forward")
         value = getattr(command, name)
+        if command.turn != 0:
+            hint = "split a large turn into several steps, or open the stance with a side step towards it, Fig. 19"
+        else:
+            hint = (f"the robot's soles ({robot.foot_width:g} m wide) do not fit side by side at its hip spacing "
+                    f"({robot.hip_spacing:g} m)")
+        sole = "left" if stage.swing == LEFT else "right"
         raise InvalidParameterError(
-            name, value, "a step whose landing foot does not overlap the supporting foot "
-            f"(the {('left' if stage.swing == LEFT else 'right')} sole would land on the other one; "
-            "split a large turn into several steps, or open the stance with a side step towards it, Fig. 19)",
+            name, value,
+            f"a step whose landing foot does not overlap the supporting foot (the {sole} sole would land on the "
+            f"other one; {hint})",
         )
