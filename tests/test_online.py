@@ -12,6 +12,7 @@ from zmpwalk import (
     OnlineWalker,  # the public API: from zmpwalk import OnlineWalker, StepCommand, load_robot
     StepCommand,
     UnreachableError,
+    ZmpwalkError,
     generate,
 )
 
@@ -120,3 +121,35 @@ def test_rate_is_checked(hubo):
     for rate in (0.0, -100.0, float("nan"), 1e6):
         with pytest.raises(InvalidParameterError, match="rate"):
             OnlineWalker(hubo, rate=rate)
+
+
+command_strategy = st.one_of(
+    st.builds(StepCommand, st.sampled_from([0.7, 0.8, 0.95]), st.floats(-0.1, 0.25)),
+    st.builds(lambda d, a: StepCommand(d, side=a), st.sampled_from([0.8, 0.95]), st.floats(-0.06, 0.06)),
+    st.builds(lambda d, t: StepCommand(d, turn=t), st.sampled_from([0.8, 0.95]), st.floats(-0.2, 0.2)),
+    st.just("stop"),
+)
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.lists(st.tuples(st.integers(0, 400), command_strategy), min_size=3, max_size=12))
+def test_commands_at_any_tick_keep_the_motion_continuous(hubo, actions):
+    """Commands queued, replaced or stopped at random ticks: positions never jump between ticks."""
+    rate = 200.0
+    walker = OnlineWalker(hubo, rate=rate)
+    previous = None
+    largest = 0.0
+    for wait, action in actions:
+        for _ in range(wait):
+            sample = walker.tick()
+            rows = np.concatenate([sample.position_pelvis_in_world, sample.position_left_ankle_in_world,
+                                   sample.position_right_ankle_in_world])
+            if previous is not None:
+                largest = max(largest, float(np.abs(rows - previous).max()))
+            previous = rows
+        queued = walker.queued
+        try:
+            walker.stop() if action == "stop" else walker.command(action)
+        except ZmpwalkError:
+            assert walker.queued == queued  # a rejected command changes nothing
+    assert largest < 2.0 / rate  # [m] less than 2 m/s between two ticks: no jump anywhere
