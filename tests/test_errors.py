@@ -102,3 +102,10 @@ def test_malformed_robot_file(tmp_path):
     path.write_text('name = "bot"\ndescription = "x"\nmass = 1.0\nheight = 0.5\n[legs]\nhip_spacing = -0.1\n')
     with pytest.raises(FileFormatError, match=r"bot\.toml"):
         load_robot(path)
+
+
+def test_unknown_generator_lists_the_known_ones():
+    from zmpwalk.patterns import generator
+
+    with pytest.raises(UnknownNameError, match=r"unknown generator 'lipm'; known: hyperbolic, polynomial"):
+        generator("lipm")

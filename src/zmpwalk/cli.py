@@ -19,8 +19,8 @@ import numpy as np
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import ZmpwalkError
 from zmpwalk.kinematics import pattern_joint_trajectory
-from zmpwalk.patterns.hyperbolic import HyperbolicGait, generate_hyperbolic
-from zmpwalk.patterns.polynomial import generate
+from zmpwalk.patterns import GENERATORS, generator
+from zmpwalk.patterns.hyperbolic import HyperbolicGait
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots import list_robots, load_robot
 from zmpwalk.scenarios import list_scenarios, load_scenario_with_labels, load_steps_file_with_labels
@@ -30,7 +30,6 @@ if TYPE_CHECKING:
     from zmpwalk.sim.run import SimulationResult
 
 EXIT_ERROR = 2
-GENERATORS = ("polynomial", "hyperbolic")
 
 
 def paper_example() -> dict[str, object]:
@@ -224,7 +223,7 @@ def _simulate(args: argparse.Namespace) -> int:
         pattern = paper_walk(robot, steps=args.steady_steps).sample(1000.0)
     else:
         commands, labels = _commands(args)
-        make = generate_hyperbolic if args.generator == "hyperbolic" else generate
+        make = generator(args.generator)
         with _source(_label(args)):
             pattern = make(robot, commands, rate=1000.0, labels=labels)
     joints = pattern_joint_trajectory(pattern, check_limits=False)
@@ -318,7 +317,7 @@ def _run(args: argparse.Namespace) -> int:
     if args.command == "plan":
         commands, labels = _commands(args)
         robot = load_robot(args.robot)
-        make = generate_hyperbolic if args.generator == "hyperbolic" else generate
+        make = generator(args.generator)
         with _source(_label(args)):
             pattern = make(robot, commands, rate=args.rate, labels=labels)
             extra = pattern_joint_trajectory(pattern).columns() if args.joints else None

@@ -45,12 +45,11 @@ from zmpwalk.patterns.polynomial import (
     Samples,
     Stage,
     StageTable,
-    check_rate,
     closing_command,
     evaluate,
     plan_next,
 )
-from zmpwalk.patterns.result import SUPPORT_NAMES
+from zmpwalk.patterns.result import SUPPORT_NAMES, check_rate
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
 

@@ -54,7 +54,6 @@ from zmpwalk.commands import StepCommand
 from zmpwalk.errors import InfeasiblePatternError, InvalidParameterError
 from zmpwalk.footsteps import LEFT, RIGHT, Pose2D, foot_corners
 from zmpwalk.kinematics import check_leg_reach
-from zmpwalk.patterns.polynomial import check_rate
 from zmpwalk.patterns.result import (
     SUPPORT_DOUBLE,
     SUPPORT_LEFT,
@@ -62,6 +61,7 @@ from zmpwalk.patterns.result import (
     StepRecord,
     SupportPhase,
     WalkingPattern,
+    sample_times,
 )
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.zmp import convex_hull, signed_margin
@@ -530,9 +530,7 @@ class HyperbolicWalk:
 
     def sample(self, rate: float, generator: str = "hyperbolic") -> WalkingPattern:
         """The walk sampled at ``rate`` [Hz] from 0 to its end, as a :class:`WalkingPattern`."""
-        check_rate(rate)
-        count = math.ceil(self.duration * rate - 1e-9) + 1  # up to the first sample at or after the end
-        time = np.arange(count) / rate
+        time = sample_times(self.duration, rate)
         x, vx, ax = self.x_axis.evaluate(time)
         y, vy, ay = self.y_axis.evaluate(time)
         n = len(time)

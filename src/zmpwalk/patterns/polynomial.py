@@ -47,7 +47,7 @@ from numpy.typing import NDArray
 
 from zmpwalk import curves
 from zmpwalk.commands import StepCommand
-from zmpwalk.errors import InvalidParameterError, UnreachableError, ZmpwalkError
+from zmpwalk.errors import UnreachableError, ZmpwalkError
 from zmpwalk.footsteps import GROUNDED_STRETCH, LEFT, Pose2D, StagePlan, Stance, grounded_stage, plan_command
 from zmpwalk.kinematics import check_leg_reach
 from zmpwalk.patterns.result import (
@@ -57,6 +57,8 @@ from zmpwalk.patterns.result import (
     StepRecord,
     SupportPhase,
     WalkingPattern,
+    check_rate,
+    sample_times,
 )
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
@@ -602,12 +604,6 @@ def _standing_plan(stance: Stance, robot: RobotModel, schedule: Schedule) -> Sta
     return StagePlan(LEFT, stance.right, stance.left, stance.left, 0.0, 1.0, parameters, True, "stand")
 
 
-def check_rate(rate: float) -> None:
-    """Raise unless ``rate`` is a sampling rate zmpwalk supports (1 Hz .. 10 kHz)."""
-    if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not (1.0 <= rate <= 10_000.0):
-        raise InvalidParameterError("rate", rate, "a sampling rate in [1, 10000] Hz")
-
-
 def generate(
     robot: RobotModel,
     commands: Sequence[StepCommand],
@@ -629,9 +625,7 @@ def generate(
     """
     check_rate(rate)
     stages, _ = plan_walk(robot, commands, schedule, labels)
-    end_time = stages[-1].start
-    count = math.ceil(end_time * rate - 1e-9) + 1  # up to the first sample at or after the end
-    times = np.arange(count) / rate
+    times = sample_times(stages[-1].start, rate)
     table = StageTable(stages)
     return pattern_from_samples(evaluate(table, times, robot), stages, robot, rate, "polynomial")
 

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from zmpwalk.errors import InvalidParameterError
 from zmpwalk.footsteps import Pose2D, foot_corners
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.zmp import convex_hull, signed_margin
@@ -22,6 +23,22 @@ Array = NDArray[np.float64]
 
 SUPPORT_DOUBLE, SUPPORT_LEFT, SUPPORT_RIGHT = 0, 1, 2  # codes of WalkingPattern.support
 SUPPORT_NAMES = ("double", "left", "right")  # indexed by the codes
+
+def check_rate(rate: float) -> None:
+    """Raise unless ``rate`` is a sampling rate zmpwalk supports (1 Hz .. 10 kHz)."""
+    if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not (1.0 <= rate <= 10_000.0):
+        raise InvalidParameterError("rate", rate, "a sampling rate in [1, 10000] Hz")
+
+
+def sample_times(end: float, rate: float) -> Array:
+    """Sample times ``k / rate`` [s] from 0 up to the first sample at or after ``end`` [s].
+
+    Raises:
+        InvalidParameterError: An unsupported rate.
+    """
+    check_rate(rate)
+    return np.arange(math.ceil(end * rate - 1e-9) + 1) / rate
+
 
 CSV_COLUMNS = (
     "t", "support", "pelvis_x", "pelvis_y", "pelvis_z", "pelvis_yaw", "left_x", "left_y", "left_z",

@@ -20,8 +20,7 @@ import numpy as np
 
 from zmpwalk.commands import StepCommand
 from zmpwalk.kinematics import pattern_joint_trajectory
-from zmpwalk.patterns.hyperbolic import generate_hyperbolic
-from zmpwalk.patterns.polynomial import generate
+from zmpwalk.patterns import generator as pattern_generator
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sim.actuators import ActuatorRow, actuator_markdown, actuator_table, write_actuator_csv
@@ -90,8 +89,7 @@ def build_report(
         if progress:
             progress(stage, STAGES.index(stage) + 1, len(STAGES))
 
-    make = generate_hyperbolic if generator == "hyperbolic" else generate
-    pattern = make(robot, commands, rate=1000.0, labels=labels)
+    pattern = pattern_generator(generator)(robot, commands, rate=1000.0, labels=labels)
     pattern.write_csv(folder / "pattern.csv")
     done("pattern")
     joints = pattern_joint_trajectory(pattern)
