@@ -109,8 +109,7 @@ class Leg:
     @classmethod
     def of(cls, robot: RobotModel, side: int) -> Leg:
         """The left (``side = +1``) or right (``-1``) leg of ``robot``."""
-        return cls(side, (0.0, side * robot.hip_spacing / 2, -robot.hip_drop), robot.thigh_length,
-                   robot.shank_length)
+        return cls(side, robot.hip_in_pelvis(side), robot.thigh_length, robot.shank_length)
 
 
 def leg_fk(leg: Leg, q: Array) -> tuple[Array, Array]:
@@ -258,10 +257,11 @@ def hip_positions_in_world(
 ) -> tuple[Array, Array]:
     """Left and right hip joint centres in world [m], each (n, 3)."""
     c, s = np.cos(yaw_pelvis_in_world), np.sin(yaw_pelvis_in_world)
-    half = robot.hip_spacing / 2
-    offset_left = np.column_stack([-s * half, c * half, np.full_like(c, -robot.hip_drop)])
-    offset_right = offset_left * np.array([-1.0, -1.0, 1.0])
-    return position_pelvis_in_world + offset_left, position_pelvis_in_world + offset_right
+    result = []
+    for side in (1, -1):
+        x, y, z = robot.hip_in_pelvis(side)
+        result.append(position_pelvis_in_world + np.column_stack([c * x - s * y, s * x + c * y, np.full_like(c, z)]))
+    return result[0], result[1]
 
 
 def leg_reach_excess(
@@ -388,23 +388,35 @@ def joint_trajectory(
     angles = np.empty((n, 12))
     velocities = np.empty((n, 12))
     for index, (side, (position, yaw, velocity, yaw_rate)) in enumerate(zip((1, -1), feet, strict=True)):
-        leg = Leg.of(robot, side)
         rel = position - position_pelvis_in_world
         ankle_in_pelvis = np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1], rel[:, 2]])
-        solution = leg_ik_yaw(leg, ankle_in_pelvis, yaw - yaw_pelvis_in_world, knee_forward)
-        if np.any(solution.excess > 0):
-            first = int(np.argmax(solution.excess > 0))
-            raise UnreachableError("left" if side > 0 else "right", float(time[first]),
-                                   float(solution.excess.max()), "inverse kinematics")
         # Relative velocity of the ankle in the (rotating) pelvis frame.
         v = velocity - velocity_pelvis_in_world
         v[:, 0] += yaw_rate_pelvis * rel[:, 1]
         v[:, 1] -= yaw_rate_pelvis * rel[:, 0]
         twist = np.column_stack([c * v[:, 0] + s * v[:, 1], -s * v[:, 0] + c * v[:, 1], v[:, 2],
                                  np.zeros(n), np.zeros(n), yaw_rate - yaw_rate_pelvis])
-        rates = np.linalg.solve(leg_jacobian(leg, solution.angles), twist[..., None])[..., 0]
-        angles[:, 6 * index:6 * index + 6] = solution.angles
-        velocities[:, 6 * index:6 * index + 6] = rates
+        label = "left" if side > 0 else "right"
+        if robot.legs is None:
+            leg = Leg.of(robot, side)
+            solution = leg_ik_yaw(leg, ankle_in_pelvis, yaw - yaw_pelvis_in_world, knee_forward)
+            leg_angles, excess = solution.angles, solution.excess
+            jacobian = leg_jacobian(leg, leg_angles)
+            order = list(range(6))
+            detail = "inverse kinematics"
+        else:  # an imported leg: the pattern's pelvis point is com_offset ahead of the base origin
+            chain = robot.legs[index]
+            ankle_in_base = ankle_in_pelvis + np.array([robot.com_offset[0], robot.com_offset[1], 0.0])
+            leg_angles, excess = chain.solve(ankle_in_base, rot_z(yaw - yaw_pelvis_in_world))
+            jacobian = chain.jacobian(leg_angles)
+            order = list(chain.role_order)
+            detail = "inverse kinematics, " + ("closed form" if chain.closed_form else "numeric")
+        if np.any(excess > 0):
+            first = int(np.argmax(excess > 0))
+            raise UnreachableError(label, float(time[first]), float(excess.max()), detail)
+        rates = np.linalg.solve(jacobian, twist[..., None])[..., 0]
+        angles[:, 6 * index:6 * index + 6] = leg_angles[:, order]
+        velocities[:, 6 * index:6 * index + 6] = rates[:, order]
     if check_limits:
         check_joint_limits(time, angles, robot)
     return JointTrajectory(time, angles, velocities)
@@ -412,8 +424,8 @@ def joint_trajectory(
 
 def check_joint_limits(time: Array, angles: Array, robot: RobotModel) -> None:
     """Raise :class:`JointLimitError` for the first sample and joint outside the robot's ranges."""
-    lower = np.array([robot.joint_limits.get(j, (-np.inf, np.inf))[0] for j in LEG_JOINTS] * 2)
-    upper = np.array([robot.joint_limits.get(j, (-np.inf, np.inf))[1] for j in LEG_JOINTS] * 2)
+    lower = np.array([robot.limits_of(column)[0] for column in JOINT_COLUMNS])
+    upper = np.array([robot.limits_of(column)[1] for column in JOINT_COLUMNS])
     outside = (angles < lower) | (angles > upper)
     if np.any(outside):
         sample = int(np.argmax(outside.any(axis=1)))

@@ -18,6 +18,13 @@ step up as follows:
    lookup is marked ``extrapolated``; the pattern reports it per step.
 5. Any value given in the :class:`~zmpwalk.commands.StepCommand` replaces the
    scheduled one.
+6. Another robot walks the tables at the dynamically similar condition
+   (:attr:`~zmpwalk.robots.model.RobotModel.schedule_scale`): the cart-table
+   model ``x'' = (g / l)(x - p)`` is the same equation for every ``l`` in the
+   dimensionless time ``t / sqrt(l / g)``, so a step time ``T`` is looked up at
+   ``T / sqrt(l / l_HUBO)``, a stride at ``f / (l / l_HUBO)``, and a side step and
+   the sway ``S_y`` scale with the hip spacing (the lateral distance the sway
+   must cover). HUBO's own factors are 1.
 """
 
 from __future__ import annotations
@@ -194,7 +201,7 @@ class Schedule:
         Overrides in ``command`` replace the scheduled values; the robot gives
         the values the tables do not hold (``d``, foot lift, ``V_y``).
         """
-        key = (command, robot.lateral_velocity, robot.dsp_time, robot.foot_lift)
+        key = (command, robot.lateral_velocity, robot.dsp_time, robot.foot_lift, robot.schedule_scale)
         cached = self._cache.get(key)
         if cached is None:
             if len(self._cache) > 4096:
@@ -205,17 +212,21 @@ class Schedule:
     def _stage_parameters(
         self, command: StepCommand, robot: RobotModel
     ) -> tuple[ShapeParameters, ShapeParameters]:
-        stride = abs(command.forward)
-        row, source = self._forward.lookup(command.duration, stride)
+        # The tables' robot (HUBO) walks this robot's step at the dynamically similar condition:
+        # step time / sqrt(l / l_HUBO), stride / (l / l_HUBO), side step and sway with the hip spacing.
+        time_scale, stride_scale, lateral_scale = robot.schedule_scale
+        duration = command.duration / time_scale
+        stride = abs(command.forward) / stride_scale
+        row, source = self._forward.lookup(duration, stride)
         alpha = row["alpha"]
-        sway = row["sway"]
+        sway = row["sway"] * lateral_scale
         up_ratio = row["up_ratio"]
         open_alpha1 = recovery_alpha1 = self._forward_alpha1
         open_beta1 = recovery_beta1 = self._forward_beta1
         open_d1 = recovery_d1 = self._forward_d1
         if command.side != 0.0:
-            side_row, side_source = self._side.lookup(command.duration, abs(command.side), self._on_spot_row)
-            sway = side_row["sway"]
+            side_row, side_source = self._side.lookup(duration, abs(command.side) / lateral_scale, self._on_spot_row)
+            sway = side_row["sway"] * lateral_scale
             up_ratio = side_row["up_ratio"]
             open_alpha1, open_beta1 = side_row["alpha1"], side_row["beta1"]
             open_d1, recovery_d1 = side_row["d1_open"], side_row["d1_recovery"]

@@ -18,11 +18,17 @@ import math
 import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from zmpwalk.errors import FileFormatError
 
+if TYPE_CHECKING:
+    from zmpwalk.leg_chain import LegChain
+    from zmpwalk.robots.imported import ModelPlant
+
 JOINT_NAMES = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll")
+HUBO_PENDULUM = 0.62  # [m] pendulum length the HUBO tables were tuned for (robots/data/hubo.toml)
+HUBO_HIP_SPACING = 0.17  # [m] HUBO's hip spacing (robots/data/hubo.toml)
 LINK_NAMES = ("torso", "thigh", "shank", "foot")
 
 
@@ -108,8 +114,18 @@ class RobotModel:
         dsp_time: Default double-support time ``d`` [s].
         foot_lift: Default swing apex height [m].
         lateral_velocity: Default ``V_y`` of Eq. 20 [m per unit of ``2 t_bar``].
-        joint_limits: Joint name -> (lower, upper) [rad].
+        joint_limits: Joint role (``"knee"``: both legs) or column (``"left_knee"``: one leg) ->
+            (lower, upper) [rad]; a column's entry wins over its role's.
         gravity: Gravitational acceleration [m/s^2].
+        hip_x: Hip joint centres ahead of the pelvis origin [m] (TALOS: -0.02).
+        com_offset: Centre of mass of the ready posture ahead of and left of the pelvis origin [m]. The
+            pattern's pelvis point is the point above the CoM: the pelvis origin is this far behind it.
+        legs: The two leg chains (left, right) of an imported model, in the pelvis frame and the model's
+            angles; None for the built-in yaw-roll-pitch-pitch-pitch-roll leg of the robot file.
+        plant: The model file and what the simulation needs to run it (imported robots), or None.
+        schedule_scale: Factors (time, stride, lateral) [-] mapping this robot's steps onto the HUBO
+            tables: times with ``sqrt(l / l_HUBO)``, strides and foot lift with ``l / l_HUBO``, sway with
+            the hip spacing (``zmpwalk.schedule``).
     """
 
     name: str
@@ -136,6 +152,23 @@ class RobotModel:
     links: dict[str, Link] = field(default_factory=dict)  # torso, thigh, shank, foot (one leg's)
     servos: Servos | None = None
     contact: Contact | None = None
+    hip_x: float = 0.0  # [m]
+    com_offset: tuple[float, float] = (0.0, 0.0)  # [m]
+    legs: tuple[LegChain, LegChain] | None = None
+    plant: ModelPlant | None = None
+    schedule_scale: tuple[float, float, float] = (1.0, 1.0, 1.0)  # [-] time, stride, lateral
+
+    def hip_in_pelvis(self, side: int) -> tuple[float, float, float]:
+        """Hip joint centre of the left (``side = +1``) or right (-1) leg relative to the pattern's pelvis
+        point (the pelvis origin shifted by :attr:`com_offset`) [m]."""
+        return (self.hip_x - self.com_offset[0], side * self.hip_spacing / 2 - self.com_offset[1], -self.hip_drop)
+
+    def limits_of(self, column: str) -> tuple[float, float]:
+        """Range of a joint column such as ``"left_knee"`` [rad] (unlimited where the robot gives none)."""
+        if column in self.joint_limits:
+            return self.joint_limits[column]
+        role = column.split("_", 1)[1]
+        return self.joint_limits.get(role, (-math.inf, math.inf))
 
     @property
     def link_mass(self) -> float:
@@ -159,16 +192,16 @@ class RobotModel:
 _SECTIONS: dict[str, dict[str, str]] = {
     "": {"name": "name", "description": "description", "mass": "mass", "height": "height",
          "gravity": "gravity"},
-    "legs": {"hip_spacing": "hip_spacing", "hip_drop": "hip_drop", "thigh_length": "thigh_length",
+    "legs": {"hip_spacing": "hip_spacing", "hip_drop": "hip_drop", "hip_x": "hip_x", "thigh_length": "thigh_length",
              "shank_length": "shank_length", "ankle_height": "ankle_height"},
     "foot": {"length": "foot_length", "width": "foot_width", "sole_center_x": "sole_center_x",
              "sole_center_y": "sole_center_y"},
     "posture": {"pelvis_height": "pelvis_height", "pendulum_length": "pendulum_length",
                 "min_knee": "min_knee"},
     "walking": {"dsp_time": "dsp_time", "foot_lift": "foot_lift",
-                "lateral_velocity": "lateral_velocity"},
+                "lateral_velocity": "lateral_velocity", "scale_schedule": "scale_schedule"},
 }
-_OPTIONAL = {"gravity"}
+_OPTIONAL = {"gravity", "hip_x", "scale_schedule"}
 _POSITIVE = {"mass", "height", "hip_spacing", "thigh_length", "shank_length", "ankle_height",
              "foot_length", "foot_width", "pelvis_height", "pendulum_length", "gravity",
              "dsp_time", "lateral_velocity"}
@@ -258,6 +291,9 @@ def robot_from_dict(data: dict[str, Any], source: str = "<robot>") -> RobotModel
             if attribute in ("name", "description"):
                 if not isinstance(value, str):
                     raise FileFormatError(source, f"{key} must be a string")
+            elif attribute == "scale_schedule":
+                if not isinstance(value, bool):
+                    raise FileFormatError(source, f"[{section}] {key} = {value!r} must be true or false")
             else:
                 if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
                     raise FileFormatError(source, f"[{section}] {key} = {value!r} must be a finite number")
@@ -266,9 +302,11 @@ def robot_from_dict(data: dict[str, Any], source: str = "<robot>") -> RobotModel
                     raise FileFormatError(source, f"[{section}] {key} = {value:g} must be > 0")
             values[attribute] = value
     limits: dict[str, tuple[float, float]] = {}
+    columns = [f"{side}_{joint}" for side in ("left", "right") for joint in JOINT_NAMES]
     for joint, bounds in data.get("limits", {}).items():
-        if joint not in JOINT_NAMES:
-            raise FileFormatError(source, f"[limits] unknown joint {joint!r}; known: {', '.join(JOINT_NAMES)}")
+        if joint not in JOINT_NAMES and joint not in columns:
+            raise FileFormatError(source, f"[limits] unknown joint {joint!r}; known: {', '.join(JOINT_NAMES)} "
+                                  "(both legs) or one leg's, e.g. left_knee")
         if (not isinstance(bounds, list) or len(bounds) != 2
                 or not all(isinstance(b, (int, float)) for b in bounds) or bounds[0] >= bounds[1]):
             raise FileFormatError(source, f"[limits] {joint} must be [lower, upper] with lower < upper")
@@ -277,6 +315,9 @@ def robot_from_dict(data: dict[str, Any], source: str = "<robot>") -> RobotModel
     values["links"] = _links(data.get("bodies"), values, source)
     values["servos"] = _table(Servos, data.get("servos"), "servos", source)
     values["contact"] = _table(Contact, data.get("contact"), "contact", source)
+    if values.pop("scale_schedule", True):
+        length = values["pendulum_length"] / HUBO_PENDULUM
+        values["schedule_scale"] = (math.sqrt(length), length, values["hip_spacing"] / HUBO_HIP_SPACING)
     robot = RobotModel(**values)
     if robot.hip_height - robot.ankle_height >= robot.max_leg_reach:
         raise FileFormatError(source, "[posture] pelvis_height leaves the legs straighter than min_knee allows")

@@ -39,7 +39,8 @@ from zmpwalk.errors import InvalidParameterError
 from zmpwalk.kinematics import JOINT_COLUMNS, JointTrajectory
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
-from zmpwalk.sim.mjcf import TIMESTEP, contact_mapping, robot_mjcf
+from zmpwalk.sim.mjcf import contact_mapping
+from zmpwalk.sim.plant import build_plant, set_initial_state
 from zmpwalk.zmp import batch_hull_margin
 
 Array = NDArray[np.float64]
@@ -72,6 +73,12 @@ class SimulationResult:
         joint_names: The 12 joint column names.
         joint_angles, joint_velocities, joint_torques, joint_power: (n, 12) [rad], [rad/s], [N m], [W].
         mass_scale: Multiplier of all masses.
+        final_feet_error: Largest horizontal distance of a simulated ankle from its planned final place [m]
+            (nan after a fall).
+        final_feet_yaw_error: Largest yaw error of a foot at the end [rad].
+        end_min_sole_force: Smallest normal force on either sole over the final hold [N] (both loaded: > 0).
+        end_max_speed: Largest horizontal speed of the base over the final hold [m/s].
+        end_attitude_range: Largest spread of torso roll or pitch over the final hold [rad].
     """
 
     robot: RobotModel
@@ -96,6 +103,11 @@ class SimulationResult:
     joint_power: Array
     mass_scale: float = 1.0
     joint_names: tuple[str, ...] = field(default=JOINT_COLUMNS)
+    final_feet_error: float = math.nan  # [m]
+    final_feet_yaw_error: float = math.nan  # [rad]
+    end_min_sole_force: float = math.nan  # [N]
+    end_max_speed: float = math.nan  # [m/s]
+    end_attitude_range: float = math.nan  # [rad]
 
     @property
     def cop_error(self) -> Array:
@@ -191,28 +203,14 @@ def _cop_margins(cop: Array, corners: Array, loaded: NDArray[np.bool_]) -> Array
     return margin
 
 
-def _initial_state(model: mujoco.MjModel, data: mujoco.MjData, pattern: WalkingPattern, angles: Array,
-                   penetration: float) -> None:
-    """The pattern's first pose with the soles on the ground at their static penetration, at rest."""
-    data.qpos[0:3] = pattern.position_pelvis_in_world[0]
-    yaw = float(pattern.yaw_pelvis_in_world[0])
-    data.qpos[3:7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
-    data.qpos[7:19] = angles
-    data.qvel[:] = 0.0
-    data.ctrl[:] = angles
-    mujoco.mj_kinematics(model, data)
-    soles = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"{s}_sole") for s in ("left", "right")]
-    bottom = min(float(data.geom_xpos[g][2] - model.geom_size[g][2]) for g in soles)
-    data.qpos[2] += -bottom - penetration
-    mujoco.mj_forward(model, data)
-
-
 def simulate(
     robot: RobotModel,
     joints: JointTrajectory,
     pattern: WalkingPattern,
     *,
     mass_scale: float = 1.0,
+    settle: float = 0.0,
+    hold: float = 0.0,
 ) -> SimulationResult:
     """Simulate ``joints`` (made from ``pattern``) on ``robot`` and measure the walk.
 
@@ -221,7 +219,9 @@ def simulate(
         joints: The 12 joint angles over time (:func:`zmpwalk.kinematics.pattern_joint_trajectory`).
         pattern: The pattern they come from: initial pose and reference ZMP.
         mass_scale: Multiply every mass and inertia, and the servo gains with them
-            (:func:`zmpwalk.sim.mjcf.robot_mjcf`).
+            (:func:`zmpwalk.sim.mjcf.robot_mjcf`; box models only).
+        settle: Time the first pose is held before the walk [s] (the robot settles onto its soles).
+        hold: Time the last pose is held after the walk [s] (does it end standing still?).
 
     Returns:
         The measurements. The same input gives the same result.
@@ -233,28 +233,41 @@ def simulate(
         raise InvalidParameterError("joints", len(joints.time), f"{len(pattern.time)} samples, as the pattern")
     if not (0.01 <= mass_scale <= 100):
         raise InvalidParameterError("mass_scale", mass_scale, "a value in [0.01, 100]")
-    model = mujoco.MjModel.from_xml_string(robot_mjcf(robot, mass_scale))
+    if not (0.0 <= settle <= 10.0) or not (0.0 <= hold <= 60.0):
+        raise InvalidParameterError("settle" if not 0.0 <= settle <= 10.0 else "hold",
+                                    settle if not 0.0 <= settle <= 10.0 else hold, "settle in [0, 10] s, hold in [0, 60] s")
+    plant = build_plant(robot, mass_scale)
+    model = plant.model
     data = mujoco.MjData(model)
-    mapping = contact_mapping(RobotModel(**{**vars(robot), "mass": robot.link_mass * mass_scale}))
+    if plant.imported:
+        penetration = 0.0
+    else:
+        penetration = contact_mapping(RobotModel(**{**vars(robot), "mass": robot.link_mass * mass_scale})).penetration
     weight = float(model.body_subtreemass[1]) * robot.gravity
-    steps_per_tick = max(1, round(1.0 / (CONTROL_RATE * TIMESTEP)))
-    # References at the control rate, linearly interpolated.
-    time = np.arange(math.floor(pattern.time[-1] * CONTROL_RATE + 1e-9) + 1) / CONTROL_RATE
-    reference = np.column_stack([np.interp(time, joints.time, joints.angles[:, j]) for j in range(12)])
-    zmp_ref = np.column_stack([np.interp(time, pattern.time, pattern.zmp_in_world[:, i]) for i in range(2)])
-    _initial_state(model, data, pattern, reference[0], mapping.penetration)
+    steps_per_tick = max(1, round(1.0 / (CONTROL_RATE * float(model.opt.timestep))))
+    # References at the control rate, linearly interpolated; the first pose held for `settle` before, the last
+    # for `hold` after. Times are those of the pattern (the settle phase runs at negative times).
+    settle_ticks = round(settle * CONTROL_RATE)
+    time = np.arange(-settle_ticks, math.floor((pattern.time[-1] + hold) * CONTROL_RATE + 1e-9) + 1) / CONTROL_RATE
+    pattern_time = np.clip(time, pattern.time[0], pattern.time[-1])
+    reference = np.column_stack([np.interp(pattern_time, joints.time, joints.angles[:, j]) for j in range(12)])
+    zmp_ref = np.column_stack([np.interp(pattern_time, pattern.time, pattern.zmp_in_world[:, i]) for i in range(2)])
+    set_initial_state(plant, data, pattern.position_pelvis_in_world[0], float(pattern.yaw_pelvis_in_world[0]),
+                      reference[0], penetration)
     sensors = _Sensors(model)
     n = len(time)
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     state = np.empty(mujoco.mj_stateSize(model, spec))
     mujoco.mj_getState(model, data, state, spec)
-    control = np.repeat(reference, steps_per_tick, axis=0)[None]
+    control = np.repeat(plant.ctrl_hold[None, :], n, axis=0)
+    control[:, plant.leg_actuators] = reference
+    control = np.repeat(control, steps_per_tick, axis=0)[None]
     _, readings = rollout.rollout(model, data, state[None], control)
     readings = readings[0, steps_per_tick - 1::steps_per_tick]
     # --- measurements
     pelvis = sensors.take(readings, "pelvis_pos")
     rpy = _rpy(sensors.take(readings, "pelvis_quat"))
-    touch = sensors.take(readings, "torso_touch")[:, 0]
+    touch = sensors.take(readings, "torso_touch")[:, 0] if "torso_touch" in sensors.slices else np.zeros(n)
     tilt = np.arccos(np.clip(np.cos(rpy[:, 0]) * np.cos(rpy[:, 1]), -1, 1))
     fallen = (touch > 0) | (tilt > FALL_TILT) | (pelvis[:, 2] < FALL_HEIGHT_FRACTION * robot.pelvis_height)
     fall_index = int(np.argmax(fallen)) if fallen.any() else None
@@ -297,6 +310,21 @@ def simulate(
             drift = np.linalg.norm(ankles[a:b + 1, foot] - ankles[a, foot], axis=1)
             slip = max(slip, float(drift.max()))
     distance = float(np.linalg.norm(pelvis[-1, :2] - pelvis[0, :2]))
+    # How the walk ends: the feet against the plan, and the last `hold` seconds (standing still?).
+    feet_error = feet_yaw_error = math.nan
+    end_force = end_speed = end_attitude = math.nan
+    if fall_index is None:
+        planned = (pattern.position_left_ankle_in_world[-1], pattern.position_right_ankle_in_world[-1])
+        planned_yaw = (pattern.yaw_left_foot_in_world[-1], pattern.yaw_right_foot_in_world[-1])
+        feet_error = max(float(np.linalg.norm(ankles[-1, f] - planned[f][:2])) for f in range(2))
+        yaws = [_rpy(sensors.take(readings[-1:], f"{label}_ankle_quat"))[0, 2] for label in ("left", "right")]
+        feet_yaw_error = max(abs(float((yaws[f] - planned_yaw[f] + math.pi) % (2 * math.pi) - math.pi))
+                             for f in range(2))
+        window = time > time[-1] - max(hold, 1.0 / CONTROL_RATE)
+        end_force = float(forces[window].min())
+        speed = np.linalg.norm(np.gradient(pelvis[:, :2], time, axis=0), axis=1)
+        end_speed = float(speed[window].max())
+        end_attitude = float(np.ptp(rpy[window, :2], axis=0).max())
     return SimulationResult(
         robot=robot, time=time, torso_position=pelvis, torso_rpy=rpy,
         fell=fall_index is not None, fall_time=None if fall_index is None else float(time[fall_index]),
@@ -304,4 +332,6 @@ def simulate(
         cop_left=cop_feet[:, 0], cop_right=cop_feet[:, 1], cop=cop_total, force_left=forces[:, 0],
         force_right=forces[:, 1], reference_zmp=zmp_ref, cop_margin=margin, joint_angles=angles,
         joint_velocities=velocities, joint_torques=torque, joint_power=torque * velocities, mass_scale=mass_scale,
+        final_feet_error=feet_error, final_feet_yaw_error=feet_yaw_error, end_min_sole_force=end_force,
+        end_max_speed=end_speed, end_attitude_range=end_attitude,
     )
