@@ -23,7 +23,9 @@ from zmpwalk.patterns import GENERATORS, generator
 from zmpwalk.patterns.hyperbolic import HyperbolicGait
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots import list_robots, load_robot
+from zmpwalk.robots.model import RobotModel
 from zmpwalk.scenarios import list_scenarios, load_scenario_with_labels, load_steps_file_with_labels
+from zmpwalk.schedule import Schedule
 from zmpwalk.tables import condition_margins, margins_markdown
 
 if TYPE_CHECKING:
@@ -54,6 +56,36 @@ class _UsageError(Exception):
     pass
 
 
+def _robot_options(parser: argparse.ArgumentParser, default: str | None = "hubo") -> None:
+    """--robot and the options of a robot imported from its own model."""
+    parser.add_argument("--robot", default=default,
+                        help=f"built-in robot ({', '.join(list_robots())}), a robot file (.toml) or the robot's own "
+                        "model: MJCF (.xml) or URDF (.urdf)" + (f" (default: {default})" if default else ""))
+    parser.add_argument("--feet", help="foot body names LEFT,RIGHT of a model whose tree is ambiguous")
+    parser.add_argument("--keyframe", help="the model's keyframe of the reference pose (default: its first)")
+    parser.add_argument("--package-path", type=Path, action="append", default=[],
+                        help="folder holding a URDF's package:// packages (repeatable)")
+
+
+def _load_robot(args: argparse.Namespace) -> RobotModel:
+    feet = None
+    if args.feet:
+        names = [name.strip() for name in args.feet.split(",")]
+        if len(names) != 2 or not all(names):
+            raise _UsageError(f"--feet = {args.feet!r} must be two body names: LEFT,RIGHT")
+        feet = (names[0], names[1])
+    return load_robot(args.robot, feet=feet, keyframe=args.keyframe, package_paths=tuple(args.package_path))
+
+
+def _schedule(args: argparse.Namespace) -> Schedule | None:
+    path = getattr(args, "schedule", None)
+    if path is None:
+        return None
+    if getattr(args, "generator", "polynomial") != "polynomial":
+        raise _UsageError("--schedule applies to the polynomial generator (the HUBO pattern's tables)")
+    return Schedule.from_file(path)
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="zmpwalk",
@@ -76,8 +108,8 @@ def _parser() -> argparse.ArgumentParser:
     )
     plan.add_argument("steps", nargs="?", help="steps file (TOML, [[steps]] tables)")
     plan.add_argument("--scenario", help="a built-in scenario instead of a steps file (see 'zmpwalk scenarios')")
-    plan.add_argument("--robot", default="hubo", help=f"built-in robot ({', '.join(list_robots())}) or a robot "
-                      "file (default: hubo)")
+    _robot_options(plan)
+    plan.add_argument("--schedule", type=Path, help="your own parameter tables (TOML, the format of Tables 2-3)")
     plan.add_argument("--rate", type=float, default=100.0, help="samples per second [Hz] (default: 100)")
     plan.add_argument("--generator", choices=GENERATORS, default="polynomial",
                       help="polynomial (HUBO, Park et al. 2008; default) or hyperbolic (LIPM, Lim et al.)")
@@ -108,7 +140,8 @@ def _parser() -> argparse.ArgumentParser:
     simulate_cmd.add_argument("--paper-example", action="store_true",
                               help="the walk of Lim et al. (start, 2 steady steps, stop; hyperbolic)")
     simulate_cmd.add_argument("--steady-steps", type=int, default=2, help="steady steps of --paper-example")
-    simulate_cmd.add_argument("--robot", default="hubo", help="robot name or file (default: hubo)")
+    _robot_options(simulate_cmd)
+    simulate_cmd.add_argument("--schedule", type=Path, help="your own parameter tables (TOML)")
     simulate_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
     simulate_cmd.add_argument("--mass-scale", type=float, default=1.0, help="multiply every mass (default 1)")
     simulate_cmd.add_argument("--out", type=Path, help="folder for the result files")
@@ -130,7 +163,7 @@ def _parser() -> argparse.ArgumentParser:
         report_cmd.add_argument("--scenario", default="demo" if name == "demo" else None,
                                 help="built-in scenario" + (" (default: demo)" if name == "demo" else ""))
         report_cmd.add_argument("--steps", type=Path, help="steps file (TOML) instead of a scenario")
-        report_cmd.add_argument("--robot", default="hubo", help="robot name or file (default: hubo)")
+        _robot_options(report_cmd)
         report_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
         default_out = Path("zmpwalk-demo" if name == "demo" else "zmpwalk-report")
         report_cmd.add_argument("--out", type=Path, default=default_out,
@@ -144,9 +177,23 @@ def _parser() -> argparse.ArgumentParser:
         "steps at 1 kHz and print the smallest cart-table ZMP margin of each as a Markdown table.",
         epilog="example: zmpwalk tables --steps 10",
     )
-    tables.add_argument("--robot", default="hubo", help="robot name or file (default: hubo)")
+    _robot_options(tables)
     tables.add_argument("--steps", type=int, default=10, help="steps walked per condition (default: 10)")
     tables.add_argument("--json", action="store_true", help="print JSON instead of Markdown")
+    robot_cmd = commands.add_parser(
+        "robot", help="import a robot from its MJCF or URDF and show what zmpwalk derived",
+        description="Load a robot (its own MJCF or URDF model, a robot file or a built-in name), print what "
+        "zmpwalk derives from it (legs and joints with axes, signs, limits and actuators; hip positions, link "
+        "lengths, sole polygon, mass, centre of mass, ready posture), and optionally write a robot file.",
+        epilog="example: zmpwalk robot ../shared/robots/pal_talos/scene_position.xml --write talos.toml",
+    )
+    robot_cmd.add_argument("model", help="the model file (.xml, .urdf) or robot file (.toml) or built-in name")
+    robot_cmd.add_argument("--feet", help="foot body names LEFT,RIGHT of a model whose tree is ambiguous")
+    robot_cmd.add_argument("--keyframe", help="the model's keyframe of the reference pose (default: its first)")
+    robot_cmd.add_argument("--package-path", type=Path, action="append", default=[],
+                           help="folder holding a URDF's package:// packages (repeatable)")
+    robot_cmd.add_argument("--write", type=Path, help="write a robot file (TOML) that loads this model")
+    robot_cmd.add_argument("--json", action="store_true", help="print JSON")
     return parser
 
 
@@ -193,7 +240,7 @@ def _report(args: argparse.Namespace) -> int:
         (commands, labels), name = load_scenario_with_labels(args.scenario), args.scenario
     else:
         raise _UsageError("give --scenario NAME or --steps FILE (see 'zmpwalk scenarios')")
-    robot = load_robot(args.robot)
+    robot = _load_robot(args)
     quiet = args.json or not sys.stderr.isatty()
     with _source(str(args.steps) if args.steps else f"scenario {args.scenario}"):
         report = build_report(robot, commands, args.out, title=f"zmpwalk: {robot.name}, {name}",
@@ -214,7 +261,7 @@ def _simulate(args: argparse.Namespace) -> int:
     from zmpwalk.patterns.hyperbolic import paper_walk
     from zmpwalk.sim import actuator_markdown, actuator_table, simulate, write_actuator_csv
 
-    robot = load_robot(args.robot)
+    robot = _load_robot(args)
     if args.paper_example:
         if args.steps or args.scenario:
             raise _UsageError("--paper-example takes no steps file or scenario")
@@ -224,8 +271,10 @@ def _simulate(args: argparse.Namespace) -> int:
     else:
         commands, labels = _commands(args)
         make = generator(args.generator)
+        schedule = _schedule(args)
+        extra = {"schedule": schedule} if schedule else {}
         with _source(_label(args)):
-            pattern = make(robot, commands, rate=1000.0, labels=labels)
+            pattern = make(robot, commands, rate=1000.0, labels=labels, **extra)
     joints = pattern_joint_trajectory(pattern, check_limits=False)
     result = simulate(robot, joints, pattern, mass_scale=args.mass_scale)
     rows = actuator_table(result)
@@ -316,10 +365,12 @@ def _run(args: argparse.Namespace) -> int:
         return 0
     if args.command == "plan":
         commands, labels = _commands(args)
-        robot = load_robot(args.robot)
+        robot = _load_robot(args)
         make = generator(args.generator)
+        schedule = _schedule(args)
+        extra = {"schedule": schedule} if schedule else {}
         with _source(_label(args)):
-            pattern = make(robot, commands, rate=args.rate, labels=labels)
+            pattern = make(robot, commands, rate=args.rate, labels=labels, **extra)
             extra = pattern_joint_trajectory(pattern).columns() if args.joints else None
         if args.out:
             pattern.write_csv(args.out, extra)
@@ -338,6 +389,18 @@ def _run(args: argparse.Namespace) -> int:
         return _report(args)
     if args.command == "simulate":
         return _simulate(args)
+    if args.command == "robot":
+        from zmpwalk.robots.inspect import robot_summary, robot_table, robot_toml
+
+        args.robot = args.model
+        robot = _load_robot(args)
+        if args.write:
+            args.write.write_text(robot_toml(robot, args.write.parent), encoding="utf-8")
+        if args.json:
+            print(json.dumps(_json_safe(robot_summary(robot)), indent=2, allow_nan=False))
+        else:
+            print(robot_table(robot) + (f"\nwritten: {args.write}" if args.write else ""))
+        return 0
     if args.command == "hyperbolic":
         result = paper_example()
         if args.json:
@@ -349,7 +412,7 @@ def _run(args: argparse.Namespace) -> int:
     if args.command == "tables":
         if args.steps < 1:
             raise _UsageError(f"--steps = {args.steps} must be >= 1")
-        results = condition_margins(load_robot(args.robot), steps=args.steps)
+        results = condition_margins(_load_robot(args), steps=args.steps)
         if args.json:
             print(json.dumps([vars(r) for r in results], indent=2))
         else:

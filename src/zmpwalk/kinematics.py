@@ -39,7 +39,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from zmpwalk.errors import UnreachableError, ZmpwalkError
+from zmpwalk.errors import InvalidParameterError, UnreachableError, ZmpwalkError
 from zmpwalk.robots.model import JOINT_NAMES, RobotModel
 
 if TYPE_CHECKING:
@@ -344,12 +344,15 @@ class JointTrajectory:
         time: [s], (n,).
         angles: [rad], (n, 12), columns :data:`JOINT_COLUMNS` (left leg, then right leg).
         velocities: [rad/s], (n, 12).
+        position_base_in_world: For an imported robot, the base origin that puts the whole-body CoM on the
+            pattern's point [m], (n, 3); None for the robot-file legs (their pelvis is the pattern's).
     """
 
     time: Array
     angles: Array
     velocities: Array
     names: tuple[str, ...] = JOINT_COLUMNS
+    position_base_in_world: Array | None = None
 
     def columns(self) -> dict[str, Array]:
         """Angles by column name, for the CSV of ``zmpwalk plan --joints``."""
@@ -387,6 +390,16 @@ def joint_trajectory(
     c, s = np.cos(yaw_pelvis_in_world), np.sin(yaw_pelvis_in_world)
     angles = np.empty((n, 12))
     velocities = np.empty((n, 12))
+    base: Array | None = None
+    solutions: list[tuple[Array, Array]] = []
+    if robot.legs is not None:
+        # An imported robot: the pattern moves the whole-body centre of mass; find the base that puts it there.
+        base, solutions = _base_under_com(position_pelvis_in_world, yaw_pelvis_in_world,
+                                          [(f[0], f[1]) for f in feet], robot)
+        if n > 1:
+            velocity_pelvis_in_world = velocity_pelvis_in_world + np.gradient(base - position_pelvis_in_world,
+                                                                              time, axis=0)
+        position_pelvis_in_world = base
     for index, (side, (position, yaw, velocity, yaw_rate)) in enumerate(zip((1, -1), feet, strict=True)):
         rel = position - position_pelvis_in_world
         ankle_in_pelvis = np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1], rel[:, 2]])
@@ -404,10 +417,9 @@ def joint_trajectory(
             jacobian = leg_jacobian(leg, leg_angles)
             order = list(range(6))
             detail = "inverse kinematics"
-        else:  # an imported leg: the pattern's pelvis point is com_offset ahead of the base origin
+        else:
             chain = robot.legs[index]
-            ankle_in_base = ankle_in_pelvis + np.array([robot.com_offset[0], robot.com_offset[1], 0.0])
-            leg_angles, excess = chain.solve(ankle_in_base, rot_z(yaw - yaw_pelvis_in_world))
+            leg_angles, excess = solutions[index]
             jacobian = chain.jacobian(leg_angles)
             order = list(chain.role_order)
             detail = "inverse kinematics, " + ("closed form" if chain.closed_form else "numeric")
@@ -419,7 +431,55 @@ def joint_trajectory(
         velocities[:, 6 * index:6 * index + 6] = rates[:, order]
     if check_limits:
         check_joint_limits(time, angles, robot)
-    return JointTrajectory(time, angles, velocities)
+    return JointTrajectory(time, angles, velocities, position_base_in_world=base)
+
+
+COM_TOLERANCE = 1e-6  # [m] the base is placed until the whole-body CoM is this close to the pattern's
+COM_ITERATIONS = 12
+
+
+def _base_under_com(position_com_in_world: Array, yaw_pelvis_in_world: Array, feet: list[tuple[Array, Array]],
+                    robot: RobotModel) -> tuple[Array, list[tuple[Array, Array]]]:
+    r"""Base positions (n, 3) [m] that put the whole-body CoM of an imported robot on the pattern's point, and
+    the leg solutions there.
+
+    The pattern (Eqs. 1-2 of Park et al.) moves one mass; a real robot's legs carry part of it (TALOS: 17 %
+    each), so a swinging leg moves the CoM away from where the pattern put it. With the feet fixed in world,
+    the base is moved horizontally by the remaining CoM error until it is below :data:`COM_TOLERANCE`:
+
+    .. math:: p_{base}^{k+1} = p_{base}^k + (c_{pattern} - c(p_{base}^k, q^k))_{xy}
+
+    (a contraction: moving the base by ``d`` moves the CoM by about ``d (1 - m_{feet} / M)``).
+    The CoM height stays the pattern's (its vertical motion is what the pattern neglects too).
+    """
+    legs, plant = robot.legs, robot.plant
+    if legs is None or plant is None:
+        raise InvalidParameterError("robot", robot.name, "an imported robot (leg chains and masses)")
+    n = len(yaw_pelvis_in_world)
+    c, s = np.cos(yaw_pelvis_in_world), np.sin(yaw_pelvis_in_world)
+    rotation = rot_z(yaw_pelvis_in_world)
+    offset = np.array([robot.com_offset[0], robot.com_offset[1], 0.0])
+    base = position_com_in_world - np.einsum("nij,j->ni", rotation, offset)
+    total = plant.rest_mass + sum(float(leg.link_masses.sum()) for leg in legs)
+    starts: list[Array | None] = [None, None]
+    solutions: list[tuple[Array, Array]] = []
+    for _ in range(COM_ITERATIONS):
+        solutions = []
+        com_in_base = plant.rest_mass * np.asarray(plant.rest_com)
+        com_in_base = np.broadcast_to(com_in_base, (n, 3)).copy()
+        for index, (chain, (position, yaw)) in enumerate(zip(legs, feet, strict=True)):
+            rel = position - base
+            ankle_in_base = np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1], rel[:, 2]])
+            solution = chain.solve(ankle_in_base, rot_z(yaw - yaw_pelvis_in_world), start=starts[index])
+            solutions.append(solution)
+            starts[index] = solution[0]
+            com_in_base += np.einsum("k,nki->ni", chain.link_masses, chain.link_com_positions(solution[0]))
+        com = base + np.einsum("nij,nj->ni", rotation, com_in_base / total)
+        error = position_com_in_world[:, :2] - com[:, :2]
+        base[:, :2] += error
+        if np.max(np.abs(error)) < COM_TOLERANCE:
+            break
+    return base, solutions
 
 
 def check_joint_limits(time: Array, angles: Array, robot: RobotModel) -> None:

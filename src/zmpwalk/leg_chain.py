@@ -153,6 +153,8 @@ class LegChain:
         ankle: Origin of the foot frame at ``q = 0`` [m], (3,).
         reference: Angles that choose the IK branch (the ready posture) [rad], (6,).
         lower, upper: Joint ranges [rad], (6,) (``-inf``/``inf`` where unlimited).
+        link_masses: Mass of each segment (what joint ``i`` moves up to the next joint) [kg], (6,).
+        link_coms: Its centre of mass at ``q = 0`` in the pelvis frame [m], (6, 3).
         role_order: Chain index of each role (hip yaw, hip roll, hip pitch, knee, ankle pitch, ankle
             roll): ``angles[:, role_order]`` lists a solution in the role order of zmpwalk's joint columns.
     """
@@ -166,6 +168,17 @@ class LegChain:
     lower: Array = field(default_factory=lambda: np.full(6, -np.inf))
     upper: Array = field(default_factory=lambda: np.full(6, np.inf))
     role_order: tuple[int, ...] = (0, 1, 2, 3, 4, 5)
+    link_masses: Array = field(default_factory=lambda: np.zeros(6))
+    link_coms: Array = field(default_factory=lambda: np.zeros((6, 3)))
+
+    def link_com_positions(self, q: Array) -> Array:
+        """Centres of mass of the six moving segments in the pelvis frame [m], (n, 6, 3).
+
+        Segment ``i`` is everything joint ``i`` moves up to the next joint; :attr:`link_coms` holds its
+        centre of mass at ``q = 0``.
+        """
+        rotations, translations = self.transforms(q)
+        return np.asarray(np.einsum("nkij,kj->nki", rotations[:, 1:], self.link_coms) + translations[:, 1:])
 
     @property
     def label(self) -> str:
@@ -240,12 +253,13 @@ class LegChain:
 
     # --- inverse kinematics -------------------------------------------------------------------------------
     def solve(self, position_ankle_in_pelvis: Array, rotation_foot_in_pelvis: Array,
-              numeric: bool | None = None) -> tuple[Array, Array]:
+              numeric: bool | None = None, start: Array | None = None) -> tuple[Array, Array]:
         """Joint angles (n, 6) [rad] for ankle positions (n, 3) [m] and foot rotations (n, 3, 3).
 
         Args:
             numeric: Force the numeric IK (True) or the closed form (False); None picks the closed form
                 where :attr:`closed_form` holds.
+            start: Warm start of the numeric IK (n, 6) [rad] (default: :attr:`reference`).
 
         Returns:
             The angles and, per sample, how far the target is out of reach [m] (> 0 unreachable; the
@@ -256,7 +270,7 @@ class LegChain:
         if numeric is None:
             numeric = not self.closed_form
         if numeric:
-            return self._solve_numeric(p, rotation)
+            return self._solve_numeric(p, rotation, start)
         return self._solve_closed(p, rotation)
 
     def _solve_closed(self, p: Array, rotation: Array) -> tuple[Array, Array]:

@@ -24,10 +24,12 @@ def render_gif(robot: RobotModel, result: SimulationResult, fps: int = FPS) -> b
     import mujoco
     from PIL import Image
 
-    from zmpwalk.sim.mjcf import robot_mjcf
+    from zmpwalk.sim.plant import build_plant
 
-    model = mujoco.MjModel.from_xml_string(robot_mjcf(robot, result.mass_scale))
+    plant = build_plant(robot, result.mass_scale)
+    model = plant.model
     data = mujoco.MjData(model)
+    data.qpos[:] = plant.qpos_hold
     renderer = mujoco.Renderer(model, HEIGHT, WIDTH)
     camera = mujoco.MjvCamera()
     camera.distance = 2.2 * robot.height
@@ -39,7 +41,7 @@ def render_gif(robot: RobotModel, result: SimulationResult, fps: int = FPS) -> b
     for i in range(0, len(result.time), step):
         data.qpos[0:3] = result.torso_position[i]
         data.qpos[3:7] = rotation[i]
-        data.qpos[7:19] = result.joint_angles[i]
+        data.qpos[plant.leg_qpos] = result.joint_angles[i]
         mujoco.mj_kinematics(model, data)
         camera.lookat[:] = (result.torso_position[i, 0], result.torso_position[i, 1], 0.6 * robot.pelvis_height)
         renderer.update_scene(data, camera)

@@ -113,6 +113,9 @@ class ModelPlant:
         package_paths: Folders searched for a URDF's ``package://`` paths.
         sole_polygon: Sole corners in the left foot frame (x forward, y left) [m], counter-clockwise, (m, 2).
         held_joints: Joints held at the reference pose (names).
+        keyframe: The keyframe of the reference pose, or None (the zero pose).
+        rest_mass: Mass of everything but the leg segments (rigid with the base) [kg].
+        rest_com: Its centre of mass in the pelvis frame [m].
     """
 
     path: Path
@@ -125,6 +128,8 @@ class ModelPlant:
     sole_polygon: tuple[tuple[float, float], ...] = ()
     held_joints: tuple[str, ...] = field(default=())
     keyframe: str | None = None
+    rest_mass: float = 0.0  # [kg]
+    rest_com: tuple[float, float, float] = (0.0, 0.0, 0.0)  # [m]
 
 
 def load_model(path: Path, package_paths: tuple[Path, ...] = ()) -> Any:
@@ -259,6 +264,26 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     def in_pelvis(point: Array) -> Array:
         return np.asarray(base_rotation.T @ (point - base_origin), dtype=np.float64)
 
+    # Mass of each leg segment and of the rest (base, trunk, arms, head: rigid with the base at the reference).
+    segment_of = {j: (leg_index, k) for leg_index, leg in enumerate(chains_joints) for k, j in enumerate(leg)}
+    segment_mass = np.zeros((2, 6))
+    segment_moment = np.zeros((2, 6, 3))
+    rest_mass, rest_moment = 0.0, np.zeros(3)
+    for body in range(1, model.nbody):
+        last = None
+        for j in _joint_path(model, base, body):
+            last = segment_of.get(j, last)
+        mass = float(model.body_mass[body])
+        com = in_pelvis(data.xipos[body])
+        if last is None:
+            rest_mass += mass
+            rest_moment += mass * com
+        else:
+            segment_mass[last] += mass
+            segment_moment[last] += mass * com
+    segment_com = segment_moment / np.maximum(segment_mass, 1e-12)[..., None]
+    rest_com = rest_moment / max(rest_mass, 1e-12)
+
     chains: list[LegChain] = []
     leg_joints: list[LegJoint] = []
     soles = []
@@ -277,8 +302,10 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
         if abs(reference[knee]) < 0.1:
             bend = 0.5 if upper[knee] > 0.5 or upper[knee] >= -lower[knee] else -0.5
             reference[knee] = bend
+        index = 0 if side > 0 else 1
         chain = LegChain(side, chain.joint_names, axes, points, ankle, reference=reference, lower=lower, upper=upper,
-                         role_order=tuple(roles.index(role) for role in ROLES))
+                         role_order=tuple(roles.index(role) for role in ROLES), link_masses=segment_mass[index],
+                         link_coms=segment_com[index])
         sole_points = collision_points(model, data, rigid_bodies(model, foot))
         if len(sole_points) == 0:
             raise FileFormatError(source, f"the {label} foot body {_name(model, mujoco.mjtObj.mjOBJ_BODY, foot)!r} "
@@ -337,7 +364,8 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
                        joints=tuple(leg_joints), qpos_reference=tuple(float(v) for v in qpos_reference),
                        ctrl_reference=tuple(float(v) for v in ctrl_reference), package_paths=package_paths,
                        sole_polygon=tuple((float(x), float(y)) for x, y in polygon), held_joints=held,
-                       keyframe=_name(model, mujoco.mjtObj.mjOBJ_KEY, key_id) if key_id >= 0 else None)
+                       keyframe=_name(model, mujoco.mjtObj.mjOBJ_KEY, key_id) if key_id >= 0 else None,
+                       rest_mass=rest_mass, rest_com=(float(rest_com[0]), float(rest_com[1]), float(rest_com[2])))
     pelvis_height = 0.0
     pendulum = 0.0
     chains_ready = chains
@@ -379,7 +407,7 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     limits = {f"{'left' if i < 6 else 'right'}_{joint.role}": joint.limits for i, joint in enumerate(leg_joints)}
     fields_ = {
         "name": robot_name,
-        "description": f"{robot_name}: imported from {path.name} ({mass:.1f} kg)",
+        "description": f"imported from {path.name} ({mass:.1f} kg)",
         "mass": mass, "height": height_scale, "hip_spacing": hip_spacing, "hip_drop": hip_drop,
         "thigh_length": thigh, "shank_length": shank, "ankle_height": ankle_height,
         "foot_length": float(x_max - x_min), "foot_width": float(y_max - y_min),

@@ -219,7 +219,45 @@ def robot_from_toml(path: Path) -> RobotModel:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
     except (OSError, tomllib.TOMLDecodeError) as error:
         raise FileFormatError(str(path), str(error)) from None
+    if "model" in data:
+        return _robot_from_model_table(data, path)
     return robot_from_dict(data, str(path))
+
+
+_MODEL_OVERRIDES = {"posture": ("pelvis_height",), "walking": ("dsp_time", "foot_lift", "lateral_velocity")}
+
+
+def _robot_from_model_table(data: dict[str, Any], path: Path) -> RobotModel:
+    """A robot file whose ``[model]`` names the robot's own MJCF or URDF (written by ``zmpwalk robot --write``)."""
+    from zmpwalk.robots.imported import import_robot
+
+    source = str(path)
+    table = data["model"]
+    known = {"file", "feet", "keyframe", "package_paths", "name"}
+    if not isinstance(table, dict) or "file" not in table or set(table) - known:
+        raise FileFormatError(source, f"[model] needs file = \"MODEL.xml\" and may have: {', '.join(sorted(known))}")
+    feet = table.get("feet")
+    if feet is not None and (not isinstance(feet, list) or len(feet) != 2 or not all(isinstance(f, str) for f in feet)):
+        raise FileFormatError(source, "[model] feet must be two body names: [left, right]")
+    overrides: dict[str, float] = {}
+    for section, names in _MODEL_OVERRIDES.items():
+        values = data.get(section, {})
+        if not isinstance(values, dict):
+            raise FileFormatError(source, f"[{section}] must be a table")
+        for key, value in values.items():
+            if key not in names:
+                raise FileFormatError(source, f"[{section}] unknown field {key!r} for a model robot; known: "
+                                      f"{', '.join(names)}")
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
+                raise FileFormatError(source, f"[{section}] {key} = {value!r} must be a number > 0")
+            overrides[key] = float(value)
+    unknown = set(data) - {"model", *_MODEL_OVERRIDES}
+    if unknown:
+        raise FileFormatError(source, f"unknown table(s) {', '.join(sorted(unknown))} in a robot file with [model]")
+    packages = tuple(path.parent / str(p) for p in table.get("package_paths", []))
+    return import_robot(path.parent / str(table["file"]), feet=(feet[0], feet[1]) if feet else None,
+                        keyframe=table.get("keyframe"), package_paths=packages, name=table.get("name"),
+                        overrides=overrides)
 
 
 def _table(kind: type[Any], table: object, name: str, source: str) -> Any:

@@ -45,7 +45,6 @@ class Plant:
         leg_qpos: ``qpos`` address of each joint column, (12,).
         ctrl_hold: Controls of the reference pose (the other actuators keep them), (nu,).
         qpos_hold: The reference pose, (nq,).
-        base_offset: The pattern's pelvis point in the base frame (the CoM offset) [m], (3,).
         imported: True for the robot's own model, False for the box model.
     """
 
@@ -54,7 +53,6 @@ class Plant:
     leg_qpos: NDArray[np.intp]
     ctrl_hold: Array
     qpos_hold: Array
-    base_offset: Array
     imported: bool
 
 
@@ -70,7 +68,7 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
 
         model = mujoco.MjModel.from_xml_string(robot_mjcf(robot, mass_scale))
         qpos = model.qpos0.copy()
-        return Plant(model, np.arange(12), np.arange(7, 19), np.zeros(model.nu), qpos, np.zeros(3), False)
+        return Plant(model, np.arange(12), np.arange(7, 19), np.zeros(model.nu), qpos, False)
     if mass_scale != 1.0:
         raise InvalidParameterError("mass_scale", mass_scale, "1 for a robot imported from its model (its "
                                     "masses are the model's)")
@@ -128,19 +126,16 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
         actuators.append(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, joint.actuator.name))
     leg_qpos = np.array([model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j.name)]
                          for j in plant.joints])
-    offset = np.array([robot.com_offset[0], robot.com_offset[1], 0.0])
-    return Plant(model, np.array(actuators), leg_qpos, np.array(plant.ctrl_reference), qpos, offset, True)
+    return Plant(model, np.array(actuators), leg_qpos, np.array(plant.ctrl_reference), qpos, True)
 
 
-def set_initial_state(plant: Plant, data: mujoco.MjData, position_pelvis: Array, yaw: float, angles: Array,
+def set_initial_state(plant: Plant, data: mujoco.MjData, position_base: Array, yaw: float, angles: Array,
                       penetration: float = 0.0) -> None:
-    """Stand the plant in the first pose at rest: the pattern's pelvis point and yaw, the leg angles (12,)
+    """Stand the plant in the first pose at rest: the base origin [m] and yaw [rad], the leg angles (12,)
     [rad], the other joints at the reference pose, the lowest sole ``penetration`` [m] into the ground."""
     model = plant.model
     data.qpos[:] = plant.qpos_hold
-    c, s = math.cos(yaw), math.sin(yaw)
-    offset = plant.base_offset
-    data.qpos[0:3] = position_pelvis - np.array([c * offset[0] - s * offset[1], s * offset[0] + c * offset[1], 0.0])
+    data.qpos[0:3] = position_base
     data.qpos[3:7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
     data.qpos[plant.leg_qpos] = angles
     data.qvel[:] = 0.0
@@ -156,3 +151,92 @@ def set_initial_state(plant: Plant, data: mujoco.MjData, position_pelvis: Array,
         bottom = min(float(data.geom_xpos[g][2] - model.geom_size[g][2]) for g in geoms)
     data.qpos[2] += -bottom - penetration
     mujoco.mj_forward(model, data)
+
+
+FEEDFORWARD_PERIOD = 0.005  # [s] the static feedforward is computed at this period and interpolated
+
+
+def plant_qpos(plant: Plant, position_base: Array, yaw: Array, angles: Array) -> Array:
+    """Full ``qpos`` rows (n, nq) of the planned motion: the base origin [m] (n, 3) and yaw [rad] (upright),
+    leg joint columns (n, 12), the other joints at the reference pose."""
+    n = len(yaw)
+    qpos = np.repeat(plant.qpos_hold[None, :], n, axis=0)
+    qpos[:, 0:3] = position_base
+    qpos[:, 3:7] = np.column_stack([np.cos(yaw / 2), np.zeros(n), np.zeros(n), np.sin(yaw / 2)])
+    qpos[:, plant.leg_qpos] = angles
+    return qpos
+
+
+def static_feedforward(plant: Plant, qpos: Array, zmp: Array, support: NDArray[np.integer],
+                       ankles: tuple[Array, Array]) -> Array:
+    r"""Control offsets (n, nu) [rad] that make the position servos hold each planned pose.
+
+    A position servo ``kp (u - q)`` holding a joint against a static torque ``tau`` sags by ``tau / kp``
+    (TALOS's knees: 0.09 rad; Booster T1's: 0.35 rad). zmpwalk computes that torque from the model,
+    quasi-statically, for the planned pose and the planned ground reaction:
+
+    .. math:: \tau = g(q) - \sum_{feet} J_{foot}^T w_{foot}
+
+    with ``g`` the generalised gravity (MuJoCo's RNE at rest), ``w`` each sole's wrench: the weight at the
+    planned ZMP, carried by the stance foot in single support and split between the feet by where the
+    ZMP lies between them in double support. The reference of each position actuator becomes
+    ``u = q_ref + tau / (kp gear^2)``. Accelerations are left to the servos (the gait is slow against
+    their bandwidth); the offsets only remove the sag.
+
+    Args:
+        qpos: Planned poses (n, nq) (:func:`plant_qpos`).
+        zmp: Planned ZMP in world [m], (n, 2).
+        support: 0 double, 1 left, 2 right, (n,).
+        ankles: Planned left and right ankle positions in world [m], each (n, 3).
+    """
+    model = plant.model
+    data = mujoco.MjData(model)
+    n = len(qpos)
+    offsets = np.zeros((n, model.nu))
+    position_actuators = [a for a in range(model.nu)
+                          if model.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT
+                          and model.actuator_biastype[a] == mujoco.mjtBias.mjBIAS_AFFINE
+                          and abs(model.actuator_biasprm[a][1] + model.actuator_gainprm[a][0]) < 1e-9
+                          * max(1.0, model.actuator_gainprm[a][0]) and model.actuator_gainprm[a][0] > 0]
+    dofs = np.array([model.jnt_dofadr[model.actuator_trnid[a][0]] for a in position_actuators], dtype=int)
+    stiffness = np.array([model.actuator_gainprm[a][0] * model.actuator_gear[a][0] ** 2
+                          for a in position_actuators])
+    sites = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, f"{s}_ankle") for s in ("left", "right")]
+    weight = float(np.sum(model.body_mass)) * -float(model.opt.gravity[2])
+    stride = max(1, round(FEEDFORWARD_PERIOD * CONTROL_RATE_HINT))
+    keys = np.unique(np.append(np.arange(0, n, stride), n - 1))
+    torques = np.empty((len(keys), len(position_actuators)))
+    bias = np.zeros(model.nv)
+    jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
+    for row, k in enumerate(keys):
+        data.qpos[:] = qpos[k]
+        data.qvel[:] = 0.0
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_comPos(model, data)
+        mujoco.mj_rne(model, data, 0, bias)
+        tau = bias.copy()
+        left, right = ankles[0][k, :2], ankles[1][k, :2]
+        if support[k] == 1:
+            shares = (1.0, 0.0)
+        elif support[k] == 2:
+            shares = (0.0, 1.0)
+        else:
+            span = right - left
+            ratio = float(np.clip((zmp[k] - left) @ span / max(float(span @ span), 1e-12), 0.0, 1.0))
+            shares = (1.0 - ratio, ratio)
+        base_point = left + (right - left) * shares[1]
+        for site, share, ankle in zip(sites, shares, (left, right), strict=True):
+            if share == 0.0:
+                continue
+            cop = np.append(ankle + (zmp[k] - base_point), 0.0)  # this sole's CoP, keeping the total at the ZMP
+            force = np.array([0.0, 0.0, share * weight])
+            moment = np.cross(cop - data.site_xpos[site], force)
+            mujoco.mj_jacSite(model, data, jacp, jacr, site)
+            tau -= jacp.T @ force + jacr.T @ moment
+        torques[row] = tau[dofs]
+    for column, actuator in enumerate(position_actuators):
+        offsets[:, actuator] = np.interp(np.arange(n), keys, torques[:, column]) / stiffness[column]
+    return offsets
+
+
+CONTROL_RATE_HINT = 1000.0  # [Hz] rows per second of the control series given to static_feedforward

@@ -40,7 +40,7 @@ from zmpwalk.kinematics import JOINT_COLUMNS, JointTrajectory
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sim.mjcf import contact_mapping
-from zmpwalk.sim.plant import build_plant, set_initial_state
+from zmpwalk.sim.plant import build_plant, plant_qpos, set_initial_state, static_feedforward
 from zmpwalk.zmp import batch_hull_margin
 
 Array = NDArray[np.float64]
@@ -49,6 +49,8 @@ CONTROL_RATE = 1000.0  # [Hz] servo reference rate and measurement rate
 FALL_TILT = 0.6  # [rad]
 FALL_HEIGHT_FRACTION = 0.6  # [-] of the pelvis height
 AFTER_FALL = 0.3  # [s] simulated after a fall
+SETTLE = 1.0  # [s] default settle phase of a robot's own model
+HOLD = 2.0  # [s] default hold after the walk of a robot's own model
 LOADED_FRACTION = 0.15  # [-] of the weight: a sole carrying more is "loaded" (its CoP is measured)
 
 
@@ -209,8 +211,9 @@ def simulate(
     pattern: WalkingPattern,
     *,
     mass_scale: float = 1.0,
-    settle: float = 0.0,
-    hold: float = 0.0,
+    settle: float | None = None,
+    hold: float | None = None,
+    feedforward: bool | None = None,
 ) -> SimulationResult:
     """Simulate ``joints`` (made from ``pattern``) on ``robot`` and measure the walk.
 
@@ -220,8 +223,13 @@ def simulate(
         pattern: The pattern they come from: initial pose and reference ZMP.
         mass_scale: Multiply every mass and inertia, and the servo gains with them
             (:func:`zmpwalk.sim.mjcf.robot_mjcf`; box models only).
-        settle: Time the first pose is held before the walk [s] (the robot settles onto its soles).
-        hold: Time the last pose is held after the walk [s] (does it end standing still?).
+        settle: Time the first pose is held before the walk [s] (the robot settles onto its soles; default
+            :data:`SETTLE` for a robot's own model, 0 for the box models, which start at rest on their soles).
+        hold: Time the last pose is held after the walk [s] (does it end standing still?; default :data:`HOLD`
+            for a robot's own model, 0 for the box models).
+        feedforward: Add the static torque feedforward of :func:`zmpwalk.sim.plant.static_feedforward` to
+            the servo references (default: on for a robot's own model, off for the box models, whose
+            stiff servos the papers' results were measured with).
 
     Returns:
         The measurements. The same input gives the same result.
@@ -233,10 +241,15 @@ def simulate(
         raise InvalidParameterError("joints", len(joints.time), f"{len(pattern.time)} samples, as the pattern")
     if not (0.01 <= mass_scale <= 100):
         raise InvalidParameterError("mass_scale", mass_scale, "a value in [0.01, 100]")
+    imported = robot.plant is not None
+    settle = (SETTLE if imported else 0.0) if settle is None else settle
+    hold = (HOLD if imported else 0.0) if hold is None else hold
     if not (0.0 <= settle <= 10.0) or not (0.0 <= hold <= 60.0):
         raise InvalidParameterError("settle" if not 0.0 <= settle <= 10.0 else "hold",
                                     settle if not 0.0 <= settle <= 10.0 else hold, "settle in [0, 10] s, hold in [0, 60] s")
     plant = build_plant(robot, mass_scale)
+    if feedforward is None:
+        feedforward = plant.imported
     model = plant.model
     data = mujoco.MjData(model)
     if plant.imported:
@@ -252,8 +265,9 @@ def simulate(
     pattern_time = np.clip(time, pattern.time[0], pattern.time[-1])
     reference = np.column_stack([np.interp(pattern_time, joints.time, joints.angles[:, j]) for j in range(12)])
     zmp_ref = np.column_stack([np.interp(pattern_time, pattern.time, pattern.zmp_in_world[:, i]) for i in range(2)])
-    set_initial_state(plant, data, pattern.position_pelvis_in_world[0], float(pattern.yaw_pelvis_in_world[0]),
-                      reference[0], penetration)
+    base_planned = (pattern.position_pelvis_in_world if joints.position_base_in_world is None
+                    else joints.position_base_in_world)
+    set_initial_state(plant, data, base_planned[0], float(pattern.yaw_pelvis_in_world[0]), reference[0], penetration)
     sensors = _Sensors(model)
     n = len(time)
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
@@ -261,6 +275,14 @@ def simulate(
     mujoco.mj_getState(model, data, state, spec)
     control = np.repeat(plant.ctrl_hold[None, :], n, axis=0)
     control[:, plant.leg_actuators] = reference
+    if feedforward:
+        index = np.clip(np.searchsorted(pattern.time, pattern_time), 0, len(pattern.time) - 1)
+        base_path = np.column_stack([np.interp(pattern_time, pattern.time, base_planned[:, i]) for i in range(3)])
+        yaw_path = np.interp(pattern_time, pattern.time, pattern.yaw_pelvis_in_world)
+        ankles = tuple(np.column_stack([np.interp(pattern_time, pattern.time, a[:, i]) for i in range(3)])
+                       for a in (pattern.position_left_ankle_in_world, pattern.position_right_ankle_in_world))
+        qpos_path = plant_qpos(plant, base_path, yaw_path, reference)
+        control += static_feedforward(plant, qpos_path, zmp_ref, pattern.support[index], (ankles[0], ankles[1]))
     control = np.repeat(control, steps_per_tick, axis=0)[None]
     _, readings = rollout.rollout(model, data, state[None], control)
     readings = readings[0, steps_per_tick - 1::steps_per_tick]

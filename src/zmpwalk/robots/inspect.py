@@ -1,0 +1,130 @@
+"""What zmpwalk derived from a robot, for a builder to check against the CAD: ``zmpwalk robot PATH``."""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+from zmpwalk.kinematics import JOINT_COLUMNS
+from zmpwalk.robots.model import RobotModel
+
+
+def robot_summary(robot: RobotModel) -> dict[str, Any]:
+    """The derived values as plain data (SI units: m, kg, rad, N m)."""
+    summary: dict[str, Any] = {
+        "name": robot.name, "description": robot.description, "mass": robot.mass, "height": robot.height,
+        "hips": {side: list(robot.hip_in_pelvis(s)) for side, s in (("left", 1), ("right", -1))},
+        "hip_x": robot.hip_x, "hip_spacing": robot.hip_spacing, "hip_drop": robot.hip_drop,
+        "thigh_length": robot.thigh_length, "shank_length": robot.shank_length, "ankle_height": robot.ankle_height,
+        "sole": {"length": robot.foot_length, "width": robot.foot_width, "center_x": robot.sole_center_x,
+                 "center_y": robot.sole_center_y},
+        "pelvis_height": robot.pelvis_height, "pendulum_length": robot.pendulum_length,
+        "com_offset": list(robot.com_offset), "schedule_scale": list(robot.schedule_scale),
+        "walking": {"dsp_time": robot.dsp_time, "foot_lift": robot.foot_lift,
+                    "lateral_velocity": robot.lateral_velocity},
+        "limits": {column: list(robot.limits_of(column)) for column in JOINT_COLUMNS},
+    }
+    # The hips in the base frame (the pattern's point is com_offset ahead of the base origin).
+    summary["hips"] = {side: [robot.hip_x, s * robot.hip_spacing / 2, -robot.hip_drop]
+                       for side, s in (("left", 1), ("right", -1))}
+    if robot.plant is not None and robot.legs is not None:
+        plant = robot.plant
+        summary["model"] = str(plant.path)
+        summary["base_body"] = plant.base_body
+        summary["feet"] = list(plant.feet)
+        summary["keyframe"] = plant.keyframe
+        summary["held_joints"] = list(plant.held_joints)
+        summary["sole_polygon"] = [list(p) for p in plant.sole_polygon]
+        summary["ik"] = {chain.label: ("closed form" if chain.closed_form else "numeric") for chain in robot.legs}
+        summary["hip_axes_offset"] = {chain.label: chain.hip_axes_offset for chain in robot.legs}
+        summary["ankle_axes_offset"] = {chain.label: chain.ankle_axes_offset for chain in robot.legs}
+        summary["joints"] = [
+            {"column": column, "name": joint.name, "axis": list(joint.axis), "sign": joint.sign,
+             "zero_offset": joint.zero_offset, "limits": list(joint.limits),
+             "actuator": None if joint.actuator is None else {
+                 "name": joint.actuator.name, "kind": joint.actuator.kind, "kp": joint.actuator.kp,
+                 "kv": joint.actuator.kv, "force_limit": joint.actuator.force_limit}}
+            for column, joint in zip(JOINT_COLUMNS, plant.joints, strict=True)]
+    return summary
+
+
+def _mm(value: float) -> str:
+    return f"{value * 1e3:+.1f}"
+
+
+def robot_table(robot: RobotModel) -> str:
+    """The derived values as a table (lengths in mm for reading; the files and JSON are in SI)."""
+    s = robot_summary(robot)
+    lines = [f"{robot.name}: {robot.description}"]
+    if "model" in s:
+        lines.append(f"model {s['model']}; base {s['base_body']!r}; feet {s['feet'][0]!r}, {s['feet'][1]!r}; "
+                     f"reference pose: {s['keyframe'] or 'zero pose'}")
+    lines += [
+        f"mass {robot.mass:.3f} kg, height {robot.height:.3f} m",
+        "hips in the base frame [mm]: left (" + ", ".join(_mm(v) for v in s["hips"]["left"]) + "), right ("
+        + ", ".join(_mm(v) for v in s["hips"]["right"]) + ")",
+        f"thigh {robot.thigh_length * 1e3:.1f} mm, shank {robot.shank_length * 1e3:.1f} mm, "
+        f"ankle above the sole {robot.ankle_height * 1e3:.1f} mm",
+        f"sole {robot.foot_length * 1e3:.1f} x {robot.foot_width * 1e3:.1f} mm, centre "
+        f"({_mm(robot.sole_center_x)}, {_mm(robot.sole_center_y)}) mm from the ankle",
+        f"ready posture: base {robot.pelvis_height:.4f} m above the ground, centre of mass "
+        f"{robot.pendulum_length:.4f} m high and ({_mm(robot.com_offset[0])}, {_mm(robot.com_offset[1])}) mm "
+        "from the base origin",
+        "HUBO tables scaled by: time x{:.3f}, stride x{:.3f}, lateral x{:.3f}".format(*robot.schedule_scale),
+    ]
+    if "joints" in s:
+        lines.append("IK: " + ", ".join(f"{k} {v} (hip axes {s['hip_axes_offset'][k] * 1e3:.1f} mm apart, ankle "
+                                        f"{s['ankle_axes_offset'][k] * 1e3:.1f} mm)" for k, v in s["ik"].items()))
+        lines.append("")
+        header = (f"{'column':<18} {'model joint':<22} {'axis':<16} {'sign':>4} {'zero':>7} {'range [rad]':>17} "
+                  f"{'actuator':<9} {'kp':>8} {'kv':>7} {'max [N m]':>9}")
+        lines += [header, "-" * len(header)]
+        for joint in s["joints"]:
+            actuator = joint["actuator"] or {"kind": "none", "kp": math.nan, "kv": math.nan, "force_limit": math.nan}
+            axis = "(" + ", ".join(f"{v:+.2f}" for v in joint["axis"]) + ")"
+            lines.append(f"{joint['column']:<18} {joint['name']:<22} {axis:<16} {joint['sign']:>+4d} "
+                         f"{joint['zero_offset']:>+7.3f} [{joint['limits'][0]:>+7.3f}, {joint['limits'][1]:>+7.3f}] "
+                         f"{actuator['kind']:<9} {actuator['kp']:>8.1f} {actuator['kv']:>7.2f} "
+                         f"{actuator['force_limit']:>9.1f}")
+        if s["held_joints"]:
+            lines.append(f"held at the reference pose: {', '.join(s['held_joints'])}")
+    return "\n".join(lines)
+
+
+def robot_toml(robot: RobotModel, folder: Path) -> str:
+    """A robot file that loads the robot's own model (``[model]``), with the values a builder may change
+    (``[posture]``, ``[walking]``) and the derived geometry as comments to check against the CAD.
+
+    Args:
+        folder: Where the file will be written (the model path is written relative to it).
+    """
+    lines = [f"# zmpwalk robot file of {robot.name}, derived from its model by 'zmpwalk robot'.",
+             "# Units: SI (m, kg, rad, s). Values under [posture] and [walking] replace the derived ones."]
+    if robot.plant is not None:
+        plant = robot.plant
+        try:
+            model_path = os.path.relpath(plant.path, folder.resolve())
+        except ValueError:  # another drive
+            model_path = str(plant.path)
+        lines += ["", "[model]", f"file = {_quote(model_path)}",
+                  f"feet = [{_quote(plant.feet[0])}, {_quote(plant.feet[1])}]"]
+        if plant.keyframe:
+            lines.append(f"keyframe = {_quote(plant.keyframe)}")
+        if plant.package_paths:
+            lines.append("package_paths = [" + ", ".join(_quote(str(p)) for p in plant.package_paths) + "]")
+        lines.append(f"name = {_quote(robot.name)}")
+    lines += ["", "[posture]",
+              f"pelvis_height = {robot.pelvis_height:.6g}   # [m] base origin above the ground, ready posture",
+              "", "[walking]",
+              f"dsp_time = {robot.dsp_time:.6g}   # [s] double-support time d (HUBO's 0.1 s, time-scaled)",
+              f"foot_lift = {robot.foot_lift:.6g}   # [m] swing apex height (HUBO's 0.04 m, length-scaled)",
+              f"lateral_velocity = {robot.lateral_velocity:.6g}   # [m] V_y of Eq. 20 (HUBO's 0.1 m, lateral-scaled)",
+              "", "# Derived from the model (for checking; edit the model, not these lines):"]
+    lines += [f"#   {line}" if line else "#" for line in robot_table(robot).splitlines()]
+    return "\n".join(lines) + "\n"
+
+
+def _quote(text: str) -> str:
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
