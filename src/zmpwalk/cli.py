@@ -272,9 +272,9 @@ def _simulate(args: argparse.Namespace) -> int:
         commands, labels = _commands(args)
         make = generator(args.generator)
         schedule = _schedule(args)
-        extra = {"schedule": schedule} if schedule else {}
+        options = {"schedule": schedule} if schedule else {}
         with _source(_label(args)):
-            pattern = make(robot, commands, rate=1000.0, labels=labels, **extra)
+            pattern = make(robot, commands, rate=1000.0, labels=labels, **options)
     joints = pattern_joint_trajectory(pattern, check_limits=False)
     result = simulate(robot, joints, pattern, mass_scale=args.mass_scale)
     rows = actuator_table(result)
@@ -368,9 +368,9 @@ def _run(args: argparse.Namespace) -> int:
         robot = _load_robot(args)
         make = generator(args.generator)
         schedule = _schedule(args)
-        extra = {"schedule": schedule} if schedule else {}
+        options = {"schedule": schedule} if schedule else {}
         with _source(_label(args)):
-            pattern = make(robot, commands, rate=args.rate, labels=labels, **extra)
+            pattern = make(robot, commands, rate=args.rate, labels=labels, **options)
             extra = pattern_joint_trajectory(pattern).columns() if args.joints else None
         if args.out:
             pattern.write_csv(args.out, extra)

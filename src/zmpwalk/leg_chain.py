@@ -26,7 +26,8 @@ Sastry, *A Mathematical Introduction to Robotic Manipulation*, 1994, Sec. 3.3):
 2. the ankle (subproblem 2, two intersecting axes):
    ``e^{\hat\xi_5 q_5} e^{\hat\xi_6 q_6} (g^{-1} H) = e^{-\hat\xi_4 q_4} H``;
 3. the hip (subproblem 2 on the third hip axis, then subproblem 1):
-   ``e^{\hat\xi_1 q_1} e^{\hat\xi_2 q_2} e^{\hat\xi_3 q_3} = g\,(e^{\hat\xi_4 q_4} e^{\hat\xi_5 q_5} e^{\hat\xi_6 q_6})^{-1}``.
+   ``e^{\hat\xi_1 q_1} e^{\hat\xi_2 q_2} e^{\hat\xi_3 q_3} = g\,(e^{\hat\xi_4 q_4} e^{\hat\xi_5 q_5}
+   e^{\hat\xi_6 q_6})^{-1}``.
 
 Each subproblem has up to two solutions; zmpwalk takes, at each, the one
 nearest the leg's reference angles (the ready posture), so the knee keeps the
@@ -85,7 +86,7 @@ def _rodrigues(axis: Array, angle: Array) -> Array:
     x, y, z = axis
     k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
     s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
-    return np.eye(3) + s * k + (1.0 - c) * (k @ k)
+    return np.asarray(np.eye(3) + s * k + (1.0 - c) * (k @ k), dtype=np.float64)
 
 
 def _wrap(angle: Array) -> Array:
@@ -138,7 +139,7 @@ def _closest_point_to_lines(points: Array, axes: Array) -> tuple[Array, float]:
     centre = np.linalg.lstsq(a, b, rcond=None)[0]
     distances = [float(np.linalg.norm((np.eye(3) - np.outer(w, w)) @ (centre - p))) for p, w in zip(points, axes,
                                                                                                        strict=True)]
-    return centre, max(distances)
+    return np.asarray(centre, dtype=np.float64), max(distances)
 
 
 @dataclass(frozen=True, eq=False)
@@ -208,7 +209,7 @@ class LegChain:
     def knee_point(self) -> Array:
         """Point of the knee axis nearest the hip centre [m], (3,)."""
         w, r = self.axes[3], self.points[3]
-        return r + w * float(w @ (self.hip - r))
+        return np.asarray(r + w * float(w @ (self.hip - r)), dtype=np.float64)
 
     @property
     def ankle_point(self) -> Array:

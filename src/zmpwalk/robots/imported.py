@@ -226,10 +226,7 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     base = _floating_base(model, source)
     key_id = _keyframe(model, keyframe, source)
     qpos_reference = model.key_qpos[key_id].copy() if key_id >= 0 else model.qpos0.copy()
-    if key_id >= 0 and model.nu:
-        ctrl_reference = model.key_ctrl[key_id].copy()
-    else:
-        ctrl_reference = np.zeros(model.nu)
+    ctrl_reference = model.key_ctrl[key_id].copy() if key_id >= 0 and model.nu else np.zeros(model.nu)
     data.qpos[:] = qpos_reference
     mujoco.mj_kinematics(model, data)
     foot_ids = _find_feet(model, data, base, feet, source)
@@ -405,7 +402,7 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     lateral_scale = hip_spacing / HUBO_HIP_SPACING
     time_scale = math.sqrt(length_scale)
     limits = {f"{'left' if i < 6 else 'right'}_{joint.role}": joint.limits for i, joint in enumerate(leg_joints)}
-    fields_ = {
+    fields_: dict[str, Any] = {
         "name": robot_name,
         "description": f"imported from {path.name} ({mass:.1f} kg)",
         "mass": mass, "height": height_scale, "hip_spacing": hip_spacing, "hip_drop": hip_drop,
@@ -558,8 +555,8 @@ def _find_feet(model: object, data: object, base: int, feet: tuple[str, str] | N
                               "through 6 hinge joints (a foot)")
     lowest = min(c[0] for c in candidates)
     result = []
-    for label, on_side in (("left", lambda y: y > 0), ("right", lambda y: y < 0)):
-        side = sorted((c for c in candidates if on_side(c[2])), key=lambda c: c[0])
+    for label, sign in (("left", 1.0), ("right", -1.0)):
+        side = sorted((c for c in candidates if sign * c[2] > 0), key=lambda c: c[0])
         if not side or side[0][0] > lowest + 0.05:
             raise FileFormatError(source, f"no {label} foot found (no low body with collision geoms on the "
                                   f"{label} of the base); give the feet: feet = [left body, right body]")

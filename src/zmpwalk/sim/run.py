@@ -244,9 +244,10 @@ def simulate(
     imported = robot.plant is not None
     settle = (SETTLE if imported else 0.0) if settle is None else settle
     hold = (HOLD if imported else 0.0) if hold is None else hold
-    if not (0.0 <= settle <= 10.0) or not (0.0 <= hold <= 60.0):
-        raise InvalidParameterError("settle" if not 0.0 <= settle <= 10.0 else "hold",
-                                    settle if not 0.0 <= settle <= 10.0 else hold, "settle in [0, 10] s, hold in [0, 60] s")
+    if not 0.0 <= settle <= 10.0:
+        raise InvalidParameterError("settle", settle, "a time in [0, 10] s")
+    if not 0.0 <= hold <= 60.0:
+        raise InvalidParameterError("hold", hold, "a time in [0, 60] s")
     plant = build_plant(robot, mass_scale)
     if feedforward is None:
         feedforward = plant.imported
@@ -279,10 +280,11 @@ def simulate(
         index = np.clip(np.searchsorted(pattern.time, pattern_time), 0, len(pattern.time) - 1)
         base_path = np.column_stack([np.interp(pattern_time, pattern.time, base_planned[:, i]) for i in range(3)])
         yaw_path = np.interp(pattern_time, pattern.time, pattern.yaw_pelvis_in_world)
-        ankles = tuple(np.column_stack([np.interp(pattern_time, pattern.time, a[:, i]) for i in range(3)])
-                       for a in (pattern.position_left_ankle_in_world, pattern.position_right_ankle_in_world))
+        planned_ankles = [np.column_stack([np.interp(pattern_time, pattern.time, a[:, i]) for i in range(3)])
+                          for a in (pattern.position_left_ankle_in_world, pattern.position_right_ankle_in_world)]
         qpos_path = plant_qpos(plant, base_path, yaw_path, reference)
-        control += static_feedforward(plant, qpos_path, zmp_ref, pattern.support[index], (ankles[0], ankles[1]))
+        control += static_feedforward(plant, qpos_path, zmp_ref, pattern.support[index],
+                                      (planned_ankles[0], planned_ankles[1]))
     control = np.repeat(control, steps_per_tick, axis=0)[None]
     _, readings = rollout.rollout(model, data, state[None], control)
     readings = readings[0, steps_per_tick - 1::steps_per_tick]

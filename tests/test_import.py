@@ -1,0 +1,206 @@
+"""A robot imported from its own MJCF or URDF: derived values against MuJoCo's own numbers, IK on every sample,
+the simulation of the real model, and one clear error for each bad model."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from zmpwalk.commands import StepCommand
+from zmpwalk.errors import FileFormatError
+from zmpwalk.kinematics import pattern_joint_trajectory, rot_z
+from zmpwalk.patterns.polynomial import generate
+from zmpwalk.robots import load_robot
+
+ROBOTS = Path(__file__).resolve().parents[2] / "shared" / "robots"
+TALOS = ROBOTS / "pal_talos" / "scene_position.xml"
+T1 = ROBOTS / "booster_t1" / "scene.xml"
+needs_robots = pytest.mark.skipif(not TALOS.is_file() or not T1.is_file(), reason="../shared/robots is absent")
+
+
+def body_position(model: mujoco.MjModel, name: str) -> np.ndarray:
+    """Body origin relative to its parent chain at qpos0, summed to the base (no rotations in these models)."""
+    body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
+    total = np.zeros(3)
+    while model.body_parentid[body] != 0 and model.body_jntnum[body] >= 0:
+        if model.body_parentid[body] == 0 or model.jnt_type[model.body_jntadr[body]] == mujoco.mjtJoint.mjJNT_FREE:
+            break
+        total += model.body_pos[body]
+        body = model.body_parentid[body]
+    return total
+
+
+@needs_robots
+def test_talos_derived_values_match_mujoco() -> None:
+    robot = load_robot(TALOS)
+    model = mujoco.MjModel.from_xml_path(str(TALOS))
+    hip = body_position(model, "leg_left_1_link")  # the hip axes meet at this body's origin
+    assert (robot.hip_x, robot.hip_spacing / 2, -robot.hip_drop) == pytest.approx(tuple(hip), abs=1e-9)
+    assert robot.thigh_length == pytest.approx(float(-model.body_pos[model.body("leg_left_4_link").id][2]), abs=1e-9)
+    assert robot.shank_length == pytest.approx(float(-model.body_pos[model.body("leg_left_5_link").id][2]), abs=1e-9)
+    # The sole box: size .1 .06 .006 at (-0.005, 0, -0.1) below the ankle.
+    assert robot.ankle_height == pytest.approx(0.106, abs=1e-9)
+    assert (robot.foot_length, robot.foot_width) == pytest.approx((0.2, 0.12), abs=1e-9)
+    assert robot.sole_center_x == pytest.approx(-0.005, abs=1e-9)
+    assert robot.mass == pytest.approx(float(model.body_subtreemass[model.body("base_link").id]), rel=1e-12)
+    for side in ("left", "right"):
+        joint = model.joint(f"leg_{side}_4_joint")
+        assert robot.limits_of(f"{side}_knee") == pytest.approx(tuple(joint.range), abs=1e-12)
+    assert robot.limits_of("left_hip_yaw") != robot.limits_of("right_hip_yaw")  # per side: mirrored ranges
+    assert robot.legs is not None and all(leg.closed_form for leg in robot.legs)
+    assert robot.plant is not None and robot.plant.joints[3].actuator is not None
+    assert robot.plant.joints[3].actuator.kp == pytest.approx(1000.0)
+
+
+@needs_robots
+def test_ready_posture_puts_the_com_over_the_feet() -> None:
+    for path in (TALOS, T1):
+        robot = load_robot(path)
+        pattern = generate(robot, [StepCommand(duration=1.0, forward=0.0)], rate=100.0)
+        joints = pattern_joint_trajectory(pattern)
+        model = mujoco.MjModel.from_xml_path(str(path))
+        data = mujoco.MjData(model)
+        assert robot.plant is not None and joints.position_base_in_world is not None
+        data.qpos[:] = robot.plant.qpos_reference
+        data.qpos[0:3] = joints.position_base_in_world[0]
+        data.qpos[3:7] = (1, 0, 0, 0)
+        for column, joint in enumerate(robot.plant.joints):
+            data.qpos[model.joint(joint.name).qposadr[0]] = joints.angles[0, column]
+        mujoco.mj_forward(model, data)
+        com = data.subtree_com[0]
+        assert com[:2] == pytest.approx(pattern.position_pelvis_in_world[0, :2], abs=1e-5)  # [m]
+        assert com[2] == pytest.approx(robot.pendulum_length, abs=1e-6)
+
+
+@needs_robots
+def test_t1_numeric_ik_reaches_every_sample() -> None:
+    robot = load_robot(T1)
+    assert robot.legs is not None and not any(leg.closed_form for leg in robot.legs)
+    pattern = generate(robot, [StepCommand(duration=0.8, forward=0.1)] * 10, rate=1000.0)
+    joints = pattern_joint_trajectory(pattern, check_limits=False)
+    assert joints.position_base_in_world is not None
+    base = joints.position_base_in_world
+    yaw = pattern.yaw_pelvis_in_world
+    c, s = np.cos(yaw), np.sin(yaw)
+    for index, (chain, ankle, foot_yaw) in enumerate(zip(
+            robot.legs, (pattern.position_left_ankle_in_world, pattern.position_right_ankle_in_world),
+            (pattern.yaw_left_foot_in_world, pattern.yaw_right_foot_in_world), strict=True)):
+        q = np.empty((len(yaw), 6))
+        q[:, list(chain.role_order)] = joints.angles[:, 6 * index:6 * index + 6]
+        position, rotation = chain.fk(q)
+        rel = ankle - base
+        target = np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1], rel[:, 2]])
+        assert np.abs(position - target).max() < 1e-4  # [m]: 0.1 mm
+        error = rotation @ np.swapaxes(rot_z(foot_yaw - yaw), 1, 2) - np.eye(3)
+        assert np.abs(error).max() < 1e-3  # [rad]: 1 mrad
+
+
+@needs_robots
+def test_closed_form_and_numeric_agree_on_talos() -> None:
+    robot = load_robot(TALOS)
+    assert robot.legs is not None
+    rng = np.random.default_rng(7)
+    for chain in robot.legs:
+        q = chain.reference + rng.uniform(-0.3, 0.3, (300, 6))
+        position, rotation = chain.fk(q)
+        closed, _ = chain.solve(position, rotation, numeric=False)
+        numeric, _ = chain.solve(position, rotation, numeric=True)
+        assert np.abs(closed - q).max() < 1e-9
+        assert np.abs(closed - numeric).max() < 1e-6  # [rad]
+
+
+@needs_robots
+def test_talos_stands_on_its_own_servos_with_the_feedforward() -> None:
+    from zmpwalk.sim import simulate
+
+    robot = load_robot(TALOS)
+    pattern = generate(robot, [StepCommand(duration=1.0, forward=0.0)], rate=1000.0)
+    joints = pattern_joint_trajectory(pattern)
+    planned_knee = joints.angles[0, 3]
+    sagging = simulate(robot, joints, pattern, settle=1.0, hold=0.0, feedforward=False)
+    holding = simulate(robot, joints, pattern, settle=1.0, hold=0.0, feedforward=True)
+    at_start = int(np.searchsorted(holding.time, 0.0))
+    assert abs(holding.joint_angles[at_start, 3] - planned_knee) < 0.01  # [rad]
+    assert abs(sagging.joint_angles[at_start, 3] - planned_knee) > 0.05  # the sag the feedforward removes
+    settle = holding.time < 0.0  # standing still on the starting pose
+    assert np.abs(holding.torso_rpy[settle, :2]).max() < 0.02  # [rad]
+    assert np.abs(sagging.torso_rpy[sagging.time < 0.0, 1]).max() > 0.05  # without it, TALOS tips backwards
+
+
+def write(tmp_path: Path, name: str, text: str) -> Path:
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+LEG = """
+<body name="{side}_hip" pos="0 {y} -0.1"><joint name="{side}_hy" axis="0 0 1"/><geom size="0.02" mass="1"/>
+ <body name="{side}_hr"><joint name="{side}_hr" axis="1 0 0"/><geom size="0.02" mass="1"/>
+  <body name="{side}_hp"><joint name="{side}_hp" axis="0 1 0"/><geom size="0.02" mass="1"/>
+   <body name="{side}_shank" pos="0 0 -0.3"><joint name="{side}_kn" axis="0 1 0"/><geom size="0.02" mass="1"/>
+    <body name="{side}_ank" pos="0 0 -0.3">{ankle}<geom size="0.02" mass="0.2" contype="0" conaffinity="0"/>
+     <body name="{side}_foot"><joint name="{side}_ar" axis="1 0 0"/>
+      <geom type="box" size="0.1 0.05 0.01" pos="0 0 -0.05" mass="0.5"/>{extra}
+     </body>
+    </body>
+   </body>
+  </body>
+ </body>
+</body>"""
+
+
+def biped(legs: str) -> str:
+    return f"""<mujoco><worldbody><geom type="plane" size="5 5 .1"/>
+<body name="base" pos="0 0 0.8"><freejoint/><geom type="box" size="0.1 0.15 0.1" mass="10"/>{legs}</body>
+</worldbody></mujoco>"""
+
+
+def leg(side: str, y: float, ankle: str = '<joint name="{s}_ap" axis="0 1 0"/>', extra: str = "") -> str:
+    return LEG.format(side=side, y=y, ankle=ankle.format(s=side), extra=extra)
+
+
+def test_a_small_mjcf_biped_imports(tmp_path: Path) -> None:
+    robot = load_robot(write(tmp_path, "ok.xml", biped(leg("l", 0.1) + leg("r", -0.1))))
+    assert robot.hip_spacing == pytest.approx(0.2)
+    assert robot.thigh_length == pytest.approx(0.3) and robot.shank_length == pytest.approx(0.3)
+    assert robot.ankle_height == pytest.approx(0.06)
+    assert robot.legs is not None and all(chain.closed_form for chain in robot.legs)
+
+
+@pytest.mark.parametrize(("name", "text", "words"), [
+    ("nolegs.xml", biped(""), "no legs"),
+    ("five.xml", biped(leg("l", 0.1, ankle="") + leg("r", -0.1, ankle="")), "5 joints"),
+    ("nobase.xml", "<mujoco><worldbody><body><geom size='0.1'/></body></worldbody></mujoco>", "no floating base"),
+    ("ambiguous.xml", biped(leg("l", 0.1, extra='<body name="l_toe" pos="0.12 0 0"><joint axis="0 1 0"/>'
+                                                  '<geom type="box" size="0.02 0.05 0.01" pos="0 0 -0.05"/></body>')
+                            + leg("r", -0.1)), "give the feet"),
+    ("mesh.xml", "<mujoco><asset><mesh name='m' file='missing.stl'/></asset><worldbody><body><freejoint/>"
+                 "<geom type='mesh' mesh='m'/></body></worldbody></mujoco>", "missing.stl"),
+])
+def test_bad_models_give_one_clear_error(tmp_path: Path, name: str, text: str, words: str) -> None:
+    with pytest.raises(FileFormatError, match=words):
+        load_robot(write(tmp_path, name, text))
+
+
+def test_missing_model_file_and_unresolved_package(tmp_path: Path) -> None:
+    with pytest.raises(FileFormatError, match="no such file"):
+        load_robot(tmp_path / "absent.xml")
+    urdf = write(tmp_path, "r.urdf", """<robot name="r"><link name="base"><visual><geometry>
+<mesh filename="package://nowhere_pkg/meshes/base.stl"/></geometry></visual></link></robot>""")
+    with pytest.raises(FileFormatError, match="package://nowhere_pkg"):
+        load_robot(urdf)
+
+
+def test_cli_robot_inspects_and_writes_a_loadable_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from zmpwalk.cli import main
+
+    model = write(tmp_path, "ok.xml", biped(leg("l", 0.1) + leg("r", -0.1)))
+    assert main(["robot", str(model), "--write", str(tmp_path / "ok.toml")]) == 0
+    assert "left_knee" in capsys.readouterr().out
+    robot = load_robot(tmp_path / "ok.toml")
+    assert robot.hip_spacing == pytest.approx(0.2)
+    assert main(["robot", str(tmp_path / "five.xml")]) == 2
+    assert "no such file" in capsys.readouterr().err
