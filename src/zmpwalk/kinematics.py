@@ -40,6 +40,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk.errors import InvalidParameterError, UnreachableError, ZmpwalkError
+from zmpwalk.leg_chain import LegChain
 from zmpwalk.robots.model import JOINT_NAMES, RobotModel
 
 if TYPE_CHECKING:
@@ -505,3 +506,42 @@ def pattern_joint_trajectory(pattern: WalkingPattern, knee_forward: bool = True,
          (pattern.position_right_ankle_in_world, pattern.yaw_right_foot_in_world,
           pattern.velocity_right_ankle_in_world, pattern.yaw_rate_right_foot)),
         pattern.robot, knee_forward, check_limits)
+
+
+def leg_chains(robot: RobotModel) -> tuple[LegChain, LegChain]:
+    """Both legs as :class:`~zmpwalk.leg_chain.LegChain` in the pelvis (base) frame, for any robot.
+
+    An imported robot has its own; the robot-file leg (yaw-roll-pitch-pitch-pitch-roll, links along -z)
+    becomes the same chain, with the ``[bodies]`` masses of thigh, shank and foot where the file has them.
+    """
+    if robot.legs is not None:
+        return robot.legs
+    ex, ey, ez = np.eye(3)
+    chains = []
+    for side in (1, -1):
+        hip = np.array([robot.hip_x, side * robot.hip_spacing / 2, -robot.hip_drop])
+        knee = hip + [0.0, 0.0, -robot.thigh_length]
+        ankle = knee + [0.0, 0.0, -robot.shank_length]
+        masses, coms = np.zeros(6), np.zeros((6, 3))
+        if robot.links:
+            for index, (name, origin) in enumerate((("thigh", hip), ("shank", knee), ("foot", ankle))):
+                link = robot.links[name]
+                masses[2 + index + (1 if name == "foot" else 0)] = link.mass
+                coms[2 + index + (1 if name == "foot" else 0)] = origin + np.array(link.com) * [1.0, side, 1.0]
+        limits = [robot.limits_of(f"{'left' if side > 0 else 'right'}_{joint}") for joint in LEG_JOINTS]
+        chains.append(LegChain(
+            side, tuple(f"{'left' if side > 0 else 'right'}_{joint}" for joint in LEG_JOINTS),
+            np.array([ez, ex, ey, ey, ey, ex]), np.array([hip, hip, hip, knee, ankle, ankle]), ankle,
+            reference=np.array([0.0, 0.0, -0.5, 1.0, -0.5, 0.0]),
+            lower=np.array([lo for lo, _ in limits]), upper=np.array([hi for _, hi in limits]),
+            link_masses=masses, link_coms=coms))
+    return chains[0], chains[1]
+
+
+def rest_mass(robot: RobotModel) -> tuple[float, Array]:
+    """Mass [kg] and centre of mass in the pelvis frame [m] of everything but the leg segments."""
+    if robot.plant is not None:
+        return robot.plant.rest_mass, np.array(robot.plant.rest_com)
+    if robot.links:
+        return robot.links["torso"].mass, np.array(robot.links["torso"].com)
+    return robot.mass, np.zeros(3)

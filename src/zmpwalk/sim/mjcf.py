@@ -167,6 +167,7 @@ def robot_mjcf(robot: RobotModel, mass_scale: float = 1.0) -> str:
     sensors = [
         '    <framepos name="pelvis_pos" objtype="site" objname="pelvis"/>',
         '    <framequat name="pelvis_quat" objtype="site" objname="pelvis"/>',
+        '    <gyro name="pelvis_gyro" site="pelvis"/>',
         '    <touch name="torso_touch" site="torso_touch"/>',
     ]
     for label in ("left", "right"):

@@ -102,7 +102,8 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
         mujoco.mju_mat2Quat(quaternion, rotation.T.flatten())  # site axes = pelvis axes at the zero pose
         spec.body(foot).add_site(name=f"{label}_ankle", pos=position, quat=quaternion, size=[0.005, 0.005, 0.005])
     sensors = [("pelvis_pos", mujoco.mjtSensor.mjSENS_FRAMEPOS, "pelvis"),
-               ("pelvis_quat", mujoco.mjtSensor.mjSENS_FRAMEQUAT, "pelvis")]
+               ("pelvis_quat", mujoco.mjtSensor.mjSENS_FRAMEQUAT, "pelvis"),
+               ("pelvis_gyro", mujoco.mjtSensor.mjSENS_GYRO, "pelvis")]
     for label in ("left", "right"):
         sensors += [(f"{label}_force", mujoco.mjtSensor.mjSENS_FORCE, f"{label}_ankle"),
                     (f"{label}_torque", mujoco.mjtSensor.mjSENS_TORQUE, f"{label}_ankle"),

@@ -40,7 +40,8 @@ from zmpwalk.kinematics import JOINT_COLUMNS, JointTrajectory
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sim.mjcf import contact_mapping
-from zmpwalk.sim.plant import build_plant, plant_qpos, set_initial_state, static_feedforward
+from zmpwalk.balance import BalanceMeasurement, Stabilizer
+from zmpwalk.sim.plant import Plant, build_plant, plant_qpos, set_initial_state, static_feedforward
 from zmpwalk.zmp import batch_hull_margin
 
 Array = NDArray[np.float64]
@@ -75,6 +76,8 @@ class SimulationResult:
         joint_names: The 12 joint column names.
         joint_angles, joint_velocities, joint_torques, joint_power: (n, 12) [rad], [rad/s], [N m], [W].
         mass_scale: Multiplier of all masses.
+        balance: The stabilizer's log per sample (``zmp_desired``, ``com_offset``, ``ankle_offsets``,
+            ``height_difference``, ``pelvis_turn``), or None open loop.
         final_feet_error: Largest horizontal distance of a simulated ankle from its planned final place [m]
             (nan after a fall).
         final_feet_yaw_error: Largest yaw error of a foot at the end [rad].
@@ -105,6 +108,7 @@ class SimulationResult:
     joint_power: Array
     mass_scale: float = 1.0
     joint_names: tuple[str, ...] = field(default=JOINT_COLUMNS)
+    balance: dict[str, Array] | None = None
     final_feet_error: float = math.nan  # [m]
     final_feet_yaw_error: float = math.nan  # [rad]
     end_min_sole_force: float = math.nan  # [N]
@@ -214,6 +218,9 @@ def simulate(
     settle: float | None = None,
     hold: float | None = None,
     feedforward: bool | None = None,
+    stabilizer: Stabilizer | None = None,
+    latency: float = 0.0,
+    noise: SensorNoise | None = None,
 ) -> SimulationResult:
     """Simulate ``joints`` (made from ``pattern``) on ``robot`` and measure the walk.
 
@@ -230,6 +237,10 @@ def simulate(
         feedforward: Add the static torque feedforward of :func:`zmpwalk.sim.plant.static_feedforward` to
             the servo references (default: on for a robot's own model, off for the box models, whose
             stiff servos the papers' results were measured with).
+        stabilizer: Close the loop with this :class:`~zmpwalk.balance.Stabilizer` (the same code as on the
+            robot, fed with the simulated sensors only); None walks open loop.
+        latency: Delay of every measurement the stabilizer gets [s] (0 to 0.1).
+        noise: Gaussian noise on the measurements (seeded; :class:`SensorNoise`).
 
     Returns:
         The measurements. The same input gives the same result.
@@ -248,6 +259,8 @@ def simulate(
         raise InvalidParameterError("settle", settle, "a time in [0, 10] s")
     if not 0.0 <= hold <= 60.0:
         raise InvalidParameterError("hold", hold, "a time in [0, 60] s")
+    if not 0.0 <= latency <= 0.1:
+        raise InvalidParameterError("latency", latency, "a delay in [0, 0.1] s")
     plant = build_plant(robot, mass_scale)
     if feedforward is None:
         feedforward = plant.imported
@@ -285,9 +298,13 @@ def simulate(
         qpos_path = plant_qpos(plant, base_path, yaw_path, reference)
         control += static_feedforward(plant, qpos_path, zmp_ref, pattern.support[index],
                                       (planned_ankles[0], planned_ankles[1]))
-    control = np.repeat(control, steps_per_tick, axis=0)[None]
-    _, readings = rollout.rollout(model, data, state[None], control)
-    readings = readings[0, steps_per_tick - 1::steps_per_tick]
+    balance_log: dict[str, Array] | None = None
+    if stabilizer is None:
+        _, readings = rollout.rollout(model, data, state[None], np.repeat(control, steps_per_tick, axis=0)[None])
+        readings = readings[0, steps_per_tick - 1::steps_per_tick]
+    else:
+        readings, balance_log = _closed_loop(model, data, plant, stabilizer, pattern, pattern_time, reference,
+                                             control, zmp_ref, steps_per_tick, sensors, latency, noise)
     # --- measurements
     pelvis = sensors.take(readings, "pelvis_pos")
     rpy = _rpy(sensors.take(readings, "pelvis_quat"))
@@ -358,4 +375,96 @@ def simulate(
         joint_velocities=velocities, joint_torques=torque, joint_power=torque * velocities, mass_scale=mass_scale,
         final_feet_error=feet_error, final_feet_yaw_error=feet_yaw_error, end_min_sole_force=end_force,
         end_max_speed=end_speed, end_attitude_range=end_attitude,
+        balance=None if balance_log is None else {k: v[:end] for k, v in balance_log.items()},
     )
+
+
+@dataclass(frozen=True)
+class SensorNoise:
+    """Standard deviations of Gaussian noise added to the stabilizer's measurements (seeded).
+
+    Attributes:
+        force: On each force component [N].
+        torque: On each torque component [N m].
+        attitude: On roll and pitch [rad].
+        rate: On each gyro axis [rad/s].
+        encoder: On each joint angle [rad].
+        seed: Of ``numpy.random.default_rng``.
+    """
+
+    force: float = 5.0  # [N]
+    torque: float = 0.5  # [N m]
+    attitude: float = 0.002  # [rad]
+    rate: float = 0.01  # [rad/s]
+    encoder: float = 0.0005  # [rad]
+    seed: int = 0
+
+
+def _measurement(row: Array, sensors: _Sensors) -> BalanceMeasurement:
+    """The stabilizer's inputs from one row of sensor data: the ground's wrench on each foot is the opposite
+    of what the ankle sensor between foot and leg reads (both in the foot frame)."""
+    def take(name: str) -> Array:
+        return row[sensors.slices[name]]
+
+    quaternion = take("pelvis_quat")
+    rpy = _rpy(quaternion[None])[0]
+    return BalanceMeasurement(
+        wrench_left=-np.concatenate([take("left_force"), take("left_torque")]),
+        wrench_right=-np.concatenate([take("right_force"), take("right_torque")]),
+        attitude=rpy[:2], rate=take("pelvis_gyro").copy(),
+        joint_angles=np.array([row[sensors.slices[f"{c}_q"]][0] for c in JOINT_COLUMNS]))
+
+
+def _closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabilizer: Stabilizer,
+                 pattern: WalkingPattern, pattern_time: Array, reference: Array, control: Array, zmp_ref: Array,
+                 steps_per_tick: int, sensors: _Sensors, latency: float,
+                 noise: SensorNoise | None) -> tuple[Array, dict[str, Array]]:
+    """Step the model tick by tick with the stabilizer in the loop; sensor rows (n, nsensordata) and its log."""
+    n = len(pattern_time)
+    interp = np.interp
+    com = np.column_stack([interp(pattern_time, pattern.time, pattern.position_pelvis_in_world[:, i])
+                           for i in range(3)])
+    yaw = interp(pattern_time, pattern.time, pattern.yaw_pelvis_in_world)
+    ankles = [np.column_stack([interp(pattern_time, pattern.time, a[:, i]) for i in range(3)])
+              for a in (pattern.position_left_ankle_in_world, pattern.position_right_ankle_in_world)]
+    foot_yaws = [interp(pattern_time, pattern.time, y) for y in (pattern.yaw_left_foot_in_world,
+                                                                 pattern.yaw_right_foot_in_world)]
+    support = pattern.support[np.clip(np.searchsorted(pattern.time, pattern_time - 1e-9), 0, len(pattern.time) - 1)]
+    offsets = control[:, plant.leg_actuators] - reference  # the feedforward's share of the leg controls
+    readings = np.empty((n, model.nsensordata))
+    delay = round(latency * CONTROL_RATE)
+    rng = np.random.default_rng(noise.seed) if noise else None
+    log = {"zmp_desired": np.empty((n, 2)), "com_offset": np.empty((n, 2)), "ankle_offsets": np.empty((n, 4)),
+           "height_difference": np.empty(n), "pelvis_turn": np.empty((n, 2))}
+    mujoco.mj_forward(model, data)
+    current = data.sensordata.copy()
+    stabilizer.reset()
+    for k in range(n):
+        row = current if k - 1 - delay < 0 else readings[k - 1 - delay]
+        measurement = _measurement(row, sensors)
+        if rng is not None and noise is not None:
+            measurement.wrench_left += rng.normal(0, [noise.force] * 3 + [noise.torque] * 3)
+            measurement.wrench_right += rng.normal(0, [noise.force] * 3 + [noise.torque] * 3)
+            measurement.attitude = measurement.attitude + rng.normal(0, noise.attitude, 2)
+            measurement.rate = measurement.rate + rng.normal(0, noise.rate, 3)
+            measurement.joint_angles = measurement.joint_angles + rng.normal(0, noise.encoder, 12)
+        angles = stabilizer.update(
+            support=int(support[k]), position_com_in_world=com[k], yaw_pelvis_in_world=float(yaw[k]),
+            zmp_in_world=zmp_ref[k], ankles_in_world=(ankles[0][k], ankles[1][k]),
+            foot_yaws=(float(foot_yaws[0][k]), float(foot_yaws[1][k])), joint_angles=reference[k],
+            measurement=measurement)
+        data.ctrl[:] = control[k]
+        data.ctrl[plant.leg_actuators] = angles + offsets[k]
+        for _ in range(steps_per_tick):
+            mujoco.mj_step(model, data)
+        readings[k] = data.sensordata
+        state = stabilizer.state
+        log["zmp_desired"][k] = state.zmp_desired
+        log["com_offset"][k] = state.com_offset
+        log["ankle_offsets"][k] = state.ankle_offsets.ravel()
+        log["height_difference"][k] = state.height_difference
+        log["pelvis_turn"][k] = state.pelvis_turn
+        if not np.all(np.isfinite(data.qpos)):
+            readings[k + 1:] = readings[k]
+            break
+    return readings, log
