@@ -159,6 +159,7 @@ class Stabilizer:
         self._half_length = robot.foot_length / 2
         self._half_width = robot.foot_width / 2
         self._sole_centre = np.array([robot.sole_center_x, robot.sole_center_y])
+        self._angles = np.empty((2, 6))  # work buffer: measured and reference angles of one leg
         self.reset()
 
     def reset(self) -> None:
@@ -214,11 +215,16 @@ class Stabilizer:
         q = np.asarray(measurement.joint_angles, dtype=float)
         com_in_base = self._rest_mass * self._rest_com
         relative = np.empty((2, 3))
+        reference_angles = np.asarray(joint_angles, dtype=float)
+        kinematics = []  # per leg: transforms of (measured, reference) angles, computed once
         for index, chain in enumerate(self.chains):
-            angles = np.empty(6)
-            angles[self._orders[index]] = q[6 * index:6 * index + 6]
-            com_in_base = com_in_base + chain.link_masses @ chain.link_com_positions(angles[None])[0]
-            relative[index] = chain.fk(angles[None])[0][0]
+            angles = self._angles
+            angles[0, self._orders[index]] = q[6 * index:6 * index + 6]
+            angles[1, self._orders[index]] = reference_angles[6 * index:6 * index + 6]
+            transforms = chain.transforms(angles)
+            kinematics.append((angles[1:].copy(), (transforms[0][1:], transforms[1][1:])))
+            com_in_base = com_in_base + chain.link_masses @ chain.link_com_positions(angles, transforms)[0]
+            relative[index] = chain.fk(angles, transforms)[0][0]
         com_in_base = com_in_base / self._mass
         anchor = 0 if forces[0] >= forces[1] else 1
         arm = rotation @ (com_in_base - relative[anchor])
@@ -237,10 +243,7 @@ class Stabilizer:
         zmp_desired = np.asarray(zmp_in_world, dtype=float) + (1.0 + g.dcm / omega) * dcm_error
         zmp_desired = self._clamp(zmp_desired, support, ankles_in_world, foot_yaws)
         # --- 2. CoM admittance
-        if loaded.any():
-            acceleration = g.com_admittance * (zmp_measured - zmp_desired)
-        else:
-            acceleration = np.zeros(2)
+        acceleration = g.com_admittance * (zmp_measured - zmp_desired) if loaded.any() else np.zeros(2)
         acceleration -= g.com_damping * self._offset_rate + g.com_stiffness * self._offset
         self._offset_rate += acceleration * dt
         self._offset += self._offset_rate * dt
@@ -270,15 +273,13 @@ class Stabilizer:
                        - g.attitude_damping * np.asarray(measurement.rate, dtype=float)[:2],
                        -g.attitude_limit, g.attitude_limit)
         # --- corrections of the feet relative to the pelvis, onto the joints through the Jacobians
-        reference_angles = np.asarray(joint_angles, dtype=float)
         result = reference_angles.copy()
         shift_in_pelvis = _rotate(self._offset, -yaw_pelvis_in_world)
         pelvis_turn = np.array([turn[0], turn[1], 0.0])
         for index, chain in enumerate(self.chains):
-            angles = np.empty(6)
-            angles[self._orders[index]] = reference_angles[6 * index:6 * index + 6]
-            position, _ = chain.fk(angles[None])
-            jacobian = chain.jacobian(angles[None])[0]
+            angles, transforms = kinematics[index]
+            position, _ = chain.fk(angles, transforms)
+            jacobian = chain.jacobian(angles, transforms)[0]
             foot_turn = _rotate(self._ankle[index], foot_yaws[index] - yaw_pelvis_in_world)
             change = np.empty(6)
             change[:2] = -shift_in_pelvis

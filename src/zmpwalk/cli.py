@@ -86,6 +86,19 @@ def _schedule(args: argparse.Namespace) -> Schedule | None:
     return Schedule.from_file(path)
 
 
+def _balance_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--balance", choices=("on", "off"), default=None,
+                        help="close the loop with the stabilizer on the simulated sensors (default: on for a "
+                        "robot's own model, off for the built-in box models)")
+    parser.add_argument("--latency", type=float, default=0.0, help="sensor latency of the stabilizer [s]")
+
+
+def _balance(args: argparse.Namespace, robot: RobotModel) -> bool:
+    if args.balance is None:
+        return robot.plant is not None
+    return bool(args.balance == "on")
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="zmpwalk",
@@ -142,6 +155,7 @@ def _parser() -> argparse.ArgumentParser:
     simulate_cmd.add_argument("--steady-steps", type=int, default=2, help="steady steps of --paper-example")
     _robot_options(simulate_cmd)
     simulate_cmd.add_argument("--schedule", type=Path, help="your own parameter tables (TOML)")
+    _balance_options(simulate_cmd)
     simulate_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
     simulate_cmd.add_argument("--mass-scale", type=float, default=1.0, help="multiply every mass (default 1)")
     simulate_cmd.add_argument("--out", type=Path, help="folder for the result files")
@@ -164,6 +178,8 @@ def _parser() -> argparse.ArgumentParser:
                                 help="built-in scenario" + (" (default: demo)" if name == "demo" else ""))
         report_cmd.add_argument("--steps", type=Path, help="steps file (TOML) instead of a scenario")
         _robot_options(report_cmd)
+        report_cmd.add_argument("--schedule", type=Path, help="your own parameter tables (TOML)")
+        _balance_options(report_cmd)
         report_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
         default_out = Path("zmpwalk-demo" if name == "demo" else "zmpwalk-report")
         report_cmd.add_argument("--out", type=Path, default=default_out,
@@ -245,7 +261,8 @@ def _report(args: argparse.Namespace) -> int:
     with _source(str(args.steps) if args.steps else f"scenario {args.scenario}"):
         report = build_report(robot, commands, args.out, title=f"zmpwalk: {robot.name}, {name}",
                               generator=args.generator, animate=not args.no_animation,
-                              progress=None if quiet else _progress, labels=labels)
+                              progress=None if quiet else _progress, labels=labels,
+                              balance=_balance(args, robot), latency=args.latency, schedule=_schedule(args))
     if args.json:
         summary = {**report.summary, "index": str(report.index), "seconds": report.seconds}
         print(json.dumps(_json_safe(summary), indent=2, allow_nan=False))
@@ -276,14 +293,21 @@ def _simulate(args: argparse.Namespace) -> int:
         with _source(_label(args)):
             pattern = make(robot, commands, rate=1000.0, labels=labels, **options)
     joints = pattern_joint_trajectory(pattern, check_limits=False)
-    result = simulate(robot, joints, pattern, mass_scale=args.mass_scale)
+    from zmpwalk.balance import Stabilizer
+
+    stabilizer = Stabilizer(robot, 1000.0) if _balance(args, robot) else None
+    result = simulate(robot, joints, pattern, mass_scale=args.mass_scale, stabilizer=stabilizer,
+                      latency=args.latency)
     rows = actuator_table(result)
     rms, largest = result.cop_error_stats()
     summary = {
         "robot": robot.name, "fell": result.fell, "fall_time": result.fall_time, "duration": float(result.time[-1]),
         "distance": result.distance, "average_speed": result.average_speed, "foot_slip": result.foot_slip,
         "cop_error_rms": rms, "cop_error_max": largest, "min_cop_margin": float(np.nanmin(result.cop_margin)),
-        "mass_scale": result.mass_scale,
+        "mass_scale": result.mass_scale, "balance": stabilizer is not None,
+        "final_feet_error": result.final_feet_error, "final_feet_yaw_error": result.final_feet_yaw_error,
+        "end_min_sole_force": result.end_min_sole_force, "end_max_speed": result.end_max_speed,
+        "end_attitude_range": result.end_attitude_range,
         "actuators": [vars(row) for row in rows],
     }
     if args.out:

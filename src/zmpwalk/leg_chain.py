@@ -81,7 +81,7 @@ class IKConvergenceError(ZmpwalkError, ValueError):
         )
 
 
-def _rodrigues(axis: Array, angle: Array) -> Array:
+def _rodrigues(axis: Array, angle: Array) -> Array:  # the IK's few rotations; transforms() has its own
     """Rotation matrices about a fixed unit ``axis`` (3,) by ``angle`` (n,), shape (n, 3, 3)."""
     x, y, z = axis
     k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
@@ -172,13 +172,13 @@ class LegChain:
     link_masses: Array = field(default_factory=lambda: np.zeros(6))
     link_coms: Array = field(default_factory=lambda: np.zeros((6, 3)))
 
-    def link_com_positions(self, q: Array) -> Array:
+    def link_com_positions(self, q: Array, transforms: tuple[Array, Array] | None = None) -> Array:
         """Centres of mass of the six moving segments in the pelvis frame [m], (n, 6, 3).
 
         Segment ``i`` is everything joint ``i`` moves up to the next joint; :attr:`link_coms` holds its
         centre of mass at ``q = 0``.
         """
-        rotations, translations = self.transforms(q)
+        rotations, translations = self.transforms(q) if transforms is None else transforms
         return np.asarray(np.einsum("nkij,kj->nki", rotations[:, 1:], self.link_coms) + translations[:, 1:])
 
     @property
@@ -217,39 +217,43 @@ class LegChain:
         return _closest_point_to_lines(self.points[4:], self.axes[4:])[0]
 
     # --- forward kinematics -------------------------------------------------------------------------------
+    def __post_init__(self) -> None:
+        skews = np.array([[[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]] for w in self.axes])
+        object.__setattr__(self, "_skews", skews)
+        object.__setattr__(self, "_skews2", skews @ skews)
+
     def transforms(self, q: Array) -> tuple[Array, Array]:
         """Cumulative rotations (n, 7, 3, 3) and translations (n, 7, 3): ``prod_{j<i} exp(xi_j q_j)``, i = 0..6."""
         q = np.atleast_2d(q)
         n = len(q)
         rotations = np.empty((n, 7, 3, 3))
         translations = np.empty((n, 7, 3))
-        rotation = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
-        translation = np.zeros((n, 3))
-        rotations[:, 0], translations[:, 0] = rotation, translation
+        rotations[:, 0] = np.eye(3)
+        translations[:, 0] = 0.0
+        sines, cosines = np.sin(q), 1.0 - np.cos(q)
+        skews, skews2 = self._skews, self._skews2  # type: ignore[attr-defined]
         for i in range(6):
-            r_i = _rodrigues(self.axes[i], q[:, i])
+            r_i = np.eye(3) + sines[:, i, None, None] * skews[i] + cosines[:, i, None, None] * skews2[i]
             t_i = self.points[i] - r_i @ self.points[i]  # exp(xi q): x -> R x + (I - R) r
-            translation = translation + np.einsum("nij,nj->ni", rotation, t_i)
-            rotation = rotation @ r_i
-            rotations[:, i + 1], translations[:, i + 1] = rotation, translation
+            translations[:, i + 1] = translations[:, i] + np.einsum("nij,nj->ni", rotations[:, i], t_i)
+            rotations[:, i + 1] = rotations[:, i] @ r_i
         return rotations, translations
 
-    def fk(self, q: Array) -> tuple[Array, Array]:
+    def fk(self, q: Array, transforms: tuple[Array, Array] | None = None) -> tuple[Array, Array]:
         """Ankle position [m] (n, 3) and foot rotation (n, 3, 3) in the pelvis frame for angles (n, 6) [rad]."""
-        rotations, translations = self.transforms(q)
+        rotations, translations = self.transforms(q) if transforms is None else transforms
         rotation, translation = rotations[:, 6], translations[:, 6]
         return translation + rotation @ self.ankle, rotation
 
-    def jacobian(self, q: Array) -> Array:
+    def jacobian(self, q: Array, transforms: tuple[Array, Array] | None = None) -> Array:
         """Geometric Jacobian of the ankle point in the pelvis frame, (n, 6, 6): rows (v, omega)."""
-        rotations, translations = self.transforms(q)
+        rotations, translations = self.transforms(q) if transforms is None else transforms
         ankle = translations[:, 6] + rotations[:, 6] @ self.ankle
+        axes = np.einsum("nkij,kj->nki", rotations[:, :6], self.axes)  # (n, 6, 3)
+        origins = np.einsum("nkij,kj->nki", rotations[:, :6], self.points) + translations[:, :6]
         jacobian = np.empty((len(ankle), 6, 6))
-        for i in range(6):
-            axis = rotations[:, i] @ self.axes[i]
-            origin = translations[:, i] + rotations[:, i] @ self.points[i]
-            jacobian[:, :3, i] = np.cross(axis, ankle - origin)
-            jacobian[:, 3:, i] = axis
+        jacobian[:, :3, :] = np.swapaxes(np.cross(axes, ankle[:, None, :] - origins), 1, 2)
+        jacobian[:, 3:, :] = np.swapaxes(axes, 1, 2)
         return jacobian
 
     # --- inverse kinematics -------------------------------------------------------------------------------

@@ -18,11 +18,13 @@ from typing import Any
 
 import numpy as np
 
+from zmpwalk.balance import Stabilizer
 from zmpwalk.commands import StepCommand
 from zmpwalk.kinematics import pattern_joint_trajectory
 from zmpwalk.patterns import generator as pattern_generator
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.schedule import Schedule
 from zmpwalk.sim.actuators import ActuatorRow, actuator_markdown, actuator_table, write_actuator_csv
 from zmpwalk.sim.run import simulate
 
@@ -71,6 +73,9 @@ def build_report(
     animate: bool = True,
     progress: Progress | None = None,
     labels: Sequence[str] | None = None,
+    balance: bool = False,
+    latency: float = 0.0,
+    schedule: Schedule | None = None,
 ) -> Report:
     """Generate, check, simulate and report a walk into ``folder``.
 
@@ -89,12 +94,14 @@ def build_report(
         if progress:
             progress(stage, STAGES.index(stage) + 1, len(STAGES))
 
-    pattern = pattern_generator(generator)(robot, commands, rate=1000.0, labels=labels)
+    options = {"schedule": schedule} if schedule is not None else {}
+    pattern = pattern_generator(generator)(robot, commands, rate=1000.0, labels=labels, **options)
     pattern.write_csv(folder / "pattern.csv")
     done("pattern")
     joints = pattern_joint_trajectory(pattern)
     done("joints")
-    result = simulate(robot, joints, pattern)
+    stabilizer = Stabilizer(robot, 1000.0) if balance else None
+    result = simulate(robot, joints, pattern, stabilizer=stabilizer, latency=latency)
     rows = actuator_table(result)
     write_actuator_csv(rows, folder / "actuators.csv")
     done("simulation")
@@ -108,6 +115,8 @@ def build_report(
         "Right leg: joint angles, torques and powers in the simulation (Figs. 12-14 of Lim et al.)":
             plots.joints(result),
     }
+    if result.balance is not None:
+        images["The stabilizer: pattern ZMP, desired ZMP and measured CoP; its corrections"] = plots.balance(result)
     for index, payload in enumerate(images.values()):
         (folder / f"figure{index + 1}.png").write_bytes(payload)
     done("plots")
@@ -128,7 +137,7 @@ def build_report(
         "robot": robot.name, "generator": generator, "duration": pattern.duration, "swings": len(pattern.steps),
         "min_zmp_margin": margin, "min_zmp_margin_time": at, "fell": result.fell, "fall_time": result.fall_time,
         "distance": result.distance, "average_speed": result.average_speed, "foot_slip": result.foot_slip,
-        "cop_error_rms": rms, "cop_error_max": largest,
+        "cop_error_rms": rms, "cop_error_max": largest, "balance": result.balance is not None,
     }
     page = _page(title, robot, report.summary, images, animation, animation_note, step_margins(pattern), rows)
     report.index.write_text(page, encoding="utf-8")

@@ -104,3 +104,25 @@ def joints(result: SimulationResult) -> bytes:
     axes[0].legend(loc="upper right", fontsize=7, ncol=3)
     axes[0].set_title("Right leg: joint angles, torques and powers (simulation)")
     return _png(figure)
+
+
+def balance(result: SimulationResult) -> bytes:
+    """The stabilizer at work: reference ZMP, desired ZMP and measured CoP (x, y), and its corrections."""
+    if result.balance is None:
+        raise ValueError("the walk was simulated open loop (no stabilizer log)")
+    log = result.balance
+    figure, axes = plt.subplots(3, 1, figsize=(9, 7.5), sharex=True)
+    for axis, (index, label) in zip(axes[:2], ((0, "x"), (1, "y")), strict=True):
+        axis.plot(result.time, result.reference_zmp[:, index], label="pattern ZMP", color="0.4")
+        axis.plot(result.time, log["zmp_desired"][:, index], label="desired ZMP (DCM feedback)", color="tab:orange")
+        axis.plot(result.time, result.cop[:, index], label="measured CoP", color="tab:blue", linewidth=0.8)
+        axis.set_ylabel(f"{label} [m]")
+        axis.legend(loc="upper left", fontsize=8)
+    axes[2].plot(result.time, log["com_offset"][:, 0] * 1e3, label="CoM offset x [mm]")
+    axes[2].plot(result.time, log["com_offset"][:, 1] * 1e3, label="CoM offset y [mm]")
+    axes[2].plot(result.time, np.degrees(log["ankle_offsets"][:, 0]), label="left ankle roll offset [deg]")
+    axes[2].plot(result.time, np.degrees(log["ankle_offsets"][:, 1]), label="left ankle pitch offset [deg]")
+    axes[2].plot(result.time, log["height_difference"] * 1e3, label="foot height difference [mm]")
+    axes[2].set_xlabel("t [s]")
+    axes[2].legend(loc="upper left", fontsize=8, ncol=2)
+    return _png(figure)

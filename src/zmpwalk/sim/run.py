@@ -35,12 +35,12 @@ import numpy as np
 from mujoco import rollout
 from numpy.typing import NDArray
 
+from zmpwalk.balance import BalanceMeasurement, Stabilizer
 from zmpwalk.errors import InvalidParameterError
 from zmpwalk.kinematics import JOINT_COLUMNS, JointTrajectory
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sim.mjcf import contact_mapping
-from zmpwalk.balance import BalanceMeasurement, Stabilizer
 from zmpwalk.sim.plant import Plant, build_plant, plant_qpos, set_initial_state, static_feedforward
 from zmpwalk.zmp import batch_hull_margin
 
