@@ -9,8 +9,9 @@ stabilization of the HRP-4 humanoid robot using whole-body admittance control*, 
 needs only what a position-controlled robot has (no torque control) and each of its parts is a small,
 separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega = sqrt(g / l)``:
 
-1. **DCM tracking.** The CoM ``c`` is estimated from the encoders and the IMU, anchored at the loaded sole
-   (kinematic odometry); the divergent component of motion ``xi = c + c' / omega`` must follow the
+1. **DCM tracking.** The CoM ``c`` is estimated from the encoders and the IMU, anchored at the loaded sole,
+   whose place in world comes from leg odometry (when the load passes to the other sole, that sole is
+   placed from the measured kinematics), so a step landed short shows as a DCM error; the divergent component of motion ``xi = c + c' / omega`` must follow the
    pattern's. Its error ``e = xi - xi_ref`` decays at rate ``k_xi`` when the ZMP is
 
    .. math:: p_d = p_{ref} + (1 + k_\xi / \omega)\, e, \qquad \dot e = -k_\xi e
@@ -66,6 +67,9 @@ class StabilizerGains:
         attitude_limit: Largest pelvis turn [rad].
         zmp_margin: ``p_d`` is kept this far inside the support polygon [m].
         velocity_filter: Time constant of the CoM velocity estimate's low-pass filter [s].
+        landing_time_constant: How fast a swinging foot's aim moves to its planned place in world [s].
+        landing_release: How fast that correction is released once the foot carries load [s].
+        landing_limit: Largest landing correction [m].
     """
 
     dcm: float = 3.0  # [1/s]
@@ -84,6 +88,9 @@ class StabilizerGains:
     attitude_limit: float = 0.15  # [rad]
     zmp_margin: float = 0.01  # [m]
     velocity_filter: float = 0.01  # [s]
+    landing_time_constant: float = 0.05  # [s]
+    landing_release: float = 0.3  # [s]
+    landing_limit: float = 0.1  # [m]
 
     def __post_init__(self) -> None:
         for name, value in vars(self).items():
@@ -172,6 +179,9 @@ class Stabilizer:
         self._offset_rate = np.zeros(2)
         self._ankle = np.zeros((2, 2))
         self._height = 0.0
+        self._feet = np.zeros((2, 2))  # estimated ankle positions in world (leg odometry) [m]
+        self._landing = np.zeros((2, 2))  # landing corrections of the feet in world [m]
+        self._anchor = 0
         self.state = BalanceState(np.zeros(2), np.full(2, np.nan), np.zeros(2), np.zeros(2), np.zeros((2, 2)),
                                   0.0, np.zeros(2))
 
@@ -199,16 +209,6 @@ class Stabilizer:
         # --- measured sole wrenches: CoPs in world and the total ZMP
         forces = np.array([measurement.wrench_left[2], measurement.wrench_right[2]])
         loaded = forces > 0.05 * self._mass * self.robot.gravity
-        cops = np.zeros((2, 2))
-        for foot, wrench in enumerate((measurement.wrench_left, measurement.wrench_right)):
-            if loaded[foot]:
-                h = self.robot.ankle_height
-                local = np.array([-(wrench[4] + h * wrench[0]) / wrench[2], (wrench[3] - h * wrench[1]) / wrench[2]])
-                cops[foot] = ankles_in_world[foot][:2] + _rotate(local, foot_yaws[foot])
-        zmp_measured = np.full(2, np.nan)
-        if loaded.any():
-            weights = np.where(loaded, forces, 0.0)
-            zmp_measured = (weights @ cops) / weights.sum()
         # --- CoM estimate: kinematics of the measured legs, tilted by the IMU, anchored at the loaded sole
         roll, pitch = float(measurement.attitude[0]), float(measurement.attitude[1])
         rotation = _rz(yaw_pelvis_in_world) @ _ry(pitch) @ _rx(roll)
@@ -226,12 +226,35 @@ class Stabilizer:
             com_in_base = com_in_base + chain.link_masses @ chain.link_com_positions(angles, transforms)[0]
             relative[index] = chain.fk(angles, transforms)[0][0]
         com_in_base = com_in_base / self._mass
-        anchor = 0 if forces[0] >= forces[1] else 1
-        arm = rotation @ (com_in_base - relative[anchor])
-        com = ankles_in_world[anchor][:2] + arm[:2]
         if not self._started:
             self._previous_relative = relative.copy()
+            self._feet = np.array([ankles_in_world[0][:2], ankles_in_world[1][:2]], dtype=float)
+            self._anchor = 0 if forces[0] >= forces[1] else 1
             self._started = True
+        # Leg odometry: when the load moves to the other sole, place it from the measured kinematics.
+        anchor = 0 if forces[0] >= forces[1] else 1
+        if anchor != self._anchor and loaded.all():
+            self._feet[anchor] = self._feet[self._anchor] + (rotation @ (relative[anchor] - relative[self._anchor]))[:2]
+            self._anchor = anchor
+        anchor = self._anchor
+        arm = rotation @ (com_in_base - relative[anchor])
+        com = self._feet[anchor] + arm[:2]
+        # Where the feet are (odometry; the swing foot follows from the stance foot and the kinematics): the
+        # measured CoPs, the support polygon and the wrench distribution use these places.
+        feet = [self._feet[anchor], self._feet[anchor] + (rotation @ (relative[1 - anchor] - relative[anchor]))[:2]]
+        if anchor == 1:
+            feet.reverse()
+        cops = np.zeros((2, 2))
+        for foot, wrench in enumerate((measurement.wrench_left, measurement.wrench_right)):
+            if loaded[foot]:
+                h = self.robot.ankle_height
+                local = np.array([-(wrench[4] + h * wrench[0]) / wrench[2], (wrench[3] - h * wrench[1]) / wrench[2]])
+                cops[foot] = feet[foot] + _rotate(local, foot_yaws[foot])
+        zmp_measured = np.full(2, np.nan)
+        if loaded.any():
+            weights = np.where(loaded, forces, 0.0)
+            zmp_measured = (weights @ cops) / weights.sum()
+        measured_feet = (feet[0], feet[1])
         previous_arm = rotation @ (com_in_base - self._previous_relative[anchor])
         spin = rotation @ np.asarray(measurement.rate, dtype=float)
         raw_velocity = (arm[:2] - previous_arm[:2]) / dt + np.cross(spin, arm)[:2]
@@ -241,7 +264,7 @@ class Stabilizer:
         # --- 1. DCM feedback -> desired ZMP inside the support polygon
         dcm_error = (com + self._com_velocity / omega) - (reference + velocity_reference / omega)
         zmp_desired = np.asarray(zmp_in_world, dtype=float) + (1.0 + g.dcm / omega) * dcm_error
-        zmp_desired = self._clamp(zmp_desired, support, ankles_in_world, foot_yaws)
+        zmp_desired = self._clamp(zmp_desired, support, measured_feet, foot_yaws)
         # --- 2. CoM admittance
         acceleration = g.com_admittance * (zmp_measured - zmp_desired) if loaded.any() else np.zeros(2)
         acceleration -= g.com_damping * self._offset_rate + g.com_stiffness * self._offset
@@ -252,7 +275,7 @@ class Stabilizer:
             self._offset *= g.com_limit / norm
             self._offset_rate *= 0.0
         # --- 3. ankle damping: each loaded sole's CoP follows its share of p_d
-        shares, targets = self._distribute(zmp_desired, support, ankles_in_world, foot_yaws)
+        shares, targets = self._distribute(zmp_desired, support, measured_feet, foot_yaws)
         decay = dt / g.ankle_time_constant
         for foot in range(2):
             if loaded[foot] and shares[foot] > 0.0:
@@ -272,17 +295,32 @@ class Stabilizer:
         turn = np.clip(-g.attitude_gain * np.array([roll, pitch])
                        - g.attitude_damping * np.asarray(measurement.rate, dtype=float)[:2],
                        -g.attitude_limit, g.attitude_limit)
+        # --- 6. landing: a swinging foot aims at its planned place in world from where the base is (odometry),
+        # not where the plan has it; the correction is released once the foot carries load.
+        base_estimate = self._feet[anchor] - (rotation @ relative[anchor])[:2]
+        planned_relative = [chain.fk(angles, transforms)[0][0] for chain, (angles, transforms)
+                            in zip(self.chains, kinematics, strict=True)]
+        yaw_rotation = _rz(yaw_pelvis_in_world)
+        base_planned = np.asarray(ankles_in_world[anchor], dtype=float)[:2] - (yaw_rotation @ planned_relative[anchor])[:2]
+        for foot in range(2):
+            swinging = (support == 1 and foot == 1) or (support == 2 and foot == 0)
+            if swinging:
+                target = base_planned + self._offset - base_estimate
+                self._landing[foot] += dt / g.landing_time_constant * (target - self._landing[foot])
+            else:
+                self._landing[foot] -= dt / g.landing_release * self._landing[foot]
+        np.clip(self._landing, -g.landing_limit, g.landing_limit, out=self._landing)
         # --- corrections of the feet relative to the pelvis, onto the joints through the Jacobians
         result = reference_angles.copy()
         shift_in_pelvis = _rotate(self._offset, -yaw_pelvis_in_world)
         pelvis_turn = np.array([turn[0], turn[1], 0.0])
         for index, chain in enumerate(self.chains):
             angles, transforms = kinematics[index]
-            position, _ = chain.fk(angles, transforms)
+            position = planned_relative[index][None]
             jacobian = chain.jacobian(angles, transforms)[0]
             foot_turn = _rotate(self._ankle[index], foot_yaws[index] - yaw_pelvis_in_world)
             change = np.empty(6)
-            change[:2] = -shift_in_pelvis
+            change[:2] = _rotate(self._landing[index], -yaw_pelvis_in_world) - shift_in_pelvis
             change[2] = -self._height / 2 if index == 0 else self._height / 2
             change[:3] -= np.cross(pelvis_turn, position[0])
             change[3:5] = foot_turn

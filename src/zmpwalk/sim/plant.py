@@ -169,26 +169,29 @@ def plant_qpos(plant: Plant, position_base: Array, yaw: Array, angles: Array) ->
 
 
 def static_feedforward(plant: Plant, qpos: Array, zmp: Array, support: NDArray[np.integer],
-                       ankles: tuple[Array, Array]) -> Array:
-    r"""Control offsets (n, nu) [rad] that make the position servos hold each planned pose.
+                       ankles: tuple[Array, Array], rate: float = 1000.0, dynamic: bool = True) -> Array:
+    r"""Control offsets (n, nu) [rad] that make the position servos deliver the planned motion's joint torques.
 
-    A position servo ``kp (u - q)`` holding a joint against a static torque ``tau`` sags by ``tau / kp``
-    (TALOS's knees: 0.09 rad; Booster T1's: 0.35 rad). zmpwalk computes that torque from the model,
-    quasi-statically, for the planned pose and the planned ground reaction:
+    A position servo ``kp (u - q)`` that must deliver a torque ``tau`` lags by ``tau / kp`` (standing, TALOS's
+    knees sag 0.09 rad and Booster T1's 0.35 rad; swinging, TALOS's 16 kg leg on 1000 N m/rad servos
+    touches down 30 mm short). zmpwalk computes that torque from the model by inverse dynamics of the
+    planned motion with the planned ground reaction:
 
-    .. math:: \tau = g(q) - \sum_{feet} J_{foot}^T w_{foot}
+    .. math:: \tau = M(q)\ddot q + C(q, \dot q) + g(q) - \sum_{feet} J_{foot}^T w_{foot}
 
-    with ``g`` the generalised gravity (MuJoCo's RNE at rest), ``w`` each sole's wrench: the weight at the
-    planned ZMP, carried by the stance foot in single support and split between the feet by where the
-    ZMP lies between them in double support. The reference of each position actuator becomes
-    ``u = q_ref + tau / (kp gear^2)``. Accelerations are left to the servos (the gait is slow against
-    their bandwidth); the offsets only remove the sag.
+    with ``q`` the planned poses (base included), ``q', q''`` their central differences, and ``w`` each
+    sole's planned wrench: the force ``m (c'' + g)`` of the pattern's CoM acceleration at the planned ZMP,
+    on the stance foot in single support and split between the feet by where the ZMP lies between them in
+    double support. The reference of each position actuator becomes ``u = q_ref + tau / (kp gear^2)``.
+    ``dynamic=False`` keeps only gravity and the static reaction (``q' = q'' = 0``).
 
     Args:
-        qpos: Planned poses (n, nq) (:func:`plant_qpos`).
+        qpos: Planned poses (n, nq) (:func:`plant_qpos`) at ``rate``.
         zmp: Planned ZMP in world [m], (n, 2).
         support: 0 double, 1 left, 2 right, (n,).
         ankles: Planned left and right ankle positions in world [m], each (n, 3).
+        rate: Rows per second [Hz].
+        dynamic: Include the inertial terms and the horizontal reaction.
     """
     model = plant.model
     data = mujoco.MjData(model)
@@ -203,19 +206,35 @@ def static_feedforward(plant: Plant, qpos: Array, zmp: Array, support: NDArray[n
     stiffness = np.array([model.actuator_gainprm[a][0] * model.actuator_gear[a][0] ** 2
                           for a in position_actuators])
     sites = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, f"{s}_ankle") for s in ("left", "right")]
-    weight = float(np.sum(model.body_mass)) * -float(model.opt.gravity[2])
-    stride = max(1, round(FEEDFORWARD_PERIOD * CONTROL_RATE_HINT))
+    mass = float(np.sum(model.body_mass))
+    gravity = -float(model.opt.gravity[2])
+    stride = max(1, round(FEEDFORWARD_PERIOD * rate))
     keys = np.unique(np.append(np.arange(0, n, stride), n - 1))
     torques = np.empty((len(keys), len(position_actuators)))
-    bias = np.zeros(model.nv)
+    result = np.zeros(model.nv)
     jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
+    before, after = np.zeros(model.nv), np.zeros(model.nv)
+    h = stride / rate
     for row, k in enumerate(keys):
         data.qpos[:] = qpos[k]
         data.qvel[:] = 0.0
+        data.qacc[:] = 0.0
+        com_acceleration = np.zeros(2)
+        if dynamic and stride <= k < n - stride:
+            mujoco.mj_differentiatePos(model, before, h, qpos[k - stride], qpos[k])
+            mujoco.mj_differentiatePos(model, after, h, qpos[k], qpos[k + stride])
+            data.qvel[:] = (before + after) / 2
+            data.qacc[:] = (after - before) / h
         mujoco.mj_kinematics(model, data)
         mujoco.mj_comPos(model, data)
-        mujoco.mj_rne(model, data, 0, bias)
-        tau = bias.copy()
+        if dynamic:
+            mujoco.mj_comVel(model, data)
+        mujoco.mj_rne(model, data, 1 if dynamic else 0, result)
+        tau = result.copy()
+        if dynamic and stride <= k < n - stride:
+            # the CoM acceleration the ZMP implies (cart-table, Eqs. 1-2 of Park et al.): c'' = (g / l)(c - p)
+            com = data.subtree_com[0]
+            com_acceleration = gravity / max(float(com[2]), 1e-6) * (com[:2] - zmp[k])
         left, right = ankles[0][k, :2], ankles[1][k, :2]
         if support[k] == 1:
             shares = (1.0, 0.0)
@@ -230,7 +249,7 @@ def static_feedforward(plant: Plant, qpos: Array, zmp: Array, support: NDArray[n
             if share == 0.0:
                 continue
             cop = np.append(ankle + (zmp[k] - base_point), 0.0)  # this sole's CoP, keeping the total at the ZMP
-            force = np.array([0.0, 0.0, share * weight])
+            force = share * mass * np.array([com_acceleration[0], com_acceleration[1], gravity])
             moment = np.cross(cop - data.site_xpos[site], force)
             mujoco.mj_jacSite(model, data, jacp, jacr, site)
             tau -= jacp.T @ force + jacr.T @ moment
@@ -240,4 +259,18 @@ def static_feedforward(plant: Plant, qpos: Array, zmp: Array, support: NDArray[n
     return offsets
 
 
-CONTROL_RATE_HINT = 1000.0  # [Hz] rows per second of the control series given to static_feedforward
+def damping_feedforward(plant: Plant, velocities: Array) -> Array:
+    """Control offsets (n, 12) [rad] that cancel the lag of the leg servos' damping at the planned joint rates.
+
+    MuJoCo's position servo applies ``kp (u - q) - kv q'``: at a steady rate ``q'`` it lags by ``kv q' / kp``
+    (TALOS's hip: 0.027 rad at 1 rad/s, 19 mm at the foot). With ``u = q_ref + (kv / kp) q'_ref`` it
+    tracks the reference: the damping then acts on the rate error, as a PD servo with a velocity
+    reference does.
+
+    Args:
+        velocities: Planned joint rates [rad/s], (n, 12) in the leg-column order.
+    """
+    model = plant.model
+    ratio = np.array([-model.actuator_biasprm[a][2] / model.actuator_gainprm[a][0] for a in plant.leg_actuators])
+    return np.asarray(velocities * ratio, dtype=np.float64)
+

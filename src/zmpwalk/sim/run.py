@@ -41,7 +41,14 @@ from zmpwalk.kinematics import JOINT_COLUMNS, JointTrajectory
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sim.mjcf import contact_mapping
-from zmpwalk.sim.plant import Plant, build_plant, plant_qpos, set_initial_state, static_feedforward
+from zmpwalk.sim.plant import (
+    Plant,
+    build_plant,
+    damping_feedforward,
+    plant_qpos,
+    set_initial_state,
+    static_feedforward,
+)
 from zmpwalk.zmp import batch_hull_margin
 
 Array = NDArray[np.float64]
@@ -76,6 +83,7 @@ class SimulationResult:
         joint_names: The 12 joint column names.
         joint_angles, joint_velocities, joint_torques, joint_power: (n, 12) [rad], [rad/s], [N m], [W].
         mass_scale: Multiplier of all masses.
+        ankle_positions: Left and right ankle positions in world [m], (n, 2, 3).
         balance: The stabilizer's log per sample (``zmp_desired``, ``com_offset``, ``ankle_offsets``,
             ``height_difference``, ``pelvis_turn``), or None open loop.
         final_feet_error: Largest horizontal distance of a simulated ankle from its planned final place [m]
@@ -109,6 +117,7 @@ class SimulationResult:
     mass_scale: float = 1.0
     joint_names: tuple[str, ...] = field(default=JOINT_COLUMNS)
     balance: dict[str, Array] | None = None
+    ankle_positions: Array | None = None  # [m] (n, 2, 3)
     final_feet_error: float = math.nan  # [m]
     final_feet_yaw_error: float = math.nan  # [rad]
     end_min_sole_force: float = math.nan  # [N]
@@ -234,7 +243,8 @@ def simulate(
             :data:`SETTLE` for a robot's own model, 0 for the box models, which start at rest on their soles).
         hold: Time the last pose is held after the walk [s] (does it end standing still?; default :data:`HOLD`
             for a robot's own model, 0 for the box models).
-        feedforward: Add the static torque feedforward of :func:`zmpwalk.sim.plant.static_feedforward` to
+        feedforward: Add the feedforwards of :func:`zmpwalk.sim.plant.static_feedforward` (gravity and the
+            planned ground reaction) and :func:`zmpwalk.sim.plant.damping_feedforward` (servo damping) to
             the servo references (default: on for a robot's own model, off for the box models, whose
             stiff servos the papers' results were measured with).
         stabilizer: Close the loop with this :class:`~zmpwalk.balance.Stabilizer` (the same code as on the
@@ -296,6 +306,8 @@ def simulate(
         planned_ankles = [np.column_stack([np.interp(pattern_time, pattern.time, a[:, i]) for i in range(3)])
                           for a in (pattern.position_left_ankle_in_world, pattern.position_right_ankle_in_world)]
         qpos_path = plant_qpos(plant, base_path, yaw_path, reference)
+        rates = np.column_stack([np.interp(pattern_time, joints.time, joints.velocities[:, j]) for j in range(12)])
+        control[:, plant.leg_actuators] += damping_feedforward(plant, rates)
         control += static_feedforward(plant, qpos_path, zmp_ref, pattern.support[index],
                                       (planned_ankles[0], planned_ankles[1]))
     balance_log: dict[str, Array] | None = None
@@ -376,6 +388,7 @@ def simulate(
         final_feet_error=feet_error, final_feet_yaw_error=feet_yaw_error, end_min_sole_force=end_force,
         end_max_speed=end_speed, end_attitude_range=end_attitude,
         balance=None if balance_log is None else {k: v[:end] for k, v in balance_log.items()},
+        ankle_positions=np.stack([sensors.take(readings, f"{label}_ankle_pos") for label in ("left", "right")], axis=1),
     )
 
 
