@@ -77,7 +77,7 @@ class StabilizerGains:
     com_stiffness: float = 10.0  # [1/s^2]
     com_damping: float = 6.0  # [1/s]
     com_limit: float = 0.05  # [m]
-    ankle_gain: float = 8.0  # [rad/(s m)]
+    ankle_gain: float = 2.0  # [rad/(s m)]
     ankle_time_constant: float = 0.5  # [s]
     ankle_limit: float = 0.12  # [rad]
     force_gain: float = 0.05  # [m/s]
@@ -88,7 +88,7 @@ class StabilizerGains:
     attitude_limit: float = 0.15  # [rad]
     zmp_margin: float = 0.01  # [m]
     velocity_filter: float = 0.01  # [s]
-    landing_time_constant: float = 0.05  # [s]
+    landing_time_constant: float = 0.2  # [s]
     landing_release: float = 0.3  # [s]
     landing_limit: float = 0.1  # [m]
 
