@@ -245,8 +245,8 @@ def simulate(
             for a robot's own model, 0 for the box models).
         feedforward: Add the feedforwards of :func:`zmpwalk.sim.plant.static_feedforward` (gravity and the
             planned ground reaction) and :func:`zmpwalk.sim.plant.damping_feedforward` (servo damping) to
-            the servo references (default: on for a robot's own model, off for the box models, whose
-            stiff servos the papers' results were measured with).
+            the servo references (default: on for a robot's own model and whenever a stabilizer runs; off
+            for the box models open loop, whose stiff servos the papers' results were measured with).
         stabilizer: Close the loop with this :class:`~zmpwalk.balance.Stabilizer` (the same code as on the
             robot, fed with the simulated sensors only); None walks open loop.
         latency: Delay of every measurement the stabilizer gets [s] (0 to 0.1).
@@ -273,7 +273,7 @@ def simulate(
         raise InvalidParameterError("latency", latency, "a delay in [0, 0.1] s")
     plant = build_plant(robot, mass_scale)
     if feedforward is None:
-        feedforward = plant.imported
+        feedforward = plant.imported or stabilizer is not None
     model = plant.model
     data = mujoco.MjData(model)
     if plant.imported:

@@ -1,0 +1,112 @@
+"""Walks with and without the stabilizer, per robot and scenario: the tables of docs/balance.md.
+
+Run: python bench/bench_balance.py [--quick]. Prints Markdown tables and the stabilizer's cost per tick;
+asserts nothing. TALOS needs ../shared/robots (skipped when absent). Runs on all cores.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import math
+import os
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+from zmpwalk import StepCommand, load_robot
+from zmpwalk.balance import BalanceMeasurement, Stabilizer
+from zmpwalk.kinematics import pattern_joint_trajectory
+from zmpwalk.patterns.polynomial import generate
+from zmpwalk.robots.model import RobotModel
+from zmpwalk.scenarios import load_scenario
+from zmpwalk.sim import simulate
+
+TALOS = Path(__file__).resolve().parents[2] / "shared" / "robots" / "pal_talos" / "scene_position.xml"
+HUBO_SCENARIOS = ("fig10", "fig27", "fig28", "fig29", "fig30", "fig31", "turn45", "demo")
+TALOS_WALKS = {
+    "10 x 10 cm, 0.8 s": [StepCommand(duration=0.8, forward=0.1)] * 10,
+    "10 x 15 cm, 0.9 s": [StepCommand(duration=0.9, forward=0.15)] * 10,
+    "10 x 20 cm, 1.0 s": [StepCommand(duration=1.0, forward=0.2)] * 10,
+    "side 6 x 5 cm, 0.9 s": [StepCommand(duration=0.9, side=0.05)] * 6,
+    "turn 3 x 15 deg, 1.0 s": [StepCommand(duration=1.0, turn=math.radians(15))] * 3,
+}
+
+
+def robot(name: str, kp: float | None) -> RobotModel:
+    model = load_robot(TALOS if name == "talos" else name)
+    if kp is not None and model.servos is not None:
+        model = dataclasses.replace(model, servos=dataclasses.replace(model.servos, kp=kp, kv=kp / 50))
+    return model
+
+
+def case(job: tuple[str, float | None, str, bool]) -> str:
+    name, kp, walk, balance = job
+    model = robot(name, kp)
+    commands = TALOS_WALKS[walk] if name == "talos" else load_scenario(walk)
+    pattern = generate(model, commands, rate=1000.0)
+    joints = pattern_joint_trajectory(pattern, check_limits=False)
+    start = time.perf_counter()
+    result = simulate(model, joints, pattern, stabilizer=Stabilizer(model, 1000.0) if balance else None,
+                      settle=0.5, hold=2.0)
+    seconds = time.perf_counter() - start
+    rms, _ = result.cop_error_stats()
+    state = f"fell at {result.fall_time:.2f} s" if result.fell else "walks"
+    label = f"{name} (kp {kp:g})" if kp else name
+    return (f"| {label} | {walk} | {'on' if balance else 'off'} | {state} | {rms * 1e3:.0f} | "
+            f"{result.final_feet_error * 1e3:.1f} | {result.end_min_sole_force:.0f} | "
+            f"{result.end_attitude_range:.3f} | {seconds:.1f} |")
+
+
+def stabilizer_cost() -> str:
+    model = load_robot("hubo")
+    pattern = generate(model, [StepCommand(duration=0.8, forward=0.2)] * 4, rate=1000.0)
+    joints = pattern_joint_trajectory(pattern)
+    stabilizer = Stabilizer(model, 1000.0)
+    weight = model.mass * model.gravity / 2
+    measurement = BalanceMeasurement(np.array([0, 0, weight, 0, 0, 0.0]), np.array([0, 0, weight, 0, 0, 0.0]),
+                                     np.zeros(2), np.zeros(3), joints.angles[0])
+    ticks = []
+    for k in range(len(pattern.time)):
+        measurement.joint_angles = joints.angles[k]
+        start = time.perf_counter()
+        stabilizer.update(support=int(pattern.support[k]), position_com_in_world=pattern.position_pelvis_in_world[k],
+                          yaw_pelvis_in_world=float(pattern.yaw_pelvis_in_world[k]), zmp_in_world=pattern.zmp_in_world[k],
+                          ankles_in_world=(pattern.position_left_ankle_in_world[k],
+                                           pattern.position_right_ankle_in_world[k]),
+                          foot_yaws=(float(pattern.yaw_left_foot_in_world[k]), float(pattern.yaw_right_foot_in_world[k])),
+                          joint_angles=joints.angles[k], measurement=measurement)
+        ticks.append(time.perf_counter() - start)
+    cost = np.array(ticks) * 1e6
+    return (f"stabilizer update, HUBO, {len(cost)} ticks: median {np.median(cost):.0f} us, p99 "
+            f"{np.percentile(cost, 99):.0f} us, max {cost.max():.0f} us")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--quick", action="store_true", help="fig27 and one TALOS walk only")
+    args = parser.parse_args()
+    jobs: list[tuple[str, float | None, str, bool]] = []
+    scenarios = ("fig27",) if args.quick else HUBO_SCENARIOS
+    for walk in scenarios:
+        for kp in (None, 3000.0):
+            jobs += [("hubo", kp, walk, False), ("hubo", kp, walk, True)]
+    if TALOS.is_file():
+        walks = list(TALOS_WALKS)[:1] if args.quick else list(TALOS_WALKS)
+        jobs += [("talos", None, walk, balance) for walk in walks for balance in (False, True)]
+    else:
+        print(f"TALOS skipped: {TALOS} is absent", file=sys.stderr)
+    print(stabilizer_cost())
+    print("| robot | walk | stabilizer | result | CoP - ZMP RMS [mm] | final feet error [mm] | "
+          "least sole force, last 2 s [N] | torso attitude spread, last 2 s [rad] | wall time [s] |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    with ProcessPoolExecutor(max_workers=os.cpu_count()) as pool:
+        for line in pool.map(case, jobs):
+            print(line, flush=True)
+
+
+if __name__ == "__main__":
+    main()

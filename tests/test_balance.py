@@ -1,0 +1,158 @@
+"""The stabilizer: each loop answers in the physically right direction, a perfect measurement changes nothing,
+bad gains are rejected, and in MuJoCo it carries walks that fall or drift open loop."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from zmpwalk.balance import BalanceMeasurement, Stabilizer, StabilizerGains
+from zmpwalk.commands import StepCommand
+from zmpwalk.errors import InvalidParameterError
+from zmpwalk.kinematics import leg_chains, pattern_joint_trajectory, rest_mass
+from zmpwalk.patterns.polynomial import generate
+from zmpwalk.robots import load_robot
+
+TALOS = Path(__file__).resolve().parents[2] / "shared" / "robots" / "pal_talos" / "scene_position.xml"
+
+
+def standing() -> tuple[Stabilizer, dict[str, object], float]:
+    """HUBO standing in the ready posture, the stabilizer's inputs for it (the CoM and the ZMP where its
+    kinematics put the CoM), and half its weight [N]."""
+    robot = load_robot("hubo")
+    pattern = generate(robot, [StepCommand(duration=0.8)], rate=1000.0)
+    angles = pattern_joint_trajectory(pattern).angles[0]
+    rest, rest_com = rest_mass(robot)
+    moment = rest * rest_com
+    total = rest
+    for index, chain in enumerate(leg_chains(robot)):
+        moment = moment + chain.link_masses @ chain.link_com_positions(angles[None, 6 * index:6 * index + 6])[0]
+        total += float(chain.link_masses.sum())
+    com = pattern.position_pelvis_in_world[0] + moment / total
+    com[2] = pattern.position_pelvis_in_world[0, 2]
+    inputs = {
+        "support": 0, "position_com_in_world": com, "yaw_pelvis_in_world": 0.0, "zmp_in_world": com[:2].copy(),
+        "ankles_in_world": (pattern.position_left_ankle_in_world[0], pattern.position_right_ankle_in_world[0]),
+        "foot_yaws": (0.0, 0.0), "joint_angles": angles,
+    }
+    return Stabilizer(robot, 1000.0), inputs, robot.mass * robot.gravity / 2
+
+
+def wrench(force: float, cop_x: float = 0.0, cop_y: float = 0.0, ankle_height: float = 0.095) -> np.ndarray:
+    """The ground's wrench on a foot about its ankle for a vertical force at (cop_x, cop_y) in the foot frame."""
+    r = np.array([cop_x, cop_y, -ankle_height])
+    f = np.array([0.0, 0.0, force])
+    return np.concatenate([f, np.cross(r, f)])
+
+
+def measured(stabilizer: Stabilizer, inputs: dict[str, object], cop_shift: tuple[float, float] = (0.0, 0.0),
+             loads: tuple[float, float] = (1.0, 1.0), **changes: object) -> BalanceMeasurement:
+    """Each sole carrying half the weight, the two CoPs placed so that the total is under the CoM (what the
+    inputs plan), unless changed."""
+    half = stabilizer.robot.mass * stabilizer.robot.gravity / 2
+    com = np.asarray(inputs["position_com_in_world"])
+    ankles = [np.asarray(a)[:2] for a in inputs["ankles_in_world"]]  # type: ignore[attr-defined]
+    shift = com[:2] - (ankles[0] + ankles[1]) / 2 + np.asarray(cop_shift)
+    values: dict[str, object] = {"wrench_left": wrench(loads[0] * half, shift[0], shift[1]),
+                                 "wrench_right": wrench(loads[1] * half, shift[0], shift[1]),
+                                 "attitude": np.zeros(2), "rate": np.zeros(3),
+                                 "joint_angles": np.asarray(inputs["joint_angles"]).copy()}
+    values.update(changes)
+    return BalanceMeasurement(**values)  # type: ignore[arg-type]
+
+
+def run(stabilizer: Stabilizer, inputs: dict[str, object], ticks: int, **changes: object) -> np.ndarray:
+    angles = np.zeros(12)
+    for _ in range(ticks):
+        measurement = measured(stabilizer, inputs, **changes)  # type: ignore[arg-type]
+        angles = stabilizer.update(**inputs, measurement=measurement)  # type: ignore[arg-type]
+    return angles
+
+
+def test_a_perfect_measurement_changes_nothing() -> None:
+    stabilizer, inputs, _ = standing()
+    angles = run(stabilizer, inputs, 200)
+    assert np.abs(angles - np.asarray(inputs["joint_angles"])).max() < 1e-6  # [rad]
+    assert np.abs(stabilizer.state.dcm_error).max() < 1e-6  # [m]
+
+
+def test_cop_behind_its_target_turns_the_foot_to_press_the_toes() -> None:
+    stabilizer, inputs, _ = standing()
+    run(stabilizer, inputs, 100, cop_shift=(-0.03, 0.0))
+    assert stabilizer.state.ankle_offsets[0, 1] > 0.001  # pitch about +y: toes down [rad]
+    assert stabilizer.state.ankle_offsets[1, 1] > 0.001
+
+
+def test_cop_right_of_its_target_turns_the_foot_to_press_its_left_edge() -> None:
+    stabilizer, inputs, _ = standing()
+    run(stabilizer, inputs, 100, cop_shift=(0.0, -0.02))
+    assert stabilizer.state.ankle_offsets[0, 0] < -0.001  # roll about +x negative lowers the +y edge [rad]
+
+
+def test_torso_leaning_forward_moves_the_desired_zmp_forward_and_turns_the_pelvis_back() -> None:
+    stabilizer, inputs, _ = standing()
+    run(stabilizer, inputs, 50, attitude=np.array([0.0, 0.03]))
+    assert stabilizer.state.dcm_error[0] > 0.01  # the CoM is estimated ahead [m]
+    assert stabilizer.state.zmp_desired[0] > np.asarray(inputs["zmp_in_world"])[0] + 0.01
+    assert stabilizer.state.pelvis_turn[1] < 0.0
+
+
+def test_measured_zmp_ahead_of_the_desired_accelerates_the_com_forward() -> None:
+    stabilizer, inputs, _ = standing()
+    gains = dataclasses.replace(stabilizer.gains, ankle_gain=0.0)
+    stabilizer = Stabilizer(stabilizer.robot, 1000.0, gains)
+    run(stabilizer, inputs, 50, cop_shift=(0.02, 0.0))
+    assert stabilizer.state.com_offset[0] > 0.0  # c'' = A (p_measured - p_desired) > 0
+
+
+def test_left_foot_under_loaded_in_double_support_is_lowered() -> None:
+    stabilizer, inputs, _ = standing()
+    run(stabilizer, inputs, 100, loads=(0.6, 1.4))
+    assert stabilizer.state.height_difference > 0.0  # left foot lowered by half of it [m]
+
+
+@pytest.mark.parametrize("field", ["dcm", "ankle_gain", "com_limit"])
+def test_bad_gains_are_rejected(field: str) -> None:
+    with pytest.raises(InvalidParameterError, match=f"gains.{field}"):
+        StabilizerGains(**{field: -1.0})
+    with pytest.raises(InvalidParameterError, match="rate"):
+        Stabilizer(load_robot("hubo"), 5.0)
+
+
+def test_stabilizer_carries_hubo_on_soft_servos() -> None:
+    from zmpwalk.scenarios import load_scenario
+    from zmpwalk.sim import simulate
+
+    robot = load_robot("hubo")
+    assert robot.servos is not None
+    soft = dataclasses.replace(robot, servos=dataclasses.replace(robot.servos, kp=3000.0, kv=60.0))
+    pattern = generate(soft, load_scenario("fig27"), rate=1000.0)
+    joints = pattern_joint_trajectory(pattern)
+    bare = simulate(soft, joints, pattern, feedforward=False, settle=0.5, hold=2.0)
+    feedforward = simulate(soft, joints, pattern, feedforward=True, settle=0.5, hold=2.0)
+    closed = simulate(soft, joints, pattern, stabilizer=Stabilizer(soft, 1000.0), settle=0.5, hold=2.0)
+    assert not closed.fell
+    # RMS CoP - ZMP: measured 233 mm bare, 54 mm with the feedforward, 34 mm with the stabilizer too
+    assert closed.cop_error_stats()[0] < 0.2 * bare.cop_error_stats()[0]
+    assert closed.cop_error_stats()[0] < 0.75 * feedforward.cop_error_stats()[0]
+    assert closed.final_feet_error < 0.02  # [m]
+    assert closed.end_min_sole_force > 0.3 * soft.mass * soft.gravity / 2  # both soles loaded at the end [N]
+    assert closed.end_attitude_range < 0.01  # [rad]
+
+
+@pytest.mark.skipif(not TALOS.is_file(), reason="../shared/robots is absent")
+def test_talos_walks_with_its_own_servos_and_the_stabilizer() -> None:
+    from zmpwalk.sim import simulate
+
+    robot = load_robot(TALOS)
+    pattern = generate(robot, [StepCommand(duration=1.0, turn=np.radians(15))] * 3, rate=1000.0)
+    joints = pattern_joint_trajectory(pattern)
+    result = simulate(robot, joints, pattern, stabilizer=Stabilizer(robot, 1000.0))
+    assert not result.fell
+    assert result.final_feet_error < 0.02  # [m]
+    assert result.final_feet_yaw_error < np.radians(2)
+    assert result.end_max_speed < 0.05  # [m/s] standing still over the last 2 s
+    assert result.end_min_sole_force > 100.0  # [N] both soles loaded
