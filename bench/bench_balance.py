@@ -74,10 +74,12 @@ def stabilizer_cost() -> str:
         measurement.joint_angles = joints.angles[k]
         start = time.perf_counter()
         stabilizer.update(support=int(pattern.support[k]), position_com_in_world=pattern.position_pelvis_in_world[k],
-                          yaw_pelvis_in_world=float(pattern.yaw_pelvis_in_world[k]), zmp_in_world=pattern.zmp_in_world[k],
+                          yaw_pelvis_in_world=float(pattern.yaw_pelvis_in_world[k]),
+                          zmp_in_world=pattern.zmp_in_world[k],
                           ankles_in_world=(pattern.position_left_ankle_in_world[k],
                                            pattern.position_right_ankle_in_world[k]),
-                          foot_yaws=(float(pattern.yaw_left_foot_in_world[k]), float(pattern.yaw_right_foot_in_world[k])),
+                          foot_yaws=(float(pattern.yaw_left_foot_in_world[k]),
+                                     float(pattern.yaw_right_foot_in_world[k])),
                           joint_angles=joints.angles[k], measurement=measurement)
         ticks.append(time.perf_counter() - start)
     cost = np.array(ticks) * 1e6

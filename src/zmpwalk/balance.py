@@ -11,7 +11,8 @@ separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega 
 
 1. **DCM tracking.** The CoM ``c`` is estimated from the encoders and the IMU, anchored at the loaded sole,
    whose place in world comes from leg odometry (when the load passes to the other sole, that sole is
-   placed from the measured kinematics), so a step landed short shows as a DCM error; the divergent component of motion ``xi = c + c' / omega`` must follow the
+   placed from the measured kinematics), so a step landed short shows as a DCM error; the divergent
+   component of motion ``xi = c + c' / omega`` must follow the
    pattern's. Its error ``e = xi - xi_ref`` decays at rate ``k_xi`` when the ZMP is
 
    .. math:: p_d = p_{ref} + (1 + k_\xi / \omega)\, e, \qquad \dot e = -k_\xi e
@@ -301,7 +302,8 @@ class Stabilizer:
         planned_relative = [chain.fk(angles, transforms)[0][0] for chain, (angles, transforms)
                             in zip(self.chains, kinematics, strict=True)]
         yaw_rotation = _rz(yaw_pelvis_in_world)
-        base_planned = np.asarray(ankles_in_world[anchor], dtype=float)[:2] - (yaw_rotation @ planned_relative[anchor])[:2]
+        base_planned = (np.asarray(ankles_in_world[anchor], dtype=float)[:2]
+                        - (yaw_rotation @ planned_relative[anchor])[:2])
         for foot in range(2):
             swinging = (support == 1 and foot == 1) or (support == 2 and foot == 0)
             if swinging:
