@@ -31,9 +31,11 @@ def test_demo_writes_the_report_folder(demo):
             "summary.json"} <= names
     summary = json.loads((demo / "summary.json").read_text())
     assert summary["fell"] is False and summary["min_zmp_margin"] > 0
+    assert summary["balance"] is True  # the demo runs the stabilizer
     page = (demo / "index.html").read_text()
     assert "http://" not in page and "https://" not in page  # opens offline: everything is embedded
-    assert page.count("data:image/png;base64,") == 4 and page.count("data:image/gif;base64,") == 1
+    assert page.count("data:image/png;base64,") == 5 and page.count("data:image/gif;base64,") == 1
+    assert "The stabilizer" in page
     assert "right_hip_roll" in page and "ZMP margin per step" in page
 
 
@@ -43,7 +45,7 @@ def test_headless_browser_loads_every_image_and_the_animation(demo):
     dom = subprocess.run([CHROMIUM, *CHROMIUM_FLAGS, f"--user-data-dir={profile}", "--virtual-time-budget=10000",
                           "--dump-dom", (demo / "index.html").as_uri()],
                          capture_output=True, text=True, timeout=120, check=True).stdout
-    assert 'data-images-loaded="yes"' in dom and 'data-image-count="5"' in dom
+    assert 'data-images-loaded="yes"' in dom and 'data-image-count="6"' in dom
     ARTIFACTS.mkdir(exist_ok=True)
     shot = ARTIFACTS / "demo-report.png"
     subprocess.run([CHROMIUM, *CHROMIUM_FLAGS, f"--user-data-dir={tempfile.mkdtemp()}", "--window-size=1000,1400",

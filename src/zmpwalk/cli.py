@@ -86,10 +86,11 @@ def _schedule(args: argparse.Namespace) -> Schedule | None:
     return Schedule.from_file(path)
 
 
-def _balance_options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--balance", choices=("on", "off"), default=None,
-                        help="close the loop with the stabilizer on the simulated sensors (default: on for a "
-                        "robot's own model, off for the built-in box models)")
+def _balance_options(parser: argparse.ArgumentParser, default: str | None = None) -> None:
+    explained = (f"default: {default}" if default else
+                 "default: on for a robot's own model, off for the built-in box models (the papers' open-loop walks)")
+    parser.add_argument("--balance", choices=("on", "off"), default=default,
+                        help=f"close the loop with the stabilizer on the simulated sensors ({explained})")
     parser.add_argument("--latency", type=float, default=0.0, help="sensor latency of the stabilizer [s]")
 
 
@@ -179,7 +180,7 @@ def _parser() -> argparse.ArgumentParser:
         report_cmd.add_argument("--steps", type=Path, help="steps file (TOML) instead of a scenario")
         _robot_options(report_cmd)
         report_cmd.add_argument("--schedule", type=Path, help="your own parameter tables (TOML)")
-        _balance_options(report_cmd)
+        _balance_options(report_cmd, default="on")
         report_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
         default_out = Path("zmpwalk-demo" if name == "demo" else "zmpwalk-report")
         report_cmd.add_argument("--out", type=Path, default=default_out,

@@ -63,6 +63,10 @@ def step_margins(pattern: WalkingPattern) -> list[tuple[int, str, str, float, fl
     return rows
 
 
+SETTLE = 0.5  # [s] standing before the walk in the report's simulation
+HOLD = 2.0  # [s] standing after it: does the robot end standing still?
+
+
 def build_report(
     robot: RobotModel,
     commands: Sequence[StepCommand],
@@ -101,7 +105,7 @@ def build_report(
     joints = pattern_joint_trajectory(pattern)
     done("joints")
     stabilizer = Stabilizer(robot, 1000.0) if balance else None
-    result = simulate(robot, joints, pattern, stabilizer=stabilizer, latency=latency)
+    result = simulate(robot, joints, pattern, stabilizer=stabilizer, latency=latency, settle=SETTLE, hold=HOLD)
     rows = actuator_table(result)
     write_actuator_csv(rows, folder / "actuators.csv")
     done("simulation")

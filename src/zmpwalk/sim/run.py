@@ -17,12 +17,15 @@ sensor at each ankle (the centre of pressure of a sole is computed from it,
 as HUBO's foot sensors do, so it includes the small inertia of the foot; a
 sole is counted as loaded, and its CoP measured, above
 :data:`LOADED_FRACTION` of the weight), the actuator torques, the joint
-encoders, the torso pose. The whole walk runs in C with
-:func:`mujoco.rollout.rollout`.
+encoders, the torso pose, the torso gyro. Open loop, the whole walk runs in C
+with :func:`mujoco.rollout.rollout`.
 
-**Balance feedback**: none. With the robot files' servos the open-loop patterns
-walk every built-in scenario to its end (docs/simulation.md), so the
-simulation measures the patterns as generated.
+**Plants and balance**: the plant is the robot's own MJCF or URDF where it has
+one, else the box model of its robot file (:mod:`zmpwalk.sim.plant`). With a
+:class:`~zmpwalk.balance.Stabilizer` the walk is stepped tick by tick and the
+stabilizer gets the sensor values only (with optional latency and noise); the
+model-based feedforward of :mod:`zmpwalk.sim.plant` is on then, and for every
+robot's own model (docs/balance.md).
 """
 
 from __future__ import annotations
