@@ -110,6 +110,7 @@ class BalanceMeasurement:
         attitude: Torso (base) roll and pitch [rad] from the IMU, (2,).
         rate: Torso angular velocity in the base frame [rad/s] (gyro), (3,).
         joint_angles: The 12 leg joint encoders [rad], columns of :data:`zmpwalk.kinematics.JOINT_COLUMNS`.
+        yaw: Torso heading in world [rad] (the IMU's, from the walk's start), or None to use the pattern's.
     """
 
     wrench_left: Array
@@ -117,6 +118,7 @@ class BalanceMeasurement:
     attitude: Array
     rate: Array
     joint_angles: Array
+    yaw: float | None = None
 
 
 @dataclass
@@ -212,7 +214,8 @@ class Stabilizer:
         loaded = forces > 0.05 * self._mass * self.robot.gravity
         # --- CoM estimate: kinematics of the measured legs, tilted by the IMU, anchored at the loaded sole
         roll, pitch = float(measurement.attitude[0]), float(measurement.attitude[1])
-        rotation = _rz(yaw_pelvis_in_world) @ _ry(pitch) @ _rx(roll)
+        heading = yaw_pelvis_in_world if measurement.yaw is None else float(measurement.yaw)
+        rotation = _rz(heading) @ _ry(pitch) @ _rx(roll)
         q = np.asarray(measurement.joint_angles, dtype=float)
         com_in_base = self._rest_mass * self._rest_com
         relative = np.empty((2, 3))

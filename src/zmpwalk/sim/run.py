@@ -427,7 +427,7 @@ def _measurement(row: Array, sensors: _Sensors) -> BalanceMeasurement:
     return BalanceMeasurement(
         wrench_left=-np.concatenate([take("left_force"), take("left_torque")]),
         wrench_right=-np.concatenate([take("right_force"), take("right_torque")]),
-        attitude=rpy[:2], rate=take("pelvis_gyro").copy(),
+        attitude=rpy[:2], rate=take("pelvis_gyro").copy(), yaw=float(rpy[2]),
         joint_angles=np.array([row[sensors.slices[f"{c}_q"]][0] for c in JOINT_COLUMNS]))
 
 
