@@ -32,6 +32,7 @@ def test_demo_writes_the_report_folder(demo):
     summary = json.loads((demo / "summary.json").read_text())
     assert summary["fell"] is False and summary["min_zmp_margin"] > 0
     assert summary["balance"] is True  # the demo runs the stabilizer
+    assert summary["verdict"]["passed"] is True  # and ends standing still where planned
     page = (demo / "index.html").read_text()
     assert "http://" not in page and "https://" not in page  # opens offline: everything is embedded
     assert page.count("data:image/png;base64,") == 5 and page.count("data:image/gif;base64,") == 1

@@ -1,6 +1,8 @@
 """The ``zmpwalk`` command.
 
-Errors print one line, ``zmpwalk: error: ...``, and exit with status 2.
+Exit status: 0 success; 2 bad input or usage (one line, ``zmpwalk: error: ...``); 3 the walk failed
+(``simulate``, ``report``, ``demo``: a criterion of the verdict failed, each printed with its figure;
+``plan``: the ZMP leaves the support polygon, unless ``--allow-outside``).
 """
 
 from __future__ import annotations
@@ -32,6 +34,9 @@ if TYPE_CHECKING:
     from zmpwalk.sim.run import SimulationResult
 
 EXIT_ERROR = 2
+EXIT_FAILED = 3  # the walk failed its verdict, or the plan's ZMP left the polygon
+SETTLE = 0.5  # [s] standing before a simulated walk
+HOLD = 2.0  # [s] standing after it (the verdict judges how it ends)
 
 
 def paper_example() -> dict[str, object]:
@@ -124,7 +129,10 @@ def _parser() -> argparse.ArgumentParser:
     plan.add_argument("--scenario", help="a built-in scenario instead of a steps file (see 'zmpwalk scenarios')")
     _robot_options(plan)
     plan.add_argument("--schedule", type=Path, help="your own parameter tables (TOML, the format of Tables 2-3)")
-    plan.add_argument("--rate", type=float, default=100.0, help="samples per second [Hz] (default: 100)")
+    plan.add_argument("--rate", type=float, default=1000.0,
+                      help="samples per second [Hz] (default: 1000, as report and simulate)")
+    plan.add_argument("--allow-outside", action="store_true",
+                      help="exit 0 even when the ZMP leaves the support polygon (default: exit 3)")
     plan.add_argument("--generator", choices=GENERATORS, default="polynomial",
                       help="polynomial (HUBO, Park et al. 2008; default) or hyperbolic (LIPM, Lim et al.)")
     plan.add_argument("--out", type=Path, help="CSV file to write")
@@ -264,20 +272,24 @@ def _report(args: argparse.Namespace) -> int:
                               generator=args.generator, animate=not args.no_animation,
                               progress=None if quiet else _progress, labels=labels,
                               balance=_balance(args, robot), latency=args.latency, schedule=_schedule(args))
+    verdict = report.verdict
     if args.json:
         summary = {**report.summary, "index": str(report.index), "seconds": report.seconds}
         print(json.dumps(_json_safe(summary), indent=2, allow_nan=False))
     else:
         s = report.summary
-        state = f"FELL at t = {s['fall_time']:.2f} s" if s["fell"] else "walked to the end without falling"
-        print(f"{robot.name}, {name}: {state}; min ZMP margin {float(s['min_zmp_margin']) * 1e3:+.1f} mm "
-              f"-> {report.index}")
-    return 0
+        state = f"FELL at t = {s['fall_time']:.2f} s" if s["fell"] else "no fall"
+        print(f"{robot.name}, {name}: {'PASS' if verdict.passed else 'FAIL'} ({state}); min ZMP margin "
+              f"{float(s['min_zmp_margin']) * 1e3:+.1f} mm -> {report.index}")
+        for line in verdict.lines():
+            print(f"  {line}")
+    return 0 if verdict.passed else EXIT_FAILED
 
 
 def _simulate(args: argparse.Namespace) -> int:
     from zmpwalk.patterns.hyperbolic import paper_walk
     from zmpwalk.sim import actuator_markdown, actuator_table, simulate, write_actuator_csv
+    from zmpwalk.sim.verdict import walk_verdict
 
     robot = _load_robot(args)
     if args.paper_example:
@@ -298,7 +310,8 @@ def _simulate(args: argparse.Namespace) -> int:
 
     stabilizer = Stabilizer(robot, 1000.0) if _balance(args, robot) else None
     result = simulate(robot, joints, pattern, mass_scale=args.mass_scale, stabilizer=stabilizer,
-                      latency=args.latency)
+                      latency=args.latency, settle=SETTLE, hold=HOLD)
+    verdict = walk_verdict(result, HOLD)
     rows = actuator_table(result)
     rms, largest = result.cop_error_stats()
     summary = {
@@ -308,7 +321,7 @@ def _simulate(args: argparse.Namespace) -> int:
         "mass_scale": result.mass_scale, "balance": stabilizer is not None,
         "final_feet_error": result.final_feet_error, "final_feet_yaw_error": result.final_feet_yaw_error,
         "end_min_sole_force": result.end_min_sole_force, "end_max_speed": result.end_max_speed,
-        "end_attitude_range": result.end_attitude_range,
+        "end_attitude_range": result.end_attitude_range, "verdict": verdict.as_dict(),
         "actuators": [vars(row) for row in rows],
     }
     if args.out:
@@ -328,7 +341,10 @@ def _simulate(args: argparse.Namespace) -> int:
         power = max(rows, key=lambda r: r.peak_power)
         print(f"largest torque {top.peak_torque:.3g} N m at {top.joint}; largest power {power.peak_power:.3g} W "
               f"at {power.joint}")
-    return 0
+        print(f"verdict: {'PASS' if verdict.passed else 'FAIL'}")
+        for line in verdict.lines():
+            print(f"  {line}")
+    return 0 if verdict.passed else EXIT_FAILED
 
 
 def _json_safe(value: object) -> object:
@@ -409,7 +425,8 @@ def _run(args: argparse.Namespace) -> int:
                   f"{args.rate:g} Hz" + (f" -> {args.out}" if args.out else ""))
             print(f"min ZMP margin: {margin * 1e3:+.1f} mm at t = {summary['min_zmp_margin_time']:.3f} s "
                   f"({verdict})")
-        return 0
+        outside = float(summary["min_zmp_margin"]) < 0  # type: ignore[arg-type]
+        return EXIT_FAILED if outside and not args.allow_outside else 0
     if args.command in ("demo", "report"):
         return _report(args)
     if args.command == "simulate":

@@ -27,6 +27,7 @@ from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
 from zmpwalk.sim.actuators import ActuatorRow, actuator_markdown, actuator_table, write_actuator_csv
 from zmpwalk.sim.run import simulate
+from zmpwalk.sim.verdict import Verdict, walk_verdict
 
 Progress = Callable[[str, int, int], None]
 STAGES = ("pattern", "joints", "simulation", "plots", "animation", "page")
@@ -41,12 +42,14 @@ class Report:
         index: Its ``index.html``.
         seconds: Wall time of each stage [s].
         summary: The numbers on the page (SI).
+        verdict: The simulated walk's verdict (every criterion with its figure).
     """
 
     folder: Path
     index: Path
     seconds: dict[str, float] = field(default_factory=dict)
     summary: dict[str, Any] = field(default_factory=dict)
+    verdict: Verdict = field(default_factory=lambda: Verdict(()))
 
 
 def _data_uri(kind: str, payload: bytes) -> str:
@@ -106,6 +109,7 @@ def build_report(
     done("joints")
     stabilizer = Stabilizer(robot, 1000.0) if balance else None
     result = simulate(robot, joints, pattern, stabilizer=stabilizer, latency=latency, settle=SETTLE, hold=HOLD)
+    report.verdict = walk_verdict(result, HOLD)
     rows = actuator_table(result)
     write_actuator_csv(rows, folder / "actuators.csv")
     done("simulation")
@@ -142,8 +146,10 @@ def build_report(
         "min_zmp_margin": margin, "min_zmp_margin_time": at, "fell": result.fell, "fall_time": result.fall_time,
         "distance": result.distance, "average_speed": result.average_speed, "foot_slip": result.foot_slip,
         "cop_error_rms": rms, "cop_error_max": largest, "balance": result.balance is not None,
+        "verdict": report.verdict.as_dict(),
     }
-    page = _page(title, robot, report.summary, images, animation, animation_note, step_margins(pattern), rows)
+    page = _page(title, robot, report.summary, images, animation, animation_note, step_margins(pattern), rows,
+                 report.verdict)
     report.index.write_text(page, encoding="utf-8")
     (folder / "summary.json").write_text(json.dumps(report.summary, indent=2), encoding="utf-8")
     done("page")
@@ -152,11 +158,17 @@ def build_report(
 
 def _page(title: str, robot: RobotModel, summary: dict[str, Any], images: dict[str, bytes],
           animation: bytes | None, animation_note: str, margins: list[tuple[int, str, str, float, float, float]],
-          rows: list[ActuatorRow]) -> str:
+          rows: list[ActuatorRow], verdict: Verdict) -> str:
     esc = html.escape
     fell = summary["fell"]
-    verdict = (f"<b class='bad'>fell at t = {summary['fall_time']:.2f} s</b>" if fell
-               else "<b class='good'>walked to the end without falling</b>")
+    outcome = ("<b class='good'>passes every criterion</b>" if verdict.passed else
+               f"<b class='bad'>fails: {esc(', '.join(verdict.failed))}</b>"
+               + (f" <b class='bad'>(fell at t = {summary['fall_time']:.2f} s)</b>" if fell else ""))
+    criteria_rows = "\n".join(
+        f"<tr><td>{esc(line.split(' ', 1)[1].split(':')[0])}</td>"
+        f"<td class='{'good' if c.passed else 'bad'}'>{'pass' if c.passed else 'FAIL'}</td>"
+        f"<td>{esc(line.split(': ', 1)[1])}</td></tr>"
+        for c, line in zip(verdict.criteria, verdict.lines(), strict=True))
     margin_rows = "\n".join(
         f"<tr><td>{n}</td><td>{esc(kind)}</td><td>{esc(swing)}</td><td>{start:.2f}</td><td>{duration:.2f}</td>"
         f"<td class='{'good' if m >= 0 else 'bad'}'>{m * 1e3:+.1f}</td></tr>"
@@ -186,7 +198,11 @@ figure {{ margin: 1.5em 0; }} img {{ max-width: 100%; }} figcaption {{ color: #5
 <p>{esc(robot.description)}. Pattern: {esc(str(summary['generator']))} generator,
 {summary['swings']} swings over {summary['duration']:.2f} s, sampled at 1 kHz.</p>
 <h2>Does it walk?</h2>
-<p>In the MuJoCo simulation it {verdict}: distance {summary['distance']:.3f} m, average speed
+<p id="verdict">In the MuJoCo simulation the walk {outcome}.</p>
+<table id="criteria"><tr><th>criterion</th><th>result</th><th>figure (limit; how it is judged)</th></tr>
+{criteria_rows}
+</table>
+<p>Distance {summary['distance']:.3f} m, average speed
 {float(summary['average_speed']) * 1e3:.1f} mm/s, largest foot slip {float(summary['foot_slip']) * 1e3:.1f} mm;
 centre of pressure against the reference ZMP: RMS {float(summary['cop_error_rms']) * 1e3:.1f} mm,
 max {float(summary['cop_error_max']) * 1e3:.1f} mm.

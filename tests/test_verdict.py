@@ -1,0 +1,42 @@
+"""The verdict: failing walks are red with a non-zero exit, each criterion carries its figure."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from zmpwalk.cli import EXIT_FAILED, main
+
+
+def test_a_too_long_stride_at_0_4_s_on_hubo_fails_and_exits_non_zero(tmp_path: Path,
+                                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    steps = tmp_path / "fast.toml"
+    steps.write_text("[[steps]]\nduration = 0.4\nforward = 0.3\nrepeat = 6\n", encoding="utf-8")
+    assert main(["simulate", str(steps), "--json"]) == EXIT_FAILED
+    verdict = json.loads(capsys.readouterr().out)["verdict"]
+    assert verdict["passed"] is False
+    by_name = {c["name"]: c for c in verdict["criteria"]}
+    assert by_name["no fall"]["passed"] is False
+    assert by_name["no fall"]["figure"] < by_name["no fall"]["limit"]  # fell before the end [s]
+
+
+def test_the_small_biped_on_hubo_tables_fails_in_the_report(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "r"
+    assert main(["report", "--robot", "mju-biped", "--scenario", "fig30", "--no-animation", "--out", str(out)]) \
+        == EXIT_FAILED
+    printed = capsys.readouterr().out
+    assert "FAIL" in printed and "no fall" in printed
+    page = (out / "index.html").read_text(encoding="utf-8")
+    assert "class='good'>passes every criterion" not in page
+    assert "<b class='bad'>fails: no fall" in page
+
+
+def test_the_papers_walk_passes_every_criterion(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["simulate", "--paper-example", "--robot", "mju-biped", "--json"]) == 0
+    verdict = json.loads(capsys.readouterr().out)["verdict"]
+    assert verdict["passed"] is True
+    assert len(verdict["criteria"]) == 7
+    for criterion in verdict["criteria"]:
+        assert criterion["figure"] is not None and criterion["passed"] is True
