@@ -117,8 +117,8 @@ def test_simulate_command_writes_results_and_json(tmp_path, capsys):
                 "min_cop_margin", "actuators"):
         assert key in summary
     assert summary["fell"] is False and len(summary["actuators"]) == 12
-    assert set(summary["actuators"][0]) == {"joint", "peak_torque", "rms_torque", "peak_velocity", "peak_power",
-                                            "mean_power"}
+    assert set(summary["actuators"][0]) == {"joint", "peak_torque", "impact_torque", "rms_torque", "peak_velocity",
+                                            "peak_power", "mean_power", "torque_limit"}
     assert {p.name for p in out.iterdir()} == {"actuators.csv", "actuators.md", "simulation.csv"}
 
 

@@ -28,6 +28,7 @@ from zmpwalk.robots import list_robots, load_robot
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.scenarios import list_scenarios, load_scenario_with_labels, load_steps_file_with_labels
 from zmpwalk.schedule import Schedule
+from zmpwalk.sim.motors import Motor
 from zmpwalk.tables import condition_margins, margins_markdown
 
 if TYPE_CHECKING:
@@ -91,12 +92,20 @@ def _schedule(args: argparse.Namespace) -> Schedule | None:
     return Schedule.from_file(path)
 
 
+def _motors(args: argparse.Namespace) -> list[Motor] | None:
+    from zmpwalk.sim.motors import load_motors
+
+    return load_motors(args.motors) if getattr(args, "motors", None) else None
+
+
 def _balance_options(parser: argparse.ArgumentParser, default: str | None = None) -> None:
     explained = (f"default: {default}" if default else
                  "default: on for a robot's own model, off for the built-in box models (the papers' open-loop walks)")
     parser.add_argument("--balance", choices=("on", "off"), default=default,
                         help=f"close the loop with the stabilizer on the simulated sensors ({explained})")
     parser.add_argument("--latency", type=float, default=0.0, help="sensor latency of the stabilizer [s]")
+    parser.add_argument("--motors", type=Path, help="a motor file (TOML, examples/motors.toml): does each joint's "
+                        "motor fit?")
 
 
 def _balance(args: argparse.Namespace, robot: RobotModel) -> bool:
@@ -271,7 +280,8 @@ def _report(args: argparse.Namespace) -> int:
         report = build_report(robot, commands, args.out, title=f"zmpwalk: {robot.name}, {name}",
                               generator=args.generator, animate=not args.no_animation,
                               progress=None if quiet else _progress, labels=labels,
-                              balance=_balance(args, robot), latency=args.latency, schedule=_schedule(args))
+                              balance=_balance(args, robot), latency=args.latency, schedule=_schedule(args),
+                              motors=_motors(args))
     verdict = report.verdict
     if args.json:
         summary = {**report.summary, "index": str(report.index), "seconds": report.seconds}
@@ -289,6 +299,7 @@ def _report(args: argparse.Namespace) -> int:
 def _simulate(args: argparse.Namespace) -> int:
     from zmpwalk.patterns.hyperbolic import paper_walk
     from zmpwalk.sim import actuator_markdown, actuator_table, simulate, write_actuator_csv
+    from zmpwalk.sim.motors import motor_fits
     from zmpwalk.sim.verdict import walk_verdict
 
     robot = _load_robot(args)
@@ -313,6 +324,8 @@ def _simulate(args: argparse.Namespace) -> int:
                       latency=args.latency, settle=SETTLE, hold=HOLD)
     verdict = walk_verdict(result, HOLD)
     rows = actuator_table(result)
+    motors = _motors(args)
+    fits = motor_fits(result, motors) if motors else []
     rms, largest = result.cop_error_stats()
     summary = {
         "robot": robot.name, "fell": result.fell, "fall_time": result.fall_time, "duration": float(result.time[-1]),
@@ -322,6 +335,8 @@ def _simulate(args: argparse.Namespace) -> int:
         "final_feet_error": result.final_feet_error, "final_feet_yaw_error": result.final_feet_yaw_error,
         "end_min_sole_force": result.end_min_sole_force, "end_max_speed": result.end_max_speed,
         "end_attitude_range": result.end_attitude_range, "verdict": verdict.as_dict(),
+        "motors": [{"joint": f.joint, "motor": f.motor, "rms_use": f.rms_use, "peak_use": f.peak_use,
+                    "fits": f.fits} for f in fits],
         "actuators": [vars(row) for row in rows],
     }
     if args.out:
@@ -341,6 +356,9 @@ def _simulate(args: argparse.Namespace) -> int:
         power = max(rows, key=lambda r: r.peak_power)
         print(f"largest torque {top.peak_torque:.3g} N m at {top.joint}; largest power {power.peak_power:.3g} W "
               f"at {power.joint}")
+        for fit in fits:
+            print(f"motor {fit.motor!r} at {fit.joint}: RMS {fit.rms_use * 100:.0f} % of rated, held peak "
+                  f"{fit.peak_use * 100:.0f} % of the envelope: {fit.verdict}")
         print(f"verdict: {'PASS' if verdict.passed else 'FAIL'}")
         for line in verdict.lines():
             print(f"  {line}")

@@ -25,7 +25,14 @@ from zmpwalk.patterns import generator as pattern_generator
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
-from zmpwalk.sim.actuators import ActuatorRow, actuator_markdown, actuator_table, write_actuator_csv
+from zmpwalk.sim.actuators import (
+    IMPACT_WINDOW,
+    ActuatorRow,
+    actuator_markdown,
+    actuator_table,
+    write_actuator_csv,
+)
+from zmpwalk.sim.motors import Motor, MotorFit, motor_fits
 from zmpwalk.sim.run import simulate
 from zmpwalk.sim.verdict import Verdict, walk_verdict
 
@@ -83,6 +90,7 @@ def build_report(
     balance: bool = False,
     latency: float = 0.0,
     schedule: Schedule | None = None,
+    motors: list[Motor] | None = None,
 ) -> Report:
     """Generate, check, simulate and report a walk into ``folder``.
 
@@ -125,6 +133,10 @@ def build_report(
     }
     if result.balance is not None:
         images["The stabilizer: pattern ZMP, desired ZMP and measured CoP; its corrections"] = plots.balance(result)
+    fits = motor_fits(result, motors) if motors else []
+    if motors:
+        images["Torque-speed operating points against the motors' envelopes (joint side)"] = \
+            plots.motor_envelopes(result, motors)
     for index, payload in enumerate(images.values()):
         (folder / f"figure{index + 1}.png").write_bytes(payload)
     done("plots")
@@ -148,8 +160,10 @@ def build_report(
         "cop_error_rms": rms, "cop_error_max": largest, "balance": result.balance is not None,
         "verdict": report.verdict.as_dict(),
     }
+    report.summary["motors"] = [{"joint": f.joint, "motor": f.motor, "rms_use": f.rms_use, "peak_use": f.peak_use,
+                                 "fits": f.fits} for f in fits]
     page = _page(title, robot, report.summary, images, animation, animation_note, step_margins(pattern), rows,
-                 report.verdict)
+                 report.verdict, fits)
     report.index.write_text(page, encoding="utf-8")
     (folder / "summary.json").write_text(json.dumps(report.summary, indent=2), encoding="utf-8")
     done("page")
@@ -158,7 +172,7 @@ def build_report(
 
 def _page(title: str, robot: RobotModel, summary: dict[str, Any], images: dict[str, bytes],
           animation: bytes | None, animation_note: str, margins: list[tuple[int, str, str, float, float, float]],
-          rows: list[ActuatorRow], verdict: Verdict) -> str:
+          rows: list[ActuatorRow], verdict: Verdict, fits: list[MotorFit]) -> str:
     esc = html.escape
     fell = summary["fell"]
     outcome = ("<b class='good'>passes every criterion</b>" if verdict.passed else
@@ -177,6 +191,12 @@ def _page(title: str, robot: RobotModel, summary: dict[str, Any], images: dict[s
     actuator_rows = "\n".join(
         "<tr>" + "".join(f"<td>{esc(cell.strip())}</td>" for cell in line.strip("|").split("|")) + "</tr>"
         for line in table[2:])
+    fit_rows = "\n".join(
+        f"<tr><td>{esc(f.joint)}</td><td>{esc(f.motor)}</td><td>{f.rms_use * 100:.0f}</td>"
+        f"<td>{f.peak_use * 100:.0f}</td><td class='{'good' if f.fits else 'bad'}'>{esc(f.verdict)}</td></tr>"
+        for f in fits)
+    fit_table = ("<table><tr><th>joint</th><th>motor</th><th>RMS torque [% of rated]</th>"
+                 f"<th>held peak [% of envelope]</th><th>verdict</th></tr>\n{fit_rows}\n</table>" if fits else "")
     figures = "\n".join(
         f"<figure><img src='{_data_uri('image/png', payload)}' alt='{esc(caption)}'>"
         f"<figcaption>{esc(caption)}</figcaption></figure>" for caption, payload in images.items())
@@ -210,10 +230,13 @@ The pattern's cart-table ZMP stays {float(summary['min_zmp_margin']) * 1e3:+.1f}
 support polygon at its closest (t = {float(summary['min_zmp_margin_time']):.2f} s; negative is outside).</p>
 {movie}
 <h2>Which motors?</h2>
-<table><tr><th>joint</th><th>peak torque [N m]</th><th>RMS torque [N m]</th><th>peak velocity [rad/s]</th>
-<th>peak power [W]</th><th>mean power [W]</th></tr>
+<p>Peaks are those held for at least {IMPACT_WINDOW * 1e3:g} ms (what sizes a motor); the largest single-sample
+torque, at touchdown impacts, has its own column.</p>
+<table><tr><th>joint</th><th>peak torque [N m]</th><th>impact peak [N m]</th><th>RMS torque [N m]</th>
+<th>peak velocity [rad/s]</th><th>peak power [W]</th><th>mean power [W]</th><th>model's limit [N m]</th></tr>
 {actuator_rows}
 </table>
+{fit_table}
 <h2>ZMP margin per step</h2>
 <table><tr><th>#</th><th>kind</th><th>swing</th><th>start [s]</th><th>duration [s]</th><th>min margin [mm]</th></tr>
 {margin_rows}

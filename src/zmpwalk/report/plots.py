@@ -14,6 +14,8 @@ from matplotlib.patches import Polygon
 
 from zmpwalk.footsteps import Pose2D, foot_corners
 from zmpwalk.patterns.result import WalkingPattern
+from zmpwalk.robots.model import JOINT_NAMES
+from zmpwalk.sim.motors import Motor, motor_for
 from zmpwalk.sim.run import SimulationResult
 
 DPI = 100
@@ -125,4 +127,28 @@ def balance(result: SimulationResult) -> bytes:
     axes[2].plot(result.time, log["height_difference"] * 1e3, label="foot height difference [mm]")
     axes[2].set_xlabel("t [s]")
     axes[2].legend(loc="upper left", fontsize=8, ncol=2)
+    return _png(figure)
+
+
+def motor_envelopes(result: SimulationResult, motors: list[Motor]) -> bytes:
+    """Each joint's torque-speed operating points against its motor's envelope (joint side)."""
+    figure, axes = plt.subplots(2, 3, figsize=(10, 6))
+    for axis, role in zip(axes.ravel(), JOINT_NAMES, strict=True):
+        motor = None
+        for index, column in enumerate(result.joint_names):
+            if not column.endswith(role):
+                continue
+            motor = motor_for(motors, column) or motor
+            axis.plot(np.abs(result.joint_velocities[:, index]), np.abs(result.joint_torques[:, index]), ".",
+                      markersize=1, alpha=0.4, label=column.split("_")[0])
+        if motor is not None:
+            speed = np.linspace(0.0, motor.joint_no_load_speed, 50)
+            axis.plot(speed, motor.joint_peak_torque * (1 - speed / motor.joint_no_load_speed), "k-", label="peak")
+            axis.axhline(motor.joint_rated_torque, color="k", linestyle="--", label="rated")
+            axis.set_xlim(0, min(motor.joint_no_load_speed, 1.5 * max(1e-3, float(np.abs(
+                result.joint_velocities).max()))))
+        axis.set_title(role.replace("_", " "), fontsize=9)
+        axis.set_xlabel("|speed| [rad/s]", fontsize=8)
+        axis.set_ylabel("|torque| [N m]", fontsize=8)
+        axis.legend(fontsize=7)
     return _png(figure)

@@ -259,6 +259,19 @@ def static_feedforward(plant: Plant, qpos: Array, zmp: Array, support: NDArray[n
     return offsets
 
 
+def planned_torques(plant: Plant, qpos: Array, zmp: Array, support: NDArray[np.integer],
+                    ankles: tuple[Array, Array], rate: float = 1000.0) -> Array:
+    """Leg joint torques of the planned motion by inverse dynamics [N m], (n, 12) in the leg-column order.
+
+    The torques of :func:`static_feedforward` (``dynamic=True``): what an ideal robot needs for the plan,
+    against which the simulated motor table is checked.
+    """
+    offsets = static_feedforward(plant, qpos, zmp, support, ankles, rate)
+    model = plant.model
+    stiffness = np.array([model.actuator_gainprm[a][0] * model.actuator_gear[a][0] ** 2 for a in plant.leg_actuators])
+    return np.asarray(offsets[:, plant.leg_actuators] * stiffness, dtype=np.float64)
+
+
 def damping_feedforward(plant: Plant, velocities: Array) -> Array:
     """Control offsets (n, 12) [rad] that cancel the lag of the leg servos' damping at the planned joint rates.
 
