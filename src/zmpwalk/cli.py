@@ -32,7 +32,7 @@ from zmpwalk.sim.motors import Motor
 from zmpwalk.tables import condition_margins, margins_markdown
 
 if TYPE_CHECKING:
-    from zmpwalk.sim.run import SimulationResult
+    pass
 
 EXIT_ERROR = 2
 EXIT_FAILED = 3  # the walk failed its verdict, or the plan's ZMP left the polygon
@@ -120,7 +120,8 @@ def _parser() -> argparse.ArgumentParser:
         description="Online ZMP walking patterns for biped humanoids (HUBO polynomial pattern).",
         epilog="example: zmpwalk plan --scenario fig28 --rate 1000 --out fig28.csv",
     )
-    commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    commands = parser.add_subparsers(dest="command", parser_class=_Parser)
 
     scenarios = commands.add_parser(
         "scenarios", help="list the built-in scenarios",
@@ -300,9 +301,14 @@ def _simulate(args: argparse.Namespace) -> int:
     from zmpwalk.patterns.hyperbolic import paper_walk
     from zmpwalk.sim import actuator_markdown, actuator_table, simulate, write_actuator_csv
     from zmpwalk.sim.motors import motor_fits
+    from zmpwalk.sim.run import write_result_csv
     from zmpwalk.sim.verdict import walk_verdict
 
     robot = _load_robot(args)
+    show = None if args.json or not sys.stderr.isatty() else _progress
+    stages = ("pattern", "joints", "simulation", "measures")
+    if show:
+        show(stages[0], 0, len(stages))
     if args.paper_example:
         if args.steps or args.scenario:
             raise _UsageError("--paper-example takes no steps file or scenario")
@@ -316,13 +322,20 @@ def _simulate(args: argparse.Namespace) -> int:
         options = {"schedule": schedule} if schedule else {}
         with _source(_label(args)):
             pattern = make(robot, commands, rate=1000.0, labels=labels, **options)
+    if show:
+        show(stages[1], 1, len(stages))
     joints = pattern_joint_trajectory(pattern, check_limits=False)
+    if show:
+        show(stages[2], 2, len(stages))
     from zmpwalk.balance import Stabilizer
 
     stabilizer = Stabilizer(robot, 1000.0) if _balance(args, robot) else None
     result = simulate(robot, joints, pattern, mass_scale=args.mass_scale, stabilizer=stabilizer,
-                      latency=args.latency, settle=SETTLE, hold=HOLD)
+                      latency=args.latency, settle=SETTLE, hold=HOLD,
+                      progress=None if show is None else lambda done: show("simulation", round(100 * done), 100))
     verdict = walk_verdict(result, HOLD)
+    if show:
+        show(stages[3], 4, len(stages))
     rows = actuator_table(result)
     motors = _motors(args)
     fits = motor_fits(result, motors) if motors else []
@@ -343,7 +356,7 @@ def _simulate(args: argparse.Namespace) -> int:
         args.out.mkdir(parents=True, exist_ok=True)
         write_actuator_csv(rows, args.out / "actuators.csv")
         (args.out / "actuators.md").write_text(actuator_markdown(rows) + "\n", encoding="utf-8")
-        result_csv(result, args.out / "simulation.csv")
+        write_result_csv(result, args.out / "simulation.csv")
     if args.json:
         print(json.dumps(_json_safe(summary), indent=2, allow_nan=False))
     else:
@@ -374,25 +387,6 @@ def _json_safe(value: object) -> object:
     if isinstance(value, list):
         return [_json_safe(item) for item in value]
     return value
-
-
-def result_csv(result: SimulationResult, path: Path) -> None:
-    """The simulation's time series as CSV (SI)."""
-    columns: dict[str, np.ndarray] = {
-        "t": result.time,
-        "torso_x": result.torso_position[:, 0], "torso_y": result.torso_position[:, 1],
-        "torso_z": result.torso_position[:, 2], "torso_roll": result.torso_rpy[:, 0],
-        "torso_pitch": result.torso_rpy[:, 1], "torso_yaw": result.torso_rpy[:, 2],
-        "cop_x": result.cop[:, 0], "cop_y": result.cop[:, 1],
-        "zmp_ref_x": result.reference_zmp[:, 0], "zmp_ref_y": result.reference_zmp[:, 1],
-        "force_left": result.force_left, "force_right": result.force_right,
-    }
-    for i, name in enumerate(result.joint_names):
-        columns[f"{name}_q"] = result.joint_angles[:, i]
-        columns[f"{name}_tau"] = result.joint_torques[:, i]
-        columns[f"{name}_power"] = result.joint_power[:, i]
-    np.savetxt(path, np.column_stack(list(columns.values())), delimiter=",", header=",".join(columns),
-               comments="", fmt="%.9g")
 
 
 def _summary(pattern: WalkingPattern) -> dict[str, object]:
@@ -481,10 +475,23 @@ def _run(args: argparse.Namespace) -> int:
     raise _UsageError(f"unknown command {args.command!r}")  # pragma: no cover
 
 
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("zmpwalk")
+    except PackageNotFoundError:  # run from a source tree that was not installed
+        return "unknown"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``zmpwalk`` command; returns the exit status."""
     try:
-        args = _parser().parse_args(argv)
+        parser = _parser()
+        args = parser.parse_args(argv)
+        if args.command is None:  # zmpwalk alone: the commands and what they do
+            parser.print_help()
+            return 0
         return _run(args)
     except (ZmpwalkError, _UsageError) as error:
         print(f"zmpwalk: error: {error}", file=sys.stderr)

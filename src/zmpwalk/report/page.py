@@ -33,7 +33,7 @@ from zmpwalk.sim.actuators import (
     write_actuator_csv,
 )
 from zmpwalk.sim.motors import Motor, MotorFit, motor_fits
-from zmpwalk.sim.run import simulate
+from zmpwalk.sim.run import simulate, write_result_csv
 from zmpwalk.sim.verdict import Verdict, walk_verdict
 
 Progress = Callable[[str, int, int], None]
@@ -116,10 +116,16 @@ def build_report(
     joints = pattern_joint_trajectory(pattern)
     done("joints")
     stabilizer = Stabilizer(robot, 1000.0) if balance else None
-    result = simulate(robot, joints, pattern, stabilizer=stabilizer, latency=latency, settle=SETTLE, hold=HOLD)
+    def simulating(done: float) -> None:
+        if progress is not None:
+            progress("simulation", round(100 * done), 100)
+
+    result = simulate(robot, joints, pattern, stabilizer=stabilizer, latency=latency, settle=SETTLE, hold=HOLD,
+                      progress=simulating)
     report.verdict = walk_verdict(result, HOLD)
     rows = actuator_table(result)
     write_actuator_csv(rows, folder / "actuators.csv")
+    write_result_csv(result, folder / "simulation.csv")
     done("simulation")
     from zmpwalk.report import plots
 
@@ -128,8 +134,9 @@ def build_report(
         "ZMP and measured CoP against time, with the support polygon's bounds (Figs. 21, 27-31)":
             plots.zmp_time(pattern, result),
         "Ankles relative to the pelvis (Figs. 10-11, 16-17)": plots.trajectories(pattern),
-        "Right leg: joint angles, torques and powers in the simulation (Figs. 12-14 of Lim et al.)":
+        "Both legs: joint angles, torques and powers in the simulation (Figs. 12-14 of Lim et al.)":
             plots.joints(result),
+        "Pelvis x, y and yaw, planned and simulated; the CoP margin over time": plots.pelvis(pattern, result),
     }
     if result.balance is not None:
         images["The stabilizer: pattern ZMP, desired ZMP and measured CoP; its corrections"] = plots.balance(result)
@@ -163,16 +170,25 @@ def build_report(
     report.summary["motors"] = [{"joint": f.joint, "motor": f.motor, "rms_use": f.rms_use, "peak_use": f.peak_use,
                                  "fits": f.fits} for f in fits]
     page = _page(title, robot, report.summary, images, animation, animation_note, step_margins(pattern), rows,
-                 report.verdict, fits)
+                 report.verdict, fits, _step_list(commands, labels))
     report.index.write_text(page, encoding="utf-8")
     (folder / "summary.json").write_text(json.dumps(report.summary, indent=2), encoding="utf-8")
     done("page")
     return report
 
 
+def _step_list(commands: Sequence[StepCommand], labels: Sequence[str] | None) -> str:
+    """The commanded steps as table rows."""
+    esc = html.escape
+    return "\n".join(
+        f"<tr><td>{n}</td><td>{esc(labels[n - 1] if labels and n <= len(labels) else f'step {n}')}</td>"
+        f"<td>{c.duration:.3g}</td><td>{c.forward:+.3g}</td><td>{c.side:+.3g}</td><td>{c.turn:+.3g}</td>"
+        f"<td>{'yes' if c.stop else ''}</td></tr>" for n, c in enumerate(commands, start=1))
+
+
 def _page(title: str, robot: RobotModel, summary: dict[str, Any], images: dict[str, bytes],
           animation: bytes | None, animation_note: str, margins: list[tuple[int, str, str, float, float, float]],
-          rows: list[ActuatorRow], verdict: Verdict, fits: list[MotorFit]) -> str:
+          rows: list[ActuatorRow], verdict: Verdict, fits: list[MotorFit], steps: str) -> str:
     esc = html.escape
     fell = summary["fell"]
     outcome = ("<b class='good'>passes every criterion</b>" if verdict.passed else
@@ -229,6 +245,13 @@ max {float(summary['cop_error_max']) * 1e3:.1f} mm.
 The pattern's cart-table ZMP stays {float(summary['min_zmp_margin']) * 1e3:+.1f} mm from the edge of the
 support polygon at its closest (t = {float(summary['min_zmp_margin_time']):.2f} s; negative is outside).</p>
 {movie}
+<p>The simulated time series (every millisecond, SI units): <a id="series" href="simulation.csv">simulation.csv</a>;
+the pattern: <a href="pattern.csv">pattern.csv</a>; the motor table: <a href="actuators.csv">actuators.csv</a>.</p>
+<h2>The walk commanded</h2>
+<table id="steps"><tr><th>#</th><th>step</th><th>step time [s]</th><th>forward [m]</th><th>side [m]</th>
+<th>turn [rad]</th><th>stop</th></tr>
+{steps}
+</table>
 <h2>Which motors?</h2>
 <p>Peaks are those held for at least {IMPACT_WINDOW * 1e3:g} ms (what sizes a motor); the largest single-sample
 torque, at touchdown impacts, has its own column.</p>

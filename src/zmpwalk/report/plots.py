@@ -45,6 +45,14 @@ def zmp_path(pattern: WalkingPattern, result: SimulationResult | None) -> bytes:
               ls="--", label="pelvis")
     if result is not None:
         axes.plot(result.cop[:, 0], result.cop[:, 1], color="C3", lw=0.8, alpha=0.8, label="measured CoP (simulation)")
+        if result.ankle_positions is not None:
+            planned = [step.landing for step in pattern.steps]
+            axes.plot([p[0] for p in planned], [p[1] for p in planned], "k+", markersize=8, label="planned ankles")
+            final = result.ankle_positions[-1]
+            landed = _landings(result)
+            axes.plot(landed[:, 0], landed[:, 1], "x", color="C3", markersize=6, label="simulated ankles at landing")
+            axes.plot(final[:, 0], final[:, 1], "o", color="C3", mfc="none", markersize=7,
+                      label="simulated, at the end")
     axes.set_aspect("equal")
     axes.set_xlabel("x [m]")
     axes.set_ylabel("y [m]")
@@ -52,6 +60,19 @@ def zmp_path(pattern: WalkingPattern, result: SimulationResult | None) -> bytes:
     axes.legend(loc="upper left", fontsize=8)
     axes.autoscale_view()
     return _png(figure)
+
+
+def _landings(result: SimulationResult) -> np.ndarray:
+    """Simulated ankle positions (x, y) where each sole became loaded, (k, 2)."""
+    if result.ankle_positions is None:
+        return np.zeros((0, 2))
+    weight = result.robot.mass * result.robot.gravity
+    points = []
+    for foot, force in enumerate((result.force_left, result.force_right)):
+        loaded = force > 0.15 * weight
+        for start in (np.flatnonzero(loaded[1:] & ~loaded[:-1]) + 1).tolist():
+            points.append(result.ankle_positions[min(int(start) + 50, len(force) - 1), foot, :2])
+    return np.array(points).reshape(-1, 2)
 
 
 def zmp_time(pattern: WalkingPattern, result: SimulationResult | None) -> bytes:
@@ -90,21 +111,40 @@ def trajectories(pattern: WalkingPattern) -> bytes:
 
 
 def joints(result: SimulationResult) -> bytes:
-    """Right-leg joint angles, torques and powers (Figs. 12-14 of Lim et al.)."""
-    figure, axes = plt.subplots(3, 1, figsize=(9, 7), sharex=True)
-    names = result.joint_names[6:]
-    for j, name in enumerate(names):
-        column = 6 + j
-        short = name.replace("right_", "")
-        axes[0].plot(result.time, result.joint_angles[:, column], lw=1, label=short)
-        axes[1].plot(result.time, result.joint_torques[:, column], lw=1, label=short)
-        axes[2].plot(result.time, result.joint_power[:, column], lw=1, label=short)
-    axes[0].set_ylabel("angle [rad]")
-    axes[1].set_ylabel("torque [N m]")
-    axes[2].set_ylabel("power [W]")
-    axes[2].set_xlabel("t [s]")
-    axes[0].legend(loc="upper right", fontsize=7, ncol=3)
-    axes[0].set_title("Right leg: joint angles, torques and powers (simulation)")
+    """Both legs' joint angles, torques and powers (Figs. 12-14 of Lim et al.), left and right side by side."""
+    figure, axes = plt.subplots(3, 2, figsize=(11, 7.5), sharex=True, sharey="row")
+    for side, label in enumerate(("left", "right")):
+        for j in range(6):
+            column = 6 * side + j
+            short = result.joint_names[column].replace(f"{label}_", "")
+            axes[0, side].plot(result.time, result.joint_angles[:, column], lw=1, label=short)
+            axes[1, side].plot(result.time, result.joint_torques[:, column], lw=1, label=short)
+            axes[2, side].plot(result.time, result.joint_power[:, column], lw=1, label=short)
+        axes[0, side].set_title(f"{label} leg (simulation)")
+        axes[2, side].set_xlabel("t [s]")
+    axes[0, 0].set_ylabel("angle [rad]")
+    axes[1, 0].set_ylabel("torque [N m]")
+    axes[2, 0].set_ylabel("power [W]")
+    axes[0, 1].legend(loc="upper right", fontsize=7, ncol=2)
+    return _png(figure)
+
+
+def pelvis(pattern: WalkingPattern, result: SimulationResult) -> bytes:
+    """Pelvis x, y and yaw against time, planned and simulated, and the CoP margin."""
+    figure, axes = plt.subplots(4, 1, figsize=(9, 8), sharex=True)
+    for i, label in enumerate(("x [m]", "y [m]")):
+        axes[i].plot(pattern.time, pattern.position_pelvis_in_world[:, i], color="0.3", lw=1.2, label="planned")
+        axes[i].plot(result.time, result.torso_position[:, i], color="C3", lw=0.9, label="simulated (base)")
+        axes[i].set_ylabel(f"pelvis {label}")
+    axes[2].plot(pattern.time, pattern.yaw_pelvis_in_world, color="0.3", lw=1.2, label="planned")
+    axes[2].plot(result.time, result.torso_rpy[:, 2], color="C3", lw=0.9, label="simulated")
+    axes[2].set_ylabel("pelvis yaw [rad]")
+    axes[3].plot(result.time, result.cop_margin * 1e3, color="C0", lw=0.8)
+    axes[3].axhline(0.0, color="k", lw=0.6)
+    axes[3].set_ylabel("CoP margin [mm]")
+    axes[3].set_xlabel("t [s]")
+    axes[0].legend(loc="upper left", fontsize=8)
+    axes[0].set_title("Pelvis against time; CoP distance inside the loaded soles")
     return _png(figure)
 
 

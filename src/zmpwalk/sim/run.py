@@ -31,7 +31,9 @@ robot's own model (docs/balance.md).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -233,6 +235,7 @@ def simulate(
     stabilizer: Stabilizer | None = None,
     latency: float = 0.0,
     noise: SensorNoise | None = None,
+    progress: Callable[[float], None] | None = None,
 ) -> SimulationResult:
     """Simulate ``joints`` (made from ``pattern``) on ``robot`` and measure the walk.
 
@@ -254,6 +257,7 @@ def simulate(
             robot, fed with the simulated sensors only); None walks open loop.
         latency: Delay of every measurement the stabilizer gets [s] (0 to 0.1).
         noise: Gaussian noise on the measurements (seeded; :class:`SensorNoise`).
+        progress: Called with the fraction done [0, 1] now and then while a closed loop runs.
 
     Returns:
         The measurements. The same input gives the same result.
@@ -319,7 +323,7 @@ def simulate(
         readings = readings[0, steps_per_tick - 1::steps_per_tick]
     else:
         readings, balance_log = _closed_loop(model, data, plant, stabilizer, pattern, pattern_time, reference,
-                                             control, zmp_ref, steps_per_tick, sensors, latency, noise)
+                                             control, zmp_ref, steps_per_tick, sensors, latency, noise, progress)
     # --- measurements
     pelvis = sensors.take(readings, "pelvis_pos")
     rpy = _rpy(sensors.take(readings, "pelvis_quat"))
@@ -433,8 +437,8 @@ def _measurement(row: Array, sensors: _Sensors) -> BalanceMeasurement:
 
 def _closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabilizer: Stabilizer,
                  pattern: WalkingPattern, pattern_time: Array, reference: Array, control: Array, zmp_ref: Array,
-                 steps_per_tick: int, sensors: _Sensors, latency: float,
-                 noise: SensorNoise | None) -> tuple[Array, dict[str, Array]]:
+                 steps_per_tick: int, sensors: _Sensors, latency: float, noise: SensorNoise | None,
+                 progress: Callable[[float], None] | None = None) -> tuple[Array, dict[str, Array]]:
     """Step the model tick by tick with the stabilizer in the loop; sensor rows (n, nsensordata) and its log."""
     n = len(pattern_time)
     interp = np.interp
@@ -456,6 +460,8 @@ def _closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabi
     current = data.sensordata.copy()
     stabilizer.reset()
     for k in range(n):
+        if progress is not None and k % 500 == 0:
+            progress(k / n)
         row = current if k - 1 - delay < 0 else readings[k - 1 - delay]
         measurement = _measurement(row, sensors)
         if rng is not None and noise is not None:
@@ -484,3 +490,24 @@ def _closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabi
             readings[k + 1:] = readings[k]
             break
     return readings, log
+
+
+def write_result_csv(result: SimulationResult, path: Path) -> None:
+    """The simulation's time series as CSV, one row per millisecond, SI units in the column names' meaning
+    (m, rad, N, N m, W): torso pose, CoP and reference ZMP, sole forces, CoP margin, each joint's angle,
+    torque and power."""
+    columns: dict[str, np.ndarray] = {
+        "t": result.time,
+        "torso_x": result.torso_position[:, 0], "torso_y": result.torso_position[:, 1],
+        "torso_z": result.torso_position[:, 2], "torso_roll": result.torso_rpy[:, 0],
+        "torso_pitch": result.torso_rpy[:, 1], "torso_yaw": result.torso_rpy[:, 2],
+        "cop_x": result.cop[:, 0], "cop_y": result.cop[:, 1],
+        "zmp_ref_x": result.reference_zmp[:, 0], "zmp_ref_y": result.reference_zmp[:, 1],
+        "force_left": result.force_left, "force_right": result.force_right, "cop_margin": result.cop_margin,
+    }
+    for i, name in enumerate(result.joint_names):
+        columns[f"{name}_q"] = result.joint_angles[:, i]
+        columns[f"{name}_tau"] = result.joint_torques[:, i]
+        columns[f"{name}_power"] = result.joint_power[:, i]
+    np.savetxt(path, np.column_stack(list(columns.values())), delimiter=",", header=",".join(columns),
+               comments="", fmt="%.9g")
