@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import os
+from collections.abc import Callable
 
 import numpy as np
 
@@ -14,7 +15,8 @@ FPS = 12  # [1/s] frames of the GIF
 WIDTH, HEIGHT = 400, 300  # [px] of each of the two views
 
 
-def render_gif(robot: RobotModel, result: SimulationResult, fps: int = FPS) -> bytes:
+def render_gif(robot: RobotModel, result: SimulationResult, fps: int = FPS,
+               progress: Callable[[float], None] | None = None) -> bytes:
     """The walk as an animated GIF: the recorded poses replayed from the side and from the front (lateral sway
     shows there), both cameras following the torso, the simulated time written on every frame.
 
@@ -44,6 +46,8 @@ def render_gif(robot: RobotModel, result: SimulationResult, fps: int = FPS) -> b
     rotation = _quaternions(result.torso_rpy)
     font = ImageFont.load_default()
     for i in range(0, len(result.time), step):
+        if progress is not None and (i // step) % 20 == 0:
+            progress(i / len(result.time))
         data.qpos[0:3] = result.torso_position[i]
         data.qpos[3:7] = rotation[i]
         data.qpos[plant.leg_qpos] = result.joint_angles[i]

@@ -153,7 +153,8 @@ def build_report(
         from zmpwalk.report.animation import render_gif
 
         try:
-            animation = render_gif(robot, result)
+            animation = render_gif(robot, result, progress=None if progress is None else
+                                   lambda done: progress("animation", round(100 * done), 100))
             (folder / "walk.gif").write_bytes(animation)
         except Exception as error:  # no OpenGL context on this machine: say so on the page
             animation_note = f"The animation could not be rendered here: {error}. Set MUJOCO_GL=egl or osmesa."
@@ -256,7 +257,8 @@ the pattern: <a href="pattern.csv">pattern.csv</a>; the motor table: <a href="ac
 <p>Peaks are those held for at least {IMPACT_WINDOW * 1e3:g} ms (what sizes a motor); the largest single-sample
 torque, at touchdown impacts, has its own column.</p>
 <table><tr><th>joint</th><th>peak torque [N m]</th><th>impact peak [N m]</th><th>RMS torque [N m]</th>
-<th>peak velocity [rad/s]</th><th>peak power [W]</th><th>mean power [W]</th><th>model's limit [N m]</th></tr>
+<th>peak velocity [rad/s]</th><th>peak power [W]</th><th>mean power [W]</th>
+<th>model's limit [N m] (held peak's share)</th></tr>
 {actuator_rows}
 </table>
 {fit_table}

@@ -93,10 +93,14 @@ def actuator_markdown(rows: list[ActuatorRow]) -> str:
     """The table as Markdown."""
     window = f"{IMPACT_WINDOW * 1e3:g} ms"
     lines = [f"| joint | peak torque (held {window}) [N m] | impact peak [N m] | RMS torque [N m] | "
-             f"peak velocity [rad/s] | peak power (held {window}) [W] | mean power [W] | model's limit [N m] |",
+             f"peak velocity [rad/s] | peak power (held {window}) [W] | mean power [W] | "
+             "model's limit [N m] (held peak's share) |",
              "|---|---|---|---|---|---|---|---|"]
     for r in rows:
-        limit = f"{r.torque_limit:.3g}" if math.isfinite(r.torque_limit) else "none"
+        limit = "none"
+        if math.isfinite(r.torque_limit):
+            share = r.peak_torque / r.torque_limit
+            limit = f"{r.torque_limit:.3g} ({share * 100:.0f} %{', EXCEEDED' if share > 1 else ''})"
         lines.append(f"| {r.joint} | {r.peak_torque:.3g} | {r.impact_torque:.3g} | {r.rms_torque:.3g} | "
                      f"{r.peak_velocity:.3g} | {r.peak_power:.3g} | {r.mean_power:.3g} | {limit} |")
     return "\n".join(lines)
