@@ -12,7 +12,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from zmpwalk import InvalidParameterError, StepCommand, generate
+from zmpwalk import InvalidParameterError, StepCommand, generate, load_robot
 from zmpwalk.cli import main
 from zmpwalk.kinematics import pattern_joint_trajectory
 from zmpwalk.patterns.hyperbolic import paper_walk
@@ -130,3 +130,21 @@ def test_simulate_command_writes_results_and_json(tmp_path, capsys):
 def test_simulate_command_errors(capsys, argv, message):
     assert main(argv) == 2
     assert message in capsys.readouterr().err
+
+
+def test_disturbances_tilt_gravity_scale_masses_and_push_in_their_window():
+    from zmpwalk.sim.run import Disturbances
+
+    model = mujoco.MjModel.from_xml_string(robot_mjcf(load_robot("mju-biped")))
+    mass = float(model.body_mass.sum())
+    tilt = np.radians(2.0)
+    Disturbances(floor_tilt=(0.0, tilt), mass_error=0.05).apply(model)
+    assert float(model.body_mass.sum()) == pytest.approx(1.05 * mass, rel=1e-12)
+    g = model.opt.gravity
+    assert np.linalg.norm(g) == pytest.approx(9.81, rel=1e-12)
+    assert g[0] == pytest.approx(9.81 * np.sin(tilt), rel=1e-9)  # downhill ahead pulls forward [m/s^2]
+    push = Disturbances(push_time=1.0, push_impulse=(20.0, 0.0, 0.0), push_duration=0.1)
+    assert push.force_at(0.99)[0] == 0.0 and push.force_at(1.05)[0] == pytest.approx(200.0)  # [N]
+    assert push.force_at(1.1)[0] == 0.0
+    with pytest.raises(InvalidParameterError, match="mass_error"):
+        Disturbances(mass_error=2.0).apply(model)

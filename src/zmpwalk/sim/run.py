@@ -236,6 +236,7 @@ def simulate(
     latency: float = 0.0,
     noise: SensorNoise | None = None,
     progress: Callable[[float], None] | None = None,
+    disturbances: Disturbances | None = None,
 ) -> SimulationResult:
     """Simulate ``joints`` (made from ``pattern``) on ``robot`` and measure the walk.
 
@@ -258,6 +259,8 @@ def simulate(
         latency: Delay of every measurement the stabilizer gets [s] (0 to 0.1).
         noise: Gaussian noise on the measurements (seeded; :class:`SensorNoise`).
         progress: Called with the fraction done [0, 1] now and then while a closed loop runs.
+        disturbances: A push, a floor tilt or a mass error of the plant (:class:`Disturbances`); the pattern,
+            the feedforward and the stabilizer keep the nominal robot.
 
     Returns:
         The measurements. The same input gives the same result.
@@ -279,6 +282,8 @@ def simulate(
     if not 0.0 <= latency <= 0.1:
         raise InvalidParameterError("latency", latency, "a delay in [0, 0.1] s")
     plant = build_plant(robot, mass_scale)
+    if disturbances is not None:
+        disturbances.apply(plant.model)
     if feedforward is None:
         feedforward = plant.imported or stabilizer is not None
     model = plant.model
@@ -318,12 +323,13 @@ def simulate(
         control += static_feedforward(plant, qpos_path, zmp_ref, pattern.support[index],
                                       (planned_ankles[0], planned_ankles[1]))
     balance_log: dict[str, Array] | None = None
-    if stabilizer is None:
+    if stabilizer is None and (disturbances is None or disturbances.push_time is None):
         _, readings = rollout.rollout(model, data, state[None], np.repeat(control, steps_per_tick, axis=0)[None])
         readings = readings[0, steps_per_tick - 1::steps_per_tick]
     else:
         readings, balance_log = _closed_loop(model, data, plant, stabilizer, pattern, pattern_time, reference,
-                                             control, zmp_ref, steps_per_tick, sensors, latency, noise, progress)
+                                             control, zmp_ref, steps_per_tick, sensors, latency, noise, progress,
+                                             disturbances, time)
     # --- measurements
     pelvis = sensors.take(readings, "pelvis_pos")
     rpy = _rpy(sensors.take(readings, "pelvis_quat"))
@@ -400,6 +406,53 @@ def simulate(
 
 
 @dataclass(frozen=True)
+class Disturbances:
+    """What the world does to the robot that the plan does not know.
+
+    Attributes:
+        push_time: When a push on the torso (base) starts [s], or None.
+        push_impulse: Its impulse in world [N s], (x, y, z); applied as a constant force over ``push_duration``.
+        push_duration: [s].
+        floor_tilt: Roll and pitch of the floor [rad] (the floor's rotation ``Rx(roll) Ry(pitch)`` from level:
+            pitch > 0 runs downhill ahead, roll > 0 raises the left side);
+            simulated by turning gravity in the floor's frame; the IMU reads attitude against gravity.
+        mass_error: The plant's masses and inertias are ``1 + mass_error`` times the model's [-].
+    """
+
+    push_time: float | None = None  # [s]
+    push_impulse: tuple[float, float, float] = (0.0, 0.0, 0.0)  # [N s]
+    push_duration: float = 0.1  # [s]
+    floor_tilt: tuple[float, float] = (0.0, 0.0)  # [rad]
+    mass_error: float = 0.0  # [-]
+
+    @property
+    def floor_rotation(self) -> Array:
+        """The floor's rotation from level, ``Rx(roll) Ry(pitch)``."""
+        roll, pitch = self.floor_tilt
+        cr, sr, cp, sp = math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch)
+        rx = np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]])
+        ry = np.array([[cp, 0.0, sp], [0.0, 1.0, 0.0], [-sp, 0.0, cp]])
+        return np.asarray(rx @ ry, dtype=np.float64)
+
+    def apply(self, model: mujoco.MjModel) -> None:
+        """Tilt gravity and scale the masses of ``model`` (in place)."""
+        if not -0.5 < self.mass_error < 1.0:
+            raise InvalidParameterError("mass_error", self.mass_error, "a fraction in (-0.5, 1)")
+        if max(abs(a) for a in self.floor_tilt) > 0.3:
+            raise InvalidParameterError("floor_tilt", self.floor_tilt, "angles within 0.3 rad")
+        gravity = float(np.linalg.norm(model.opt.gravity))
+        model.opt.gravity[:] = self.floor_rotation.T @ np.array([0.0, 0.0, -gravity])
+        model.body_mass[:] *= 1.0 + self.mass_error
+        model.body_inertia[:] *= 1.0 + self.mass_error
+
+    def force_at(self, time: float) -> Array:
+        """The push's force at ``time`` [N], (3,)."""
+        if self.push_time is None or not self.push_time <= time < self.push_time + self.push_duration:
+            return np.zeros(3)
+        return np.asarray(self.push_impulse, dtype=float) / self.push_duration
+
+
+@dataclass(frozen=True)
 class SensorNoise:
     """Standard deviations of Gaussian noise added to the stabilizer's measurements (seeded).
 
@@ -420,14 +473,20 @@ class SensorNoise:
     seed: int = 0
 
 
-def _measurement(row: Array, sensors: _Sensors) -> BalanceMeasurement:
+def _measurement(row: Array, sensors: _Sensors, floor: Array | None = None) -> BalanceMeasurement:
     """The stabilizer's inputs from one row of sensor data: the ground's wrench on each foot is the opposite
-    of what the ankle sensor between foot and leg reads (both in the foot frame)."""
+    of what the ankle sensor between foot and leg reads (both in the foot frame); the IMU's attitude is
+    relative to gravity (on a tilted floor, ``floor`` is the floor's rotation from level)."""
     def take(name: str) -> Array:
         return row[sensors.slices[name]]
 
     quaternion = take("pelvis_quat")
-    rpy = _rpy(quaternion[None])[0]
+    if floor is None or np.allclose(floor, np.eye(3)):
+        rpy = _rpy(quaternion[None])[0]
+    else:
+        level = floor @ _rotation(quaternion[None])[0]
+        rpy = np.array([math.atan2(level[2, 1], level[2, 2]), math.asin(max(-1.0, min(1.0, -level[2, 0]))),
+                        math.atan2(level[1, 0], level[0, 0])])
     return BalanceMeasurement(
         wrench_left=-np.concatenate([take("left_force"), take("left_torque")]),
         wrench_right=-np.concatenate([take("right_force"), take("right_torque")]),
@@ -435,12 +494,15 @@ def _measurement(row: Array, sensors: _Sensors) -> BalanceMeasurement:
         joint_angles=np.array([row[sensors.slices[f"{c}_q"]][0] for c in JOINT_COLUMNS]))
 
 
-def _closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabilizer: Stabilizer,
+def _closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabilizer: Stabilizer | None,
                  pattern: WalkingPattern, pattern_time: Array, reference: Array, control: Array, zmp_ref: Array,
                  steps_per_tick: int, sensors: _Sensors, latency: float, noise: SensorNoise | None,
-                 progress: Callable[[float], None] | None = None) -> tuple[Array, dict[str, Array]]:
-    """Step the model tick by tick with the stabilizer in the loop; sensor rows (n, nsensordata) and its log."""
+                 progress: Callable[[float], None] | None = None, disturbances: Disturbances | None = None,
+                 time: Array | None = None) -> tuple[Array, dict[str, Array]]:
+    """Step the model tick by tick (the stabilizer in the loop where given, pushes applied); sensor rows
+    (n, nsensordata) and the stabilizer's log."""
     n = len(pattern_time)
+    time = pattern_time if time is None else time
     interp = np.interp
     com = np.column_stack([interp(pattern_time, pattern.time, pattern.position_pelvis_in_world[:, i])
                            for i in range(3)])
@@ -458,12 +520,26 @@ def _closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabi
            "height_difference": np.empty(n), "pelvis_turn": np.empty((n, 2))}
     mujoco.mj_forward(model, data)
     current = data.sensordata.copy()
-    stabilizer.reset()
+    tilt = np.eye(3) if disturbances is None else disturbances.floor_rotation
+    push_body = int(model.site_bodyid[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "pelvis")])
+    if stabilizer is not None:
+        stabilizer.reset()
     for k in range(n):
         if progress is not None and k % 500 == 0:
             progress(k / n)
+        if disturbances is not None:
+            data.xfrc_applied[push_body, :3] = disturbances.force_at(float(time[k]))
+        if stabilizer is None:
+            data.ctrl[:] = control[k]
+            for _ in range(steps_per_tick):
+                mujoco.mj_step(model, data)
+            readings[k] = data.sensordata
+            if not np.all(np.isfinite(data.qpos)):
+                readings[k + 1:] = readings[k]
+                break
+            continue
         row = current if k - 1 - delay < 0 else readings[k - 1 - delay]
-        measurement = _measurement(row, sensors)
+        measurement = _measurement(row, sensors, tilt)
         if rng is not None and noise is not None:
             measurement.wrench_left += rng.normal(0, [noise.force] * 3 + [noise.torque] * 3)
             measurement.wrench_right += rng.normal(0, [noise.force] * 3 + [noise.torque] * 3)

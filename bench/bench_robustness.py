@@ -1,0 +1,119 @@
+"""Robustness of walking with and without the stabilizer: sensor latency, a mass error, a tilted floor, pushes.
+
+Run: python bench/bench_robustness.py [--quick]. Prints Markdown tables; asserts nothing. Runs on all cores.
+
+Push recovery: the largest impulse [N s] on the torso, applied over 0.1 s in the middle of a single support
+(the fourth step's), that the walk survives (no fall to its end), found by bisection to 1 N s, forward,
+backward and sideways (towards the swinging foot's side), open loop (the feedforward only) and with the
+stabilizer. TALOS needs ../shared/robots (skipped when absent).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import math
+import os
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+from zmpwalk import StepCommand, load_robot
+from zmpwalk.balance import Stabilizer
+from zmpwalk.kinematics import pattern_joint_trajectory
+from zmpwalk.patterns.polynomial import generate
+from zmpwalk.robots.model import RobotModel
+from zmpwalk.scenarios import load_scenario
+from zmpwalk.sim import simulate
+from zmpwalk.sim.run import Disturbances
+from zmpwalk.sim.verdict import walk_verdict
+
+TALOS = Path(__file__).resolve().parents[2] / "shared" / "robots" / "pal_talos" / "scene_position.xml"
+
+
+def robot(name: str) -> RobotModel:
+    if name == "talos":
+        return load_robot(TALOS)
+    model = load_robot("hubo")
+    if name == "hubo-soft" and model.servos is not None:
+        model = dataclasses.replace(model, servos=dataclasses.replace(model.servos, kp=3000.0, kv=60.0))
+    return model
+
+
+def walk(name: str) -> list[StepCommand]:
+    if name == "talos":
+        return [StepCommand(duration=1.0, forward=0.1)] * 8
+    return load_scenario("fig10")[:1] + [StepCommand(duration=0.95, forward=0.2)] * 8
+
+
+def run(job: tuple[str, str, bool, float]) -> tuple[str, str, bool, float, bool, bool]:
+    """(robot, condition, stabilizer, value) -> (..., fell, verdict passed)."""
+    name, condition, balance, value = job
+    model = robot(name)
+    pattern = generate(model, walk(name), rate=1000.0)
+    joints = pattern_joint_trajectory(pattern, check_limits=False)
+    latency = value / 1000.0 if condition == "latency" else 0.0
+    disturbances = None
+    if condition == "mass":
+        disturbances = Disturbances(mass_error=value)
+    elif condition in ("tilt-pitch", "tilt-roll"):
+        angle = math.radians(value)
+        disturbances = Disturbances(floor_tilt=(angle, 0.0) if condition == "tilt-roll" else (0.0, angle))
+    elif condition.startswith("push"):
+        step = pattern.steps[4]
+        middle = step.start + step.duration / 2
+        direction = {"push-forward": (1.0, 0.0), "push-backward": (-1.0, 0.0),
+                     "push-sideways": (0.0, 1.0 if step.swing == "left" else -1.0)}[condition]
+        disturbances = Disturbances(push_time=middle, push_impulse=(direction[0] * value, direction[1] * value, 0.0))
+    result = simulate(model, joints, pattern, stabilizer=Stabilizer(model, 1000.0) if balance else None,
+                      feedforward=True, settle=0.5, hold=2.0, latency=latency, disturbances=disturbances)
+    return name, condition, balance, value, result.fell, walk_verdict(result, 2.0).passed
+
+
+def largest_push(name: str, direction: str, balance: bool, high: float) -> float:
+    """Bisection on the impulse [N s] to 1 N s (serial: each probe depends on the last)."""
+    low = 0.0
+    while high - low > 1.0:
+        middle = (low + high) / 2
+        fell = run((name, direction, balance, middle))[4]
+        low, high = (low, middle) if fell else (middle, high)
+    return low
+
+
+def push_job(job: tuple[str, str, bool, float]) -> tuple[str, str, bool, float]:
+    name, direction, balance, high = job
+    return name, direction, balance, largest_push(name, direction, balance, high)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--quick", action="store_true", help="HUBO only, no pushes")
+    args = parser.parse_args()
+    robots = ["hubo", "hubo-soft"] + ([] if args.quick or not TALOS.is_file() else ["talos"])
+    conditions = [("latency", 10.0), ("mass", 0.05), ("mass", -0.05), ("tilt-pitch", 2.0), ("tilt-pitch", -2.0),
+                  ("tilt-roll", 2.0)]
+    jobs = [(r, c, b, v) for r in robots for c, v in conditions for b in (False, True)]
+    print("| robot | condition | stabilizer | fell | verdict |")
+    print("|---|---|---|---|---|")
+    with ProcessPoolExecutor(max_workers=os.cpu_count()) as pool:
+        for name, condition, balance, value, fell, passed in pool.map(run, jobs):
+            unit = {"latency": " ms", "mass": "", "tilt-pitch": " deg", "tilt-roll": " deg"}[condition]
+            shown = f"{value:+.0%}" if condition == "mass" else f"{value:g}{unit}"
+            print(f"| {name} | {condition} {shown} | {'on' if balance else 'off'} | {'yes' if fell else 'no'} | "
+                  f"{'pass' if passed else 'FAIL'} |", flush=True)
+        if args.quick:
+            return
+        print("\n| robot | push | largest impulse survived, open loop [N s] | with the stabilizer [N s] | ratio |")
+        print("|---|---|---|---|---|")
+        pushed = [r for r in robots if r != "hubo-soft"]
+        pushes = [(r, d, b, 96.0 if r == "talos" else 48.0) for r in pushed
+                  for d in ("push-forward", "push-backward", "push-sideways") for b in (False, True)]
+        found = {(n, d, b): v for n, d, b, v in pool.map(push_job, pushes)}
+        for r in pushed:
+            for d in ("push-forward", "push-backward", "push-sideways"):
+                off, on = found[(r, d, False)], found[(r, d, True)]
+                ratio = f"{on / off:.1f}" if off > 0 else "inf"
+                print(f"| {r} | {d[5:]} | {off:.0f} | {on:.0f} | {ratio} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
