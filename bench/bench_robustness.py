@@ -87,6 +87,7 @@ def push_job(job: tuple[str, str, bool, float]) -> tuple[str, str, bool, float]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true", help="HUBO only, no pushes")
+    parser.add_argument("--no-push", action="store_true", help="the conditions only, no push search")
     args = parser.parse_args()
     robots = ["hubo", "hubo-soft"] + ([] if args.quick or not TALOS.is_file() else ["talos"])
     conditions = [("latency", 10.0), ("mass", 0.05), ("mass", -0.05), ("tilt-pitch", 2.0), ("tilt-pitch", -2.0),
@@ -100,7 +101,7 @@ def main() -> None:
             shown = f"{value:+.0%}" if condition == "mass" else f"{value:g}{unit}"
             print(f"| {name} | {condition} {shown} | {'on' if balance else 'off'} | {'yes' if fell else 'no'} | "
                   f"{'pass' if passed else 'FAIL'} |", flush=True)
-        if args.quick:
+        if args.quick or args.no_push:
             return
         print("\n| robot | push | largest impulse survived, open loop [N s] | with the stabilizer [N s] | ratio |")
         print("|---|---|---|---|---|")

@@ -282,8 +282,6 @@ def simulate(
     if not 0.0 <= latency <= 0.1:
         raise InvalidParameterError("latency", latency, "a delay in [0, 0.1] s")
     plant = build_plant(robot, mass_scale)
-    if disturbances is not None:
-        disturbances.apply(plant.model)
     if feedforward is None:
         feedforward = plant.imported or stabilizer is not None
     model = plant.model
@@ -322,6 +320,8 @@ def simulate(
         control[:, plant.leg_actuators] += damping_feedforward(plant, rates)
         control += static_feedforward(plant, qpos_path, zmp_ref, pattern.support[index],
                                       (planned_ankles[0], planned_ankles[1]))
+    if disturbances is not None:  # the world changes after the controller's model is made
+        disturbances.apply(model)
     balance_log: dict[str, Array] | None = None
     if stabilizer is None and (disturbances is None or disturbances.push_time is None):
         _, readings = rollout.rollout(model, data, state[None], np.repeat(control, steps_per_tick, axis=0)[None])
@@ -435,7 +435,7 @@ class Disturbances:
         return np.asarray(rx @ ry, dtype=np.float64)
 
     def apply(self, model: mujoco.MjModel) -> None:
-        """Tilt gravity and scale the masses of ``model`` (in place)."""
+        """Tilt gravity and scale the masses of ``model`` (in place; MuJoCo's derived constants recomputed)."""
         if not -0.5 < self.mass_error < 1.0:
             raise InvalidParameterError("mass_error", self.mass_error, "a fraction in (-0.5, 1)")
         if max(abs(a) for a in self.floor_tilt) > 0.3:
@@ -444,6 +444,7 @@ class Disturbances:
         model.opt.gravity[:] = self.floor_rotation.T @ np.array([0.0, 0.0, -gravity])
         model.body_mass[:] *= 1.0 + self.mass_error
         model.body_inertia[:] *= 1.0 + self.mass_error
+        mujoco.mj_setConst(model, mujoco.MjData(model))  # scratch data: mj_setConst works at qpos0
 
     def force_at(self, time: float) -> Array:
         """The push's force at ``time`` [N], (3,)."""
