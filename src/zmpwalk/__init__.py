@@ -7,6 +7,7 @@ import os
 os.environ.setdefault("MUJOCO_GL", "egl")
 
 
+from zmpwalk.balance import BalanceMeasurement, Stabilizer, StabilizerGains
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import (
     FileFormatError,
@@ -17,6 +18,7 @@ from zmpwalk.errors import (
     ZmpwalkError,
 )
 from zmpwalk.kinematics import JointLimitError, JointTrajectory, pattern_joint_trajectory
+from zmpwalk.leg_chain import LegChain
 from zmpwalk.online import OnlineWalker, WalkingSample
 from zmpwalk.patterns.hyperbolic import generate_hyperbolic
 from zmpwalk.patterns.polynomial import generate
@@ -25,15 +27,19 @@ from zmpwalk.robots import RobotModel, list_robots, load_robot
 from zmpwalk.schedule import Schedule, ShapeParameters
 
 __all__ = [
+    "BalanceMeasurement",
     "FileFormatError",
     "InfeasiblePatternError",
     "InvalidParameterError",
     "JointLimitError",
     "JointTrajectory",
+    "LegChain",
     "OnlineWalker",
     "RobotModel",
     "Schedule",
     "ShapeParameters",
+    "Stabilizer",
+    "StabilizerGains",
     "StepCommand",
     "UnknownNameError",
     "UnreachableError",

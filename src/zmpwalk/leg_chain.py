@@ -40,9 +40,10 @@ T1's hip (pitch, roll and yaw axes 2 cm and 8.2 cm apart):
 .. math:: \Delta q = J^T (J J^T + \lambda^2 I)^{-1} e
 
 with ``e`` the foot's position error and the rotation vector of its
-orientation error. It stops when every sample is within :data:`IK_TOLERANCE`
-and raises :class:`IKConvergenceError` (naming the leg, the time and the
-residual) when one does not converge.
+orientation error. It stops when every sample is within :data:`IK_TOLERANCE`;
+a sample that does not converge is reported with its remaining error as the
+``excess`` of :meth:`LegChain.solve`, and a joint trajectory then raises
+:class:`~zmpwalk.errors.UnreachableError` naming the leg and the time.
 """
 
 from __future__ import annotations
@@ -53,8 +54,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from zmpwalk.errors import ZmpwalkError
-
 Array = NDArray[np.float64]
 
 IK_TOLERANCE = 1e-10  # [m] and [rad]: convergence of the numeric IK
@@ -62,23 +61,6 @@ IK_MAX_ITERATIONS = 100
 IK_DAMPING = 1e-6  # lambda of the damped least squares [-]
 IK_MAX_STEP = 0.3  # [rad] largest joint change of one iteration (keeps far targets from overshooting)
 AXES_MEET_TOLERANCE = 1e-6  # [m] axes closer than this meet (closed form applies)
-
-
-class IKConvergenceError(ZmpwalkError, ValueError):
-    """The numeric inverse kinematics did not converge for a foot target.
-
-    Attributes:
-        leg: ``"left"`` or ``"right"``.
-        time: When [s] (nan where unknown).
-        residual: Remaining position error [m].
-    """
-
-    def __init__(self, leg: str, time: float, residual: float) -> None:
-        self.leg, self.time, self.residual = leg, time, residual
-        super().__init__(
-            f"{leg} leg: the numeric inverse kinematics did not converge at t = {time:.3f} s "
-            f"(foot still {residual * 1e3:.2f} mm from its target); the target is likely out of reach"
-        )
 
 
 def _rodrigues(axis: Array, angle: Array) -> Array:  # the IK's few rotations; transforms() has its own
@@ -371,4 +353,4 @@ def _rotation_vector(rotation: Array) -> Array:
     return np.asarray(vee * scale[:, None], dtype=np.float64)
 
 
-__all__ = ["IKConvergenceError", "LegChain"]
+__all__ = ["LegChain"]
