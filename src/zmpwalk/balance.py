@@ -21,9 +21,10 @@ separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega 
 2. **CoM admittance** realises ``p_d``: the commanded CoM accelerates by
    ``Delta c'' = A (p_measured - p_d) - K_v Delta c' - K_p Delta c`` (in the cart-table model
    ``p = c - c'' / omega^2``, accelerating forward moves the ZMP back).
-3. **Ankle damping control** (Kajita 2010, Eq. 18): each loaded sole's centre of pressure follows its share
-   of ``p_d`` by turning the foot, ``delta' = -(tau_d - tau) / D - delta / T``, written per metre of CoP error.
-4. **Foot force difference control** (Kajita 2010, Eq. 21): in double support the feet's heights move apart
+3. **Ankle damping control** (the damping control of Kajita et al. 2010): each loaded sole's centre of
+   pressure follows its share of ``p_d`` by turning the foot, ``delta' = -(tau_d - tau) / D - delta / T``,
+   written per metre of CoP error.
+4. **Foot force difference control** (Kajita et al. 2010): in double support the feet's heights move apart
    until the measured force difference is the desired one.
 5. **Torso attitude**: the pelvis is turned against the measured roll and pitch (and their rates).
 
