@@ -43,6 +43,7 @@ from numpy.typing import NDArray
 
 from zmpwalk.errors import InvalidParameterError
 from zmpwalk.kinematics import leg_chains, rest_mass
+from zmpwalk.leg_chain import cross3
 from zmpwalk.robots.model import RobotModel
 
 Array = NDArray[np.float64]
@@ -262,7 +263,7 @@ class Stabilizer:
         measured_feet = (feet[0], feet[1])
         previous_arm = rotation @ (com_in_base - self._previous_relative[anchor])
         spin = rotation @ np.asarray(measurement.rate, dtype=float)
-        raw_velocity = (arm[:2] - previous_arm[:2]) / dt + np.cross(spin, arm)[:2]
+        raw_velocity = (arm[:2] - previous_arm[:2]) / dt + cross3(spin, arm)[:2]
         self._previous_relative = relative
         alpha = dt / (g.velocity_filter + dt)
         self._com_velocity += alpha * (raw_velocity - self._com_velocity)
@@ -328,7 +329,7 @@ class Stabilizer:
             change = np.empty(6)
             change[:2] = _rotate(self._landing[index], -yaw_pelvis_in_world) - shift_in_pelvis
             change[2] = -self._height / 2 if index == 0 else self._height / 2
-            change[:3] -= np.cross(pelvis_turn, position[0])
+            change[:3] -= cross3(pelvis_turn, position[0])
             change[3:5] = foot_turn
             change[5] = 0.0
             change[3:] -= pelvis_turn

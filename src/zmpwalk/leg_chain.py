@@ -71,6 +71,16 @@ def _rodrigues(axis: Array, angle: Array) -> Array:  # the IK's few rotations; t
     return np.asarray(np.eye(3) + s * k + (1.0 - c) * (k @ k), dtype=np.float64)
 
 
+def cross3(a: Array, b: Array) -> Array:
+    """Cross products along the last axis of 3-vectors (``np.cross`` without its axis handling, which
+    dominates on the small arrays of one control tick)."""
+    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1], a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+
+
+_EYE = np.eye(3)
+
+
 def _wrap(angle: Array) -> Array:
     return np.asarray((angle + np.pi) % (2 * np.pi) - np.pi, dtype=np.float64)
 
@@ -161,7 +171,7 @@ class LegChain:
         centre of mass at ``q = 0``.
         """
         rotations, translations = self.transforms(q) if transforms is None else transforms
-        return np.asarray(np.einsum("nkij,kj->nki", rotations[:, 1:], self.link_coms) + translations[:, 1:])
+        return np.asarray((rotations[:, 1:] @ self.link_coms[:, :, None])[..., 0] + translations[:, 1:])
 
     @property
     def label(self) -> str:
@@ -210,14 +220,15 @@ class LegChain:
         n = len(q)
         rotations = np.empty((n, 7, 3, 3))
         translations = np.empty((n, 7, 3))
-        rotations[:, 0] = np.eye(3)
+        rotations[:, 0] = _EYE
         translations[:, 0] = 0.0
         sines, cosines = np.sin(q), 1.0 - np.cos(q)
         skews, skews2 = self._skews, self._skews2  # type: ignore[attr-defined]
+        points = self.points
         for i in range(6):
-            r_i = np.eye(3) + sines[:, i, None, None] * skews[i] + cosines[:, i, None, None] * skews2[i]
-            t_i = self.points[i] - r_i @ self.points[i]  # exp(xi q): x -> R x + (I - R) r
-            translations[:, i + 1] = translations[:, i] + np.einsum("nij,nj->ni", rotations[:, i], t_i)
+            r_i = _EYE + sines[:, i, None, None] * skews[i] + cosines[:, i, None, None] * skews2[i]
+            t_i = points[i] - r_i @ points[i]  # exp(xi q): x -> R x + (I - R) r
+            translations[:, i + 1] = translations[:, i] + (rotations[:, i] @ t_i[..., None])[..., 0]
             rotations[:, i + 1] = rotations[:, i] @ r_i
         return rotations, translations
 
@@ -231,10 +242,10 @@ class LegChain:
         """Geometric Jacobian of the ankle point in the pelvis frame, (n, 6, 6): rows (v, omega)."""
         rotations, translations = self.transforms(q) if transforms is None else transforms
         ankle = translations[:, 6] + rotations[:, 6] @ self.ankle
-        axes = np.einsum("nkij,kj->nki", rotations[:, :6], self.axes)  # (n, 6, 3)
-        origins = np.einsum("nkij,kj->nki", rotations[:, :6], self.points) + translations[:, :6]
+        axes = (rotations[:, :6] @ self.axes[:, :, None])[..., 0]  # (n, 6, 3)
+        origins = (rotations[:, :6] @ self.points[:, :, None])[..., 0] + translations[:, :6]
         jacobian = np.empty((len(ankle), 6, 6))
-        jacobian[:, :3, :] = np.swapaxes(np.cross(axes, ankle[:, None, :] - origins), 1, 2)
+        jacobian[:, :3, :] = np.swapaxes(cross3(axes, ankle[:, None, :] - origins), 1, 2)
         jacobian[:, 3:, :] = np.swapaxes(axes, 1, 2)
         return jacobian
 
@@ -353,4 +364,4 @@ def _rotation_vector(rotation: Array) -> Array:
     return np.asarray(vee * scale[:, None], dtype=np.float64)
 
 
-__all__ = ["LegChain"]
+__all__ = ["LegChain", "cross3"]
