@@ -137,3 +137,24 @@ def test_planning_errors_name_the_file_the_table_and_the_walked_step(tmp_path, c
     steps.write_text("[[steps]]\nduration = 0.8\nforward = 0.1\nrepeat = 3\n[[steps]]\nduration = 0.8\nforward = 0.9\n")
     assert main(["plan", str(steps)]) == 2
     assert f"{steps}: step 4 ([[steps]] 2): right ankle out of reach" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["plan", "--scenario", "fig10", "--feet", "only_one"], "--feet = 'only_one' must be two body names"),
+    (["plan", "--scenario", "fig10", "--generator", "hyperbolic", "--schedule", "tables.toml"],
+     "--schedule applies to the polynomial generator"),
+    (["simulate", "--scenario", "fig10", "--latency", "0.5"], "latency = 0.5"),
+    (["simulate", "--scenario", "fig10", "--motors", "no-such-motors.toml"], "no-such-motors.toml"),
+    (["robot", "no-such-robot.urdf"], "no such file"),
+])
+def test_new_options_reject_bad_input_in_one_line(argv, message, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_a_model_robot_file_rejects_tables_it_does_not_take(tmp_path, capsys):
+    robot = tmp_path / "r.toml"
+    robot.write_text('[model]\nfile = "robot.xml"\n\n[limits]\nknee = [0, 2]\n', encoding="utf-8")
+    assert main(["plan", "--scenario", "fig10", "--robot", str(robot)]) == 2
+    assert "unknown table(s) limits in a robot file with [model]" in capsys.readouterr().err
