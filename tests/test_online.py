@@ -14,6 +14,7 @@ from zmpwalk import (
     UnreachableError,
     ZmpwalkError,
     generate,
+    load_robot,
 )
 
 TOL = 1e-12  # [m] the walker and the generator evaluate the same closed forms
@@ -153,3 +154,20 @@ def test_commands_at_any_tick_keep_the_motion_continuous(hubo, actions):
         except ZmpwalkError:
             assert walker.queued == queued  # a rejected command changes nothing
     assert largest < 2.0 / rate  # [m] less than 2 m/s between two ticks: no jump anywhere
+
+
+@pytest.mark.parametrize(("joints", "command", "error"), [
+    (True, StepCommand(duration=1.0, forward=0.3, foot_lift=0.15), "right_ankle_pitch"),
+    (False, StepCommand(duration=0.78, side=-0.039, d1_recovery=0.99), "out of reach"),
+])
+def test_a_command_whose_stop_is_infeasible_is_rejected_by_command_not_by_a_later_tick(joints, command, error):
+    walker = OnlineWalker(load_robot("hubo"), rate=100, joints=joints)
+    with pytest.raises(ZmpwalkError, match=f"closing step this command would end with.*{error}"):
+        walker.command(command)
+    assert not walker.walking and walker.queued is None  # unchanged
+    for _ in range(300):  # and it goes on standing, and walking when asked
+        walker.tick()
+    walker.command(StepCommand(duration=0.8, forward=0.1))
+    for _ in range(600):
+        walker.tick()
+    assert not walker.walking  # stopped by itself with the stop planned at command()

@@ -22,10 +22,11 @@ Behaviour:
   safely: a closing step of the last step time (the swinging foot lands beside
   the other one) and a settle stage, after which it stands still in the ready
   posture until the next command. :meth:`OnlineWalker.stop` asks for the same
-  explicitly.
-* The trajectories of a command are sampled when the command is queued, so a
-  :meth:`~OnlineWalker.tick` only reads a row; the tick that begins an
-  automatic stop also samples the stop.
+  explicitly. That closing step is planned, sampled and checked (reach, joint
+  ranges) when the command before it is accepted: a command whose own stop is
+  infeasible is rejected, so no accepted command makes a later tick fail.
+* The trajectories of a command (and of its stop) are sampled when the command
+  is queued, so a :meth:`~OnlineWalker.tick` only reads a row.
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk.commands import StepCommand
-from zmpwalk.errors import InvalidParameterError
+from zmpwalk.errors import InvalidParameterError, ZmpwalkError
 from zmpwalk.footsteps import Stance
 from zmpwalk.kinematics import joint_trajectory
 from zmpwalk.patterns.polynomial import (
@@ -104,6 +105,7 @@ class _Plan:
     boundary: Boundary
     rows: Array
     first_index: int
+    closing: _Plan | None = None  # the automatic stop after this plan, planned and checked with it
 
 
 class OnlineWalker:
@@ -161,13 +163,28 @@ class OnlineWalker:
         stance, boundary = self._stance, self._boundary
         if boundary.at_rest:
             boundary = Boundary(max(boundary.time, self.time))
-        stages, next_stance, next_boundary = plan_next(self.robot, self._schedule, stance, boundary, command)
-        if not stages:  # a stop while standing
+        plan = self._plan(command, stance, boundary)
+        if plan is None:  # a stop while standing
             self._pending = None
             return
+        if not command.stop:
+            # The stop this command leads to when no other follows: planned and checked now, so that no
+            # accepted command can make a later tick fail, and no tick plans.
+            try:
+                plan.closing = self._plan(closing_command(command), plan.stance, plan.boundary)
+            except ZmpwalkError as error:
+                raise error.in_context("the closing step this command would end with (when no other follows)") \
+                    from None
+        self._pending = plan
+
+    def _plan(self, command: StepCommand, stance: Stance, boundary: Boundary) -> _Plan | None:
+        """Plan, sample (and solve the legs of) one command from a stance; None for a stop while standing."""
+        stages, next_stance, next_boundary = plan_next(self.robot, self._schedule, stance, boundary, command)
+        if not stages:
+            return None
         first_index = math.ceil(stages[0].start * self.rate - _EPS)
         rows = self._sample(stages, first_index, next_boundary.time)
-        self._pending = _Plan(command, stages, next_stance, next_boundary, rows, first_index)
+        return _Plan(command, stages, next_stance, next_boundary, rows, first_index)
 
     def stop(self) -> None:
         """Queue a closing step into the ready posture (nothing happens when standing).
@@ -202,7 +219,10 @@ class OnlineWalker:
         """Make the queued (or an automatic stop) command current; None when standing."""
         while True:
             if self._pending is None and not self._boundary.at_rest:
-                self.stop()
+                # the automatic stop, planned when its step was commanded
+                self._pending = self._current.closing if self._current is not None else None
+                if self._pending is None:
+                    self.stop()
             plan = self._pending
             self._pending = None
             if plan is None:
