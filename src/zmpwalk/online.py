@@ -106,6 +106,7 @@ class _Plan:
     rows: Array
     first_index: int
     closing: _Plan | None = None  # the automatic stop after this plan, planned and checked with it
+    standing: Array | None = None  # the row of standing still after it, where it ends at rest
 
 
 class OnlineWalker:
@@ -184,7 +185,8 @@ class OnlineWalker:
             return None
         first_index = math.ceil(stages[0].start * self.rate - _EPS)
         rows = self._sample(stages, first_index, next_boundary.time)
-        return _Plan(command, stages, next_stance, next_boundary, rows, first_index)
+        standing = self._standing_row(next_stance) if next_boundary.at_rest else None
+        return _Plan(command, stages, next_stance, next_boundary, rows, first_index, standing=standing)
 
     def stop(self) -> None:
         """Queue a closing step into the ready posture (nothing happens when standing).
@@ -233,7 +235,7 @@ class OnlineWalker:
             if not plan.command.stop:
                 self._last_command = plan.command
             if plan.boundary.at_rest:
-                self._standing = self._standing_row(plan.stance)
+                self._standing = plan.standing if plan.standing is not None else self._standing_row(plan.stance)
             if index < plan.first_index + len(plan.rows):
                 return plan
 
