@@ -109,3 +109,25 @@ def test_unknown_generator_lists_the_known_ones():
 
     with pytest.raises(UnknownNameError, match=r"unknown generator 'lipm'; known: hyperbolic, polynomial"):
         generator("lipm")
+
+
+@pytest.mark.parametrize(("fields", "words"), [
+    ({"duration": None}, "duration = None is not allowed; expected a finite number"),
+    ({"duration": 0.8, "forward": None}, "forward = None"),
+    ({"duration": 0.8, "forward": 10**400}, "forward = an integer of 401 digits"),
+    ({"duration": 1e300}, r"duration = 1e\+300 is not allowed; expected a value in \(0, 5\] s \(seconds\)"),
+    ({"duration": 800}, r"\(seconds\)"),  # milliseconds by mistake
+    ({"duration": 0.8, "forward": 20}, r"forward = 20 is not allowed; expected a value in \[-2, 2\] m \(metres\)"),
+    ({"duration": 0.8, "side": -3.0}, r"side = -3"),
+])
+def test_hostile_step_fields_are_one_clear_error(fields, words):
+    with pytest.raises(InvalidParameterError, match=words):
+        StepCommand(**fields)
+
+
+def test_numpy_scalars_are_numbers():
+    import numpy as np
+
+    command = StepCommand(duration=np.float32(0.8), forward=np.int64(0), sway=np.float64(0.03))
+    assert type(command.duration) is float and command.duration == pytest.approx(0.8, abs=1e-7)  # [s]
+    assert type(command.forward) is float and command.forward == 0.0

@@ -22,11 +22,15 @@ the value from the parameter schedule (:mod:`zmpwalk.schedule`).
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, fields
 
 from zmpwalk.errors import InvalidParameterError
 
 MAX_TURN = math.pi / 2  # [rad] largest turn of one step
+MAX_DURATION = 5.0  # [s] longest step time: walking steps last about a second; 800 is milliseconds by mistake
+MAX_STRIDE = 2.0  # [m] largest |forward| and |side| before any robot's reach is checked: 20 is centimetres
+REQUIRED = ("duration", "forward", "side", "turn")  # the fields that take no None
 
 
 @dataclass(frozen=True)
@@ -60,11 +64,21 @@ class StepCommand:
                 if not isinstance(value, bool):
                     raise InvalidParameterError("stop", value, "true or false")
                 continue
-            if value is None:
+            if value is None and item.name not in REQUIRED:
                 continue
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            # any real number, numpy's scalars included, stored as a float
+            number = math.nan
+            if isinstance(value, numbers.Real) and not isinstance(value, bool):
+                try:
+                    number = float(value)
+                except OverflowError:
+                    number = math.nan
+            if not math.isfinite(number):
                 raise InvalidParameterError(item.name, value, "a finite number")
-        _check("duration", self.duration, 0.0, math.inf, low_open=True, unit="s")
+            object.__setattr__(self, item.name, number)
+        _check("duration", self.duration, 0.0, MAX_DURATION, low_open=True, unit="s (seconds)")
+        _check("forward", self.forward, -MAX_STRIDE, MAX_STRIDE, unit="m (metres)")
+        _check("side", self.side, -MAX_STRIDE, MAX_STRIDE, unit="m (metres)")
         _check("turn", self.turn, -MAX_TURN, MAX_TURN, unit="rad")
         if self.stop:
             for name in ("forward", "side", "turn"):

@@ -88,6 +88,8 @@ class InfeasiblePatternError(ZmpwalkError, ValueError):
 
 
 def _show(value: object) -> str:
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**20:
+        return f"an integer of {len(str(abs(value)))} digits"
     if isinstance(value, float):
         if math.isnan(value):
             return "nan"
