@@ -171,3 +171,16 @@ def test_a_command_whose_stop_is_infeasible_is_rejected_by_command_not_by_a_late
     for _ in range(600):
         walker.tick()
     assert not walker.walking  # stopped by itself with the stop planned at command()
+
+
+def test_samples_do_not_alias_the_walkers_buffers():
+    walker = OnlineWalker(load_robot("hubo"), rate=100, joints=True)
+    first = walker.tick()  # standing: every standing tick reads the same row
+    expected = first.position_pelvis_in_world.copy(), first.joint_angles.copy()
+    first.position_pelvis_in_world[:] = 99.0
+    first.joint_angles[:] = 99.0
+    first.zmp_in_world[:] = 99.0
+    second = walker.tick()
+    assert np.array_equal(second.position_pelvis_in_world, expected[0])
+    assert np.array_equal(second.joint_angles, expected[1])
+    assert np.all(second.zmp_in_world != 99.0)

@@ -202,7 +202,8 @@ class OnlineWalker:
         if current is None or index >= current.first_index + len(current.rows):
             current = self._advance(index)
         self._index = index + 1
-        row = self._standing if current is None else current.rows[index - current.first_index]
+        # one copy per tick: the caller's arrays never alias the walker's buffers
+        row = (self._standing if current is None else current.rows[index - current.first_index]).copy()
         return WalkingSample(
             time=index / self.rate,
             support=SUPPORT_NAMES[int(row[_SUPPORT])],
