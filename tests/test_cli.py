@@ -158,3 +158,56 @@ def test_a_model_robot_file_rejects_tables_it_does_not_take(tmp_path, capsys):
     robot.write_text('[model]\nfile = "robot.xml"\n\n[limits]\nknee = [0, 2]\n', encoding="utf-8")
     assert main(["plan", "--scenario", "fig10", "--robot", str(robot)]) == 2
     assert "unknown table(s) limits in a robot file with [model]" in capsys.readouterr().err
+
+
+STEPS = "[[steps]]\nduration = 0.8\nforward = 0.1\n"
+
+
+@pytest.mark.parametrize("name, content, message", [
+    ("utf16.toml", STEPS.encode("utf-16"), "is UTF-16 text"),
+    ("latin1.toml", ("a = \"caf\u00e9\"\n" + STEPS).encode("latin-1"), "is not UTF-8 text"),
+    ("binary.toml", bytes(range(256)), "is not UTF-8 text"),
+    ("deep.toml", ("x = " + "[" * 5000 + "]" * 5000 + "\n").encode(), "nested too deeply"),
+    ("broken.toml", b"[[steps]\nduration = 0.8\n", "not valid TOML"),
+])
+def test_unreadable_steps_files_are_one_line_and_write_nothing(tmp_path, capsys, name, content, message):
+    path = tmp_path / name
+    path.write_bytes(content)
+    out = tmp_path / "out.csv"
+    assert main(["plan", str(path), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1 and "Traceback" not in err
+    assert not out.exists()
+
+
+def test_a_utf8_byte_order_mark_is_accepted(tmp_path):
+    path = tmp_path / "bom.toml"
+    path.write_bytes(b"\xef\xbb\xbf" + STEPS.encode())
+    assert main(["plan", str(path), "--rate", "100"]) == 0
+
+
+@pytest.mark.parametrize("target, message", [
+    (".", "is a folder: give a file name to write"),
+    ("missing/walk.csv", "does not exist"),
+])
+def test_unwritable_output_is_one_line_and_leaves_no_file(tmp_path, capsys, monkeypatch, target, message):
+    monkeypatch.chdir(tmp_path)
+    assert main(["plan", "--scenario", "fig10", "--out", target]) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1
+    assert not list(tmp_path.rglob("*.csv")) and not list(tmp_path.rglob("*.part"))
+
+
+def test_an_interrupted_write_leaves_no_partial_file(tmp_path):
+    from zmpwalk.files import atomic_output
+
+    target = tmp_path / "walk.csv"
+    with pytest.raises(RuntimeError), atomic_output(target) as temporary:
+        temporary.write_text("t,x\n0,1\n", encoding="utf-8")
+        raise RuntimeError("the disk filled up")
+    assert not target.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_a_missing_robot_file_says_no_such_file(capsys):
+    assert main(["plan", "--scenario", "fig10", "--robot", "no-such-robot.toml"]) == 2
+    assert "no-such-robot.toml: no such file" in capsys.readouterr().err

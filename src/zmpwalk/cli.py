@@ -496,6 +496,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (ZmpwalkError, _UsageError) as error:
         print(f"zmpwalk: error: {error}", file=sys.stderr)
         return EXIT_ERROR
+    except OSError as error:  # an output folder or file the system refuses (full disk, permissions)
+        where = f"{error.filename}: " if error.filename else ""
+        print(f"zmpwalk: error: {where}cannot be written: {error.strerror or error}", file=sys.stderr)
+        return EXIT_ERROR
     except KeyboardInterrupt:
         return 130
 

@@ -23,6 +23,7 @@ from typing import Any
 
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import FileFormatError, UnknownNameError, ZmpwalkError
+from zmpwalk.files import read_toml
 
 _FIELDS = {item.name for item in fields(StepCommand)}
 MAX_REPEAT = 100_000
@@ -86,13 +87,7 @@ def load_steps_file(path: str | Path) -> list[StepCommand]:
 def load_steps_file_with_labels(path: str | Path) -> tuple[list[StepCommand], list[str]]:
     """Read a steps file: the commands and how errors name each (see :func:`parse_steps_with_labels`)."""
     path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except OSError as error:
-        raise FileFormatError(str(path), error.strerror or str(error)) from None
-    except tomllib.TOMLDecodeError as error:
-        raise FileFormatError(str(path), f"not valid TOML: {error}") from None
-    return parse_steps_with_labels(data, str(path))
+    return parse_steps_with_labels(read_toml(path), str(path))
 
 
 def _scenario_dir() -> Path:

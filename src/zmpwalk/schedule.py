@@ -29,7 +29,6 @@ step up as follows:
 
 from __future__ import annotations
 
-import tomllib
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from functools import lru_cache
@@ -41,6 +40,7 @@ import numpy as np
 
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import FileFormatError
+from zmpwalk.files import read_toml
 from zmpwalk.robots.model import RobotModel
 
 
@@ -182,11 +182,7 @@ class Schedule:
     @classmethod
     def from_file(cls, path: Path) -> Schedule:
         """Read a schedule file (TOML)."""
-        try:
-            data = tomllib.loads(path.read_text(encoding="utf-8"))
-        except (OSError, tomllib.TOMLDecodeError) as error:
-            raise FileFormatError(str(path), str(error)) from None
-        return cls(data, str(path))
+        return cls(read_toml(path), str(path))
 
     @classmethod
     def hubo(cls) -> Schedule:

@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk.errors import InvalidParameterError
+from zmpwalk.files import atomic_output
 from zmpwalk.footsteps import Pose2D, foot_corners
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.zmp import convex_hull, signed_margin
@@ -208,7 +209,7 @@ class WalkingPattern:
             columns.update(extra)
         names = list(columns)
         data = [columns[name] for name in names]
-        with Path(path).open("w", newline="", encoding="utf-8") as handle:
+        with atomic_output(path) as temporary, temporary.open("w", newline="", encoding="utf-8") as handle:
             writer = csv.writer(handle)
             writer.writerow(names)
             for i in range(len(self.time)):

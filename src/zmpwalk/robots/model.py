@@ -15,7 +15,6 @@ All quantities are SI: m, s, rad, kg.
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -215,10 +214,9 @@ def robot_from_toml(path: Path) -> RobotModel:
     Raises:
         FileFormatError: Missing, unknown or out-of-range fields (names the field).
     """
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (OSError, tomllib.TOMLDecodeError) as error:
-        raise FileFormatError(str(path), str(error)) from None
+    from zmpwalk.files import read_toml
+
+    data = read_toml(path)
     if "model" in data:
         return _robot_from_model_table(data, path)
     return robot_from_dict(data, str(path))

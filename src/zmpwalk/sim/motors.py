@@ -18,7 +18,6 @@ within the rated torque and every operating point held for the impact window (se
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -26,6 +25,7 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
 from zmpwalk.errors import FileFormatError
+from zmpwalk.files import read_toml
 from zmpwalk.robots.model import JOINT_NAMES
 from zmpwalk.sim.actuators import IMPACT_WINDOW
 from zmpwalk.sim.run import SimulationResult
@@ -96,10 +96,7 @@ def load_motors(path: Path) -> list[Motor]:
         FileFormatError: Missing or non-positive fields, unknown joints (names the motor and the field).
     """
     source = str(path)
-    try:
-        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as error:
-        raise FileFormatError(source, str(error)) from None
+    data = read_toml(path)
     entries = data.get("motors")
     if not isinstance(entries, list) or not entries:
         raise FileFormatError(source, "needs [[motors]] tables")
