@@ -120,6 +120,7 @@ def test_simulate_command_writes_results_and_json(tmp_path, capsys):
     assert set(summary["actuators"][0]) == {"joint", "peak_torque", "impact_torque", "rms_torque", "peak_velocity",
                                             "peak_power", "mean_power", "torque_limit"}
     assert {p.name for p in out.iterdir()} == {"actuators.csv", "actuators.md", "simulation.csv"}
+    assert not list(out.glob("*.part"))  # written through temporary files, renamed when complete
 
 
 @pytest.mark.parametrize("argv, message", [

@@ -20,6 +20,7 @@ import numpy as np
 
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import ZmpwalkError
+from zmpwalk.files import write_text
 from zmpwalk.kinematics import pattern_joint_trajectory
 from zmpwalk.patterns import GENERATORS, generator
 from zmpwalk.patterns.hyperbolic import HyperbolicGait
@@ -355,7 +356,7 @@ def _simulate(args: argparse.Namespace) -> int:
     if args.out:
         args.out.mkdir(parents=True, exist_ok=True)
         write_actuator_csv(rows, args.out / "actuators.csv")
-        (args.out / "actuators.md").write_text(actuator_markdown(rows) + "\n", encoding="utf-8")
+        write_text(args.out / "actuators.md", actuator_markdown(rows) + "\n")
         write_result_csv(result, args.out / "simulation.csv")
     if args.json:
         print(json.dumps(_json_safe(summary), indent=2, allow_nan=False))
@@ -449,7 +450,7 @@ def _run(args: argparse.Namespace) -> int:
         args.robot = args.model
         robot = _load_robot(args)
         if args.write:
-            args.write.write_text(robot_toml(robot, args.write.parent), encoding="utf-8")
+            write_text(args.write, robot_toml(robot, args.write.parent))
         if args.json:
             print(json.dumps(_json_safe(robot_summary(robot)), indent=2, allow_nan=False))
         else:

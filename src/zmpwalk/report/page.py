@@ -20,6 +20,7 @@ import numpy as np
 
 from zmpwalk.balance import Stabilizer
 from zmpwalk.commands import StepCommand
+from zmpwalk.files import write_bytes, write_text
 from zmpwalk.kinematics import pattern_joint_trajectory
 from zmpwalk.patterns import generator as pattern_generator
 from zmpwalk.patterns.result import WalkingPattern
@@ -145,7 +146,7 @@ def build_report(
         images["Torque-speed operating points against the motors' envelopes (joint side)"] = \
             plots.motor_envelopes(result, motors)
     for index, payload in enumerate(images.values()):
-        (folder / f"figure{index + 1}.png").write_bytes(payload)
+        write_bytes(folder / f"figure{index + 1}.png", payload)
     done("plots")
     animation: bytes | None = None
     animation_note = ""
@@ -155,7 +156,7 @@ def build_report(
         try:
             animation = render_gif(robot, result, progress=None if progress is None else
                                    lambda done: progress("animation", round(100 * done), 100))
-            (folder / "walk.gif").write_bytes(animation)
+            write_bytes(folder / "walk.gif", animation)
         except Exception as error:  # no OpenGL context on this machine: say so on the page
             animation_note = f"The animation could not be rendered here: {error}. Set MUJOCO_GL=egl or osmesa."
     done("animation")
@@ -172,8 +173,8 @@ def build_report(
                                  "fits": f.fits} for f in fits]
     page = _page(title, robot, report.summary, images, animation, animation_note, step_margins(pattern), rows,
                  report.verdict, fits, _step_list(commands, labels))
-    report.index.write_text(page, encoding="utf-8")
-    (folder / "summary.json").write_text(json.dumps(report.summary, indent=2), encoding="utf-8")
+    write_text(report.index, page)
+    write_text(folder / "summary.json", json.dumps(report.summary, indent=2))
     done("page")
     return report
 

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
+from zmpwalk.files import atomic_output
 from zmpwalk.sim.run import SimulationResult
 
 IMPACT_WINDOW = 0.02  # [s] a torque or power held for less than this is an impact, shown apart
@@ -80,7 +81,7 @@ def _torque_limits(result: SimulationResult) -> list[float]:
 
 def write_actuator_csv(rows: list[ActuatorRow], path: Path) -> None:
     """The table as CSV, SI units in the header."""
-    with Path(path).open("w", newline="", encoding="utf-8") as handle:
+    with atomic_output(path) as temporary, temporary.open("w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
         writer.writerow(["joint", "peak_torque_Nm", "impact_torque_Nm", "rms_torque_Nm", "peak_velocity_rad_s",
                          "peak_power_W", "mean_power_W", "torque_limit_Nm"])

@@ -42,6 +42,7 @@ from numpy.typing import NDArray
 
 from zmpwalk.balance import BalanceMeasurement, Stabilizer
 from zmpwalk.errors import InvalidParameterError
+from zmpwalk.files import atomic_output
 from zmpwalk.kinematics import JOINT_COLUMNS, JointTrajectory
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
@@ -586,5 +587,6 @@ def write_result_csv(result: SimulationResult, path: Path) -> None:
         columns[f"{name}_q"] = result.joint_angles[:, i]
         columns[f"{name}_tau"] = result.joint_torques[:, i]
         columns[f"{name}_power"] = result.joint_power[:, i]
-    np.savetxt(path, np.column_stack(list(columns.values())), delimiter=",", header=",".join(columns),
-               comments="", fmt="%.9g")
+    with atomic_output(path) as temporary:
+        np.savetxt(temporary, np.column_stack(list(columns.values())), delimiter=",", header=",".join(columns),
+                   comments="", fmt="%.9g")
