@@ -16,7 +16,7 @@ from zmpwalk.footsteps import Pose2D, foot_corners
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import JOINT_NAMES
 from zmpwalk.sim.motors import Motor, motor_for
-from zmpwalk.sim.run import SimulationResult
+from zmpwalk.sim.run import LOADED_FRACTION, SimulationResult
 
 DPI = 100
 
@@ -69,7 +69,7 @@ def _landings(result: SimulationResult) -> np.ndarray:
     weight = result.robot.mass * result.robot.gravity
     points = []
     for foot, force in enumerate((result.force_left, result.force_right)):
-        loaded = force > 0.15 * weight
+        loaded = force > LOADED_FRACTION * weight
         for start in (np.flatnonzero(loaded[1:] & ~loaded[:-1]) + 1).tolist():
             points.append(result.ankle_positions[min(int(start) + 50, len(force) - 1), foot, :2])
     return np.array(points).reshape(-1, 2)

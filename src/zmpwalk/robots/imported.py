@@ -607,6 +607,17 @@ def _knee_offset(chain: LegChain) -> float:
     return float(math.atan2(float(axis @ np.cross(thigh, shank)), float(thigh @ shank)))
 
 
+def is_position_servo(model: Any, actuator: int) -> bool:
+    """Whether an actuator is a position servo on a joint: ``gain (u - q) - kv q'`` (MuJoCo ``<position>``
+    or an equivalent ``<general>``)."""
+    import mujoco
+
+    gain, bias = model.actuator_gainprm[actuator], model.actuator_biasprm[actuator]
+    return bool(model.actuator_trntype[actuator] == mujoco.mjtTrn.mjTRN_JOINT and gain[0] > 0
+                and model.actuator_biastype[actuator] == mujoco.mjtBias.mjBIAS_AFFINE
+                and abs(bias[1] + gain[0]) < 1e-9 * max(1.0, gain[0]))
+
+
 def _actuator(model: object, joint: int) -> Actuator | None:
     import mujoco
 
@@ -616,7 +627,7 @@ def _actuator(model: object, joint: int) -> Actuator | None:
             continue
         gear = float(m.actuator_gear[a][0])  # type: ignore[attr-defined]
         gain, bias = m.actuator_gainprm[a], m.actuator_biasprm[a]  # type: ignore[attr-defined]
-        if m.actuator_biastype[a] == mujoco.mjtBias.mjBIAS_AFFINE and abs(bias[1] + gain[0]) < 1e-9 * max(1, gain[0]):  # type: ignore[attr-defined]
+        if is_position_servo(m, a):
             kind, kp, kv = "position", float(gain[0]) * gear, float(-bias[2]) * gear
         elif m.actuator_biastype[a] == mujoco.mjtBias.mjBIAS_NONE:  # type: ignore[attr-defined]
             kind, kp, kv = "motor", 0.0, 0.0

@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 
 from zmpwalk.errors import InvalidParameterError
 from zmpwalk.kinematics import JOINT_COLUMNS
-from zmpwalk.robots.imported import collision_points, load_model_spec, rigid_bodies
+from zmpwalk.robots.imported import collision_points, is_position_servo, load_model_spec, rigid_bodies
 from zmpwalk.robots.model import RobotModel
 
 Array = NDArray[np.float64]
@@ -194,17 +194,34 @@ def static_feedforward(plant: Plant, qpos: Array, zmp: Array, support: NDArray[n
         dynamic: Include the inertial terms and the horizontal reaction.
     """
     model = plant.model
+    torques = _servo_torques(plant, qpos, zmp, support, ankles, rate, dynamic)
+    servos = [a for a in range(model.nu) if is_position_servo(model, a)]
+    offsets = np.zeros_like(torques)
+    offsets[:, servos] = torques[:, servos] / (model.actuator_gainprm[servos, 0] * model.actuator_gear[servos, 0] ** 2)
+    return offsets
+
+
+def planned_torques(plant: Plant, qpos: Array, zmp: Array, support: NDArray[np.integer],
+                    ankles: tuple[Array, Array], rate: float = 1000.0) -> Array:
+    """Leg joint torques of the planned motion by inverse dynamics [N m], (n, 12) in the leg-column order.
+
+    The torques behind :func:`static_feedforward` (``dynamic=True``): what an ideal robot needs for the plan,
+    against which the simulated motor table is checked.
+    """
+    torques = _servo_torques(plant, qpos, zmp, support, ankles, rate, dynamic=True)
+    return np.asarray(torques[:, plant.leg_actuators], dtype=np.float64)
+
+
+def _servo_torques(plant: Plant, qpos: Array, zmp: Array, support: NDArray[np.integer],
+                   ankles: tuple[Array, Array], rate: float, dynamic: bool) -> Array:
+    """Joint torques of the planned motion at each position servo [N m], (n, nu) (0 at other actuators);
+    see :func:`static_feedforward`."""
+    model = plant.model
     data = mujoco.MjData(model)
     n = len(qpos)
-    offsets = np.zeros((n, model.nu))
-    position_actuators = [a for a in range(model.nu)
-                          if model.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT
-                          and model.actuator_biastype[a] == mujoco.mjtBias.mjBIAS_AFFINE
-                          and abs(model.actuator_biasprm[a][1] + model.actuator_gainprm[a][0]) < 1e-9
-                          * max(1.0, model.actuator_gainprm[a][0]) and model.actuator_gainprm[a][0] > 0]
+    result_torques = np.zeros((n, model.nu))
+    position_actuators = [a for a in range(model.nu) if is_position_servo(model, a)]
     dofs = np.array([model.jnt_dofadr[model.actuator_trnid[a][0]] for a in position_actuators], dtype=int)
-    stiffness = np.array([model.actuator_gainprm[a][0] * model.actuator_gear[a][0] ** 2
-                          for a in position_actuators])
     sites = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, f"{s}_ankle") for s in ("left", "right")]
     mass = float(np.sum(model.body_mass))
     gravity = -float(model.opt.gravity[2])
@@ -255,21 +272,8 @@ def static_feedforward(plant: Plant, qpos: Array, zmp: Array, support: NDArray[n
             tau -= jacp.T @ force + jacr.T @ moment
         torques[row] = tau[dofs]
     for column, actuator in enumerate(position_actuators):
-        offsets[:, actuator] = np.interp(np.arange(n), keys, torques[:, column]) / stiffness[column]
-    return offsets
-
-
-def planned_torques(plant: Plant, qpos: Array, zmp: Array, support: NDArray[np.integer],
-                    ankles: tuple[Array, Array], rate: float = 1000.0) -> Array:
-    """Leg joint torques of the planned motion by inverse dynamics [N m], (n, 12) in the leg-column order.
-
-    The torques of :func:`static_feedforward` (``dynamic=True``): what an ideal robot needs for the plan,
-    against which the simulated motor table is checked.
-    """
-    offsets = static_feedforward(plant, qpos, zmp, support, ankles, rate)
-    model = plant.model
-    stiffness = np.array([model.actuator_gainprm[a][0] * model.actuator_gear[a][0] ** 2 for a in plant.leg_actuators])
-    return np.asarray(offsets[:, plant.leg_actuators] * stiffness, dtype=np.float64)
+        result_torques[:, actuator] = np.interp(np.arange(n), keys, torques[:, column])
+    return result_torques
 
 
 def damping_feedforward(plant: Plant, velocities: Array) -> Array:
