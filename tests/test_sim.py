@@ -147,5 +147,8 @@ def test_disturbances_tilt_gravity_scale_masses_and_push_in_their_window():
     push = Disturbances(push_time=1.0, push_impulse=(20.0, 0.0, 0.0), push_duration=0.1)
     assert push.force_at(0.99)[0] == 0.0 and push.force_at(1.05)[0] == pytest.approx(200.0)  # [N]
     assert push.force_at(1.1)[0] == 0.0
-    with pytest.raises(InvalidParameterError, match="mass_error"):
-        Disturbances(mass_error=2.0).apply(model)
+    for fields, name in (({"mass_error": 2.0}, "mass_error"), ({"floor_tilt": (0.0, 1.0)}, "floor_tilt"),
+                         ({"push_duration": 0.0}, "push_duration"),
+                         ({"push_impulse": (float("nan"), 0.0, 0.0)}, "push_impulse")):
+        with pytest.raises(InvalidParameterError, match=name):
+            Disturbances(**fields)

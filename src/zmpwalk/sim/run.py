@@ -426,6 +426,16 @@ class Disturbances:
     floor_tilt: tuple[float, float] = (0.0, 0.0)  # [rad]
     mass_error: float = 0.0  # [-]
 
+    def __post_init__(self) -> None:
+        if not -0.5 < self.mass_error < 1.0:
+            raise InvalidParameterError("mass_error", self.mass_error, "a fraction in (-0.5, 1)")
+        if len(self.floor_tilt) != 2 or max(abs(a) for a in self.floor_tilt) > 0.3:
+            raise InvalidParameterError("floor_tilt", self.floor_tilt, "(roll, pitch) within 0.3 rad")
+        if not 0.001 <= self.push_duration <= 1.0:
+            raise InvalidParameterError("push_duration", self.push_duration, "a time in [0.001, 1] s")
+        if len(self.push_impulse) != 3 or not all(math.isfinite(v) and abs(v) <= 1000.0 for v in self.push_impulse):
+            raise InvalidParameterError("push_impulse", self.push_impulse, "three components within 1000 N s")
+
     @property
     def floor_rotation(self) -> Array:
         """The floor's rotation from level, ``Rx(roll) Ry(pitch)``."""
@@ -437,10 +447,6 @@ class Disturbances:
 
     def apply(self, model: mujoco.MjModel) -> None:
         """Tilt gravity and scale the masses of ``model`` (in place; MuJoCo's derived constants recomputed)."""
-        if not -0.5 < self.mass_error < 1.0:
-            raise InvalidParameterError("mass_error", self.mass_error, "a fraction in (-0.5, 1)")
-        if max(abs(a) for a in self.floor_tilt) > 0.3:
-            raise InvalidParameterError("floor_tilt", self.floor_tilt, "angles within 0.3 rad")
         gravity = float(np.linalg.norm(model.opt.gravity))
         model.opt.gravity[:] = self.floor_rotation.T @ np.array([0.0, 0.0, -gravity])
         model.body_mass[:] *= 1.0 + self.mass_error
