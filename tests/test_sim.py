@@ -152,3 +152,23 @@ def test_disturbances_tilt_gravity_scale_masses_and_push_in_their_window():
                          ({"push_impulse": (float("nan"), 0.0, 0.0)}, "push_impulse")):
         with pytest.raises(InvalidParameterError, match=name):
             Disturbances(**fields)
+
+
+def test_noisy_delayed_sensors_reach_the_stabilizer_and_bad_noise_is_rejected():
+    from zmpwalk.balance import Stabilizer
+    from zmpwalk.sim.run import SensorNoise
+
+    with pytest.raises(InvalidParameterError, match=r"noise\.force"):
+        SensorNoise(force=-1.0)
+    mju = load_robot("mju-biped")
+    pattern = paper_walk(mju, steps=1).sample(1000.0)
+    joints = pattern_joint_trajectory(pattern, check_limits=False)
+    small = {"force": 0.2, "torque": 0.005}  # [N], [N m]: the 2.2 kg robot's sensors (the defaults are HUBO's)
+    runs = [simulate(mju, joints, pattern, stabilizer=Stabilizer(mju, 1000.0), latency=latency,
+                     noise=SensorNoise(seed=seed, **small), settle=0.2, hold=0.5)
+            for seed, latency in ((1, 0.0), (1, 0.0), (2, 0.0), (1, 0.002))]
+    # (with 4 ms or more of latency the default gains topple this small, fast robot: docs/balance.md)
+    assert not any(run.fell for run in runs)
+    assert np.array_equal(runs[0].joint_angles, runs[1].joint_angles)  # seeded: the same walk again
+    assert not np.array_equal(runs[0].joint_angles, runs[3].joint_angles)  # the delay reaches the loop
+    assert not np.array_equal(runs[0].joint_angles, runs[2].joint_angles)  # the noise reaches the loop

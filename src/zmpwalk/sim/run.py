@@ -480,6 +480,12 @@ class SensorNoise:
     encoder: float = 0.0005  # [rad]
     seed: int = 0
 
+    def __post_init__(self) -> None:
+        for name in ("force", "torque", "attitude", "rate", "encoder"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0.0):
+                raise InvalidParameterError(f"noise.{name}", value, "a standard deviation >= 0")
+
 
 def _measurement(row: Array, sensors: _Sensors, floor: Array | None = None) -> BalanceMeasurement:
     """The stabilizer's inputs from one row of sensor data: the ground's wrench on each foot is the opposite
