@@ -316,3 +316,41 @@ def test_no_drift_after_ten_thousand_steps(hubo, schedule, stride, turn):
     sample = evaluate(StageTable([last]), np.array([last.stop_time]), hubo, np.zeros(1, dtype=np.intp))
     landed = sample.left_position if last.plan.swing == 1 else sample.right_position
     np.testing.assert_allclose(landed[0, :2], [last.plan.swing_end.x, last.plan.swing_end.y], atol=POSITION_TOL)
+
+
+# --------------------------------------------------------------------- long walks in pieces
+
+@pytest.mark.parametrize("rate", [100.0, 333.0, 1000.0])
+def test_pieces_of_a_walk_join_to_the_whole_pattern(hubo, rate):
+    """generate_chunks: the same samples, support phases, steps and ZMP margins as generate, piece by piece."""
+    from zmpwalk.patterns.polynomial import generate_chunks
+    from zmpwalk.zmp import signed_margin
+
+    rng = np.random.default_rng(11)
+    commands = [StepCommand(duration=float(rng.uniform(0.7, 1.0)), forward=float(rng.uniform(-0.1, 0.2)),
+                            side=float(rng.choice([0.0, 0.05, -0.05])), turn=float(rng.choice([0.0, 0.1, -0.1])))
+                for _ in range(25)]
+    whole = generate(hubo, commands, rate=rate)
+    pieces = list(generate_chunks(hubo, commands, rate=rate, chunk_stages=4))
+    assert len(pieces) > 5
+    for name in ("time", "zmp_in_world", "position_pelvis_in_world", "position_left_ankle_in_world",
+                 "velocity_right_ankle_in_world", "yaw_pelvis_in_world", "support"):
+        joined = np.concatenate([getattr(piece, name) for piece in pieces])
+        np.testing.assert_array_equal(joined, getattr(whole, name))  # bit for bit
+    assert [s for piece in pieces for s in piece.steps] == whole.steps
+    margin = np.concatenate([piece.zmp_margin() for piece in pieces])
+    np.testing.assert_allclose(margin, whole.zmp_margin(), atol=1e-12)  # [m]
+    # the vectorised margin against one polygon at a time
+    polygons = whole.support_polygons()
+    begins = np.array([phase.begin for phase in whole.support_phases])
+    which = np.clip(np.searchsorted(begins, whole.time, side="right") - 1, 0, len(begins) - 1)
+    for i in range(0, len(whole.time), 13):
+        expected = signed_margin(whole.zmp_in_world[i:i + 1], polygons[which[i]])[0]
+        assert margin[i] == pytest.approx(expected, abs=1e-12)  # [m]
+
+
+def test_chunk_size_is_checked(hubo):
+    from zmpwalk.patterns.polynomial import generate_chunks
+
+    with pytest.raises(ZmpwalkError, match="chunk_stages = 0"):
+        generate_chunks(hubo, [StepCommand(0.8, 0.1)], chunk_stages=0)

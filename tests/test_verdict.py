@@ -13,7 +13,7 @@ from zmpwalk.cli import EXIT_FAILED, main
 def test_a_too_long_stride_at_0_4_s_on_hubo_fails_and_exits_non_zero(tmp_path: Path,
                                                                       capsys: pytest.CaptureFixture[str]) -> None:
     steps = tmp_path / "fast.toml"
-    steps.write_text("[[steps]]\nduration = 0.4\nforward = 0.3\nrepeat = 6\n", encoding="utf-8")
+    steps.write_text("[[steps]]\nduration = 0.4\nforward = 0.28\nrepeat = 6\n", encoding="utf-8")
     assert main(["simulate", str(steps), "--json"]) == EXIT_FAILED
     verdict = json.loads(capsys.readouterr().out)["verdict"]
     assert verdict["passed"] is False

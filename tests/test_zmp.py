@@ -104,3 +104,20 @@ def test_convex_hull_of_two_feet_is_counter_clockwise():
     assert len(hull) == 5
     x, y = hull[:, 0], hull[:, 1]
     assert 0.5 * np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y) > 0  # positive area: CCW
+
+
+def test_hull_edges_margin_equals_the_hull_polygons_margin():
+    """Many vertex sets at once (two soles, one sole given twice, collinear sides) against convex_hull + signed_margin."""
+    rng = np.random.default_rng(7)
+    square = np.array([[0.0, 0.0], [0.2, 0.0], [0.2, 0.1], [0.0, 0.1]])
+    sets = []
+    for k in range(60):
+        shift = rng.uniform(-0.3, 0.3, 2) if k % 3 else np.array([0.0, 0.2])  # every third: aligned feet
+        angle = rng.uniform(-0.5, 0.5) if k % 3 else 0.0
+        c, s = np.cos(angle), np.sin(angle)
+        other = square @ np.array([[c, s], [-s, c]]) + shift
+        sets.append(np.vstack([square, square if k % 5 == 0 else other]))
+    vertices = np.array(sets)
+    points = rng.uniform(-0.4, 0.6, (60, 2))
+    expected = [zmp_maps.signed_margin(points[k:k + 1], zmp_maps.convex_hull(vertices[k]))[0] for k in range(60)]
+    np.testing.assert_allclose(zmp_maps.batch_hull_margin(points, vertices), expected, atol=1e-12)  # [m]

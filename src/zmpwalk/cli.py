@@ -24,7 +24,8 @@ from zmpwalk.files import write_text
 from zmpwalk.kinematics import pattern_joint_trajectory
 from zmpwalk.patterns import GENERATORS, generator
 from zmpwalk.patterns.hyperbolic import HyperbolicGait
-from zmpwalk.patterns.result import WalkingPattern
+from zmpwalk.patterns.polynomial import generate_chunks
+from zmpwalk.patterns.result import WalkingPattern, write_pieces_csv
 from zmpwalk.robots import list_robots, load_robot
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.scenarios import list_scenarios, load_scenario_with_labels, load_steps_file_with_labels
@@ -390,21 +391,40 @@ def _json_safe(value: object) -> object:
     return value
 
 
-def _summary(pattern: WalkingPattern) -> dict[str, object]:
-    margin, at = pattern.min_zmp_margin()
-    left, right = pattern.position_left_ankle_in_world[-1], pattern.position_right_ankle_in_world[-1]
-    return {
-        "generator": pattern.generator,
-        "robot": pattern.robot.name,
-        "rate": pattern.rate,
-        "duration": pattern.duration,
-        "samples": len(pattern.time),
-        "swings": len([s for s in pattern.steps if s.kind not in ("start", "settle")]),
-        "min_zmp_margin": margin,
-        "min_zmp_margin_time": at,
-        "final_left_ankle": [float(v) for v in left],
-        "final_right_ankle": [float(v) for v in right],
-    }
+class _PlanSummary:
+    """What ``zmpwalk plan`` prints of a walk, gathered from its pieces as they pass."""
+
+    def __init__(self) -> None:
+        self.last: WalkingPattern | None = None
+        self.samples = 0
+        self.swings = 0
+        self.margin = (math.inf, 0.0)
+
+    def follow(self, pieces: Iterator[WalkingPattern]) -> Iterator[WalkingPattern]:
+        for piece in pieces:
+            self.last = piece
+            self.samples += len(piece.time)
+            self.swings += len([s for s in piece.steps if s.kind not in ("start", "settle")])
+            self.margin = min(self.margin, piece.min_zmp_margin())
+            yield piece
+
+    def result(self) -> dict[str, object]:
+        pattern = self.last
+        if pattern is None:  # pragma: no cover - every walk has at least one piece
+            raise ZmpwalkError("the walk has no samples")
+        left, right = pattern.position_left_ankle_in_world[-1], pattern.position_right_ankle_in_world[-1]
+        return {
+            "generator": pattern.generator,
+            "robot": pattern.robot.name,
+            "rate": pattern.rate,
+            "duration": pattern.duration,
+            "samples": self.samples,
+            "swings": self.swings,
+            "min_zmp_margin": self.margin[0],
+            "min_zmp_margin_time": self.margin[1],
+            "final_left_ankle": [float(v) for v in left],
+            "final_right_ankle": [float(v) for v in right],
+        }
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -424,21 +444,29 @@ def _run(args: argparse.Namespace) -> int:
         schedule = _schedule(args)
         options = {"schedule": schedule} if schedule else {}
         with _source(_label(args)):
-            pattern = make(robot, commands, rate=args.rate, labels=labels, **options)
-            extra = pattern_joint_trajectory(pattern).columns() if args.joints else None
-        if args.out:
-            pattern.write_csv(args.out, extra)
-        summary = _summary(pattern)
+            if args.generator == "polynomial":  # long walks: planned whole, sampled and written piece by piece
+                pieces = generate_chunks(robot, commands, rate=args.rate, schedule=schedule, labels=labels)
+            else:
+                pieces = iter([make(robot, commands, rate=args.rate, labels=labels, **options)])
+            summary = _PlanSummary()
+            stream = ((piece, pattern_joint_trajectory(piece).columns() if args.joints else None)
+                      for piece in summary.follow(pieces))
+            if args.out:
+                write_pieces_csv(args.out, stream)
+            else:
+                for _ in stream:
+                    pass
+        result = summary.result()
         if args.json:
-            print(json.dumps(summary, indent=2))
+            print(json.dumps(result, indent=2))
         else:
-            margin = float(summary["min_zmp_margin"])  # type: ignore[arg-type]
+            margin = float(result["min_zmp_margin"])  # type: ignore[arg-type]
             verdict = "inside the support polygon" if margin >= 0 else "OUTSIDE the support polygon"
-            print(f"{summary['swings']} swings, {pattern.duration:.3f} s, {len(pattern.time)} samples at "
+            print(f"{result['swings']} swings, {result['duration']:.3f} s, {result['samples']} samples at "
                   f"{args.rate:g} Hz" + (f" -> {args.out}" if args.out else ""))
-            print(f"min ZMP margin: {margin * 1e3:+.1f} mm at t = {summary['min_zmp_margin_time']:.3f} s "
+            print(f"min ZMP margin: {margin * 1e3:+.1f} mm at t = {result['min_zmp_margin_time']:.3f} s "
                   f"({verdict})")
-        outside = float(summary["min_zmp_margin"]) < 0  # type: ignore[arg-type]
+        outside = float(result["min_zmp_margin"]) < 0  # type: ignore[arg-type]
         return EXIT_FAILED if outside and not args.allow_outside else 0
     if args.command in ("demo", "report"):
         return _report(args)

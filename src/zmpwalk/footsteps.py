@@ -151,6 +151,7 @@ def plan_command(
     for stage in stages:
         if stage.kind != "settle":
             _check_clearance(stage, robot, command)
+            check_swing(stage, robot, command)
     return stages, _after(stance, stages)
 
 
@@ -188,14 +189,35 @@ def _stage(
     return StagePlan(swing, support, stance.pose(swing), end, forward, command.duration, parameters, stop, kind)
 
 
+def _sole_in_ankle(robot: RobotModel) -> tuple[np.ndarray, np.ndarray]:
+    """Sole corners about the ankle, counter-clockwise, x (4,) and y (4,) [m], before the side offset of y."""
+    half_l, half_w = robot.foot_length / 2, robot.foot_width / 2
+    return (robot.sole_center_x + np.array([-half_l, half_l, half_l, -half_l]),
+            np.array([-half_w, -half_w, half_w, half_w]))
+
+
 def foot_corners(pose: Pose2D, foot: int, robot: RobotModel) -> np.ndarray:
     """Sole corners of a foot in world, counter-clockwise, shape (4, 2) [m]."""
-    half_l, half_w = robot.foot_length / 2, robot.foot_width / 2
-    cx, cy = robot.sole_center_x, foot * robot.sole_center_y
-    local = np.array([[cx - half_l, cy - half_w], [cx + half_l, cy - half_w],
-                      [cx + half_l, cy + half_w], [cx - half_l, cy + half_w]])
+    local_x, local_y = _sole_in_ankle(robot)
+    local_y = local_y + foot * robot.sole_center_y
     c, s = math.cos(pose.yaw), math.sin(pose.yaw)
-    return np.asarray(local @ np.array([[c, s], [-s, c]]) + np.array([pose.x, pose.y]), dtype=np.float64)
+    return np.column_stack([pose.x + c * local_x - s * local_y, pose.y + s * local_x + c * local_y])
+
+
+def sole_corners(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, foot: np.ndarray, robot: RobotModel) -> np.ndarray:
+    """:func:`foot_corners` of many feet at once, shape (n, 4, 2) [m].
+
+    Args:
+        x, y, yaw: Ankle poses in world [m], [m], [rad], shape (n,).
+        foot: +1 left, -1 right, shape (n,).
+    """
+    local_x, local_y = _sole_in_ankle(robot)
+    local_y = np.asarray(foot, dtype=float)[:, None] * robot.sole_center_y + local_y
+    c, s = np.cos(yaw)[:, None], np.sin(yaw)[:, None]
+    corners = np.empty((len(x), 4, 2))
+    corners[..., 0] = np.asarray(x)[:, None] + c * local_x - s * local_y
+    corners[..., 1] = np.asarray(y)[:, None] + s * local_x + c * local_y
+    return corners
 
 
 def _rectangles_overlap(a: np.ndarray, b: np.ndarray) -> bool:
@@ -208,6 +230,59 @@ def _rectangles_overlap(a: np.ndarray, b: np.ndarray) -> bool:
             if pa.max() < pb.min() or pb.max() < pa.min():
                 return False
     return True
+
+
+SMOOTHSTEP_PEAK_SLOPE = 15.0 / 8.0  # [-] max of d/dx (10x^3 - 15x^4 + 6x^5), at x = 1/2
+SMOOTHSTEP_PEAK_CURVATURE = 10.0 / math.sqrt(3.0)  # [-] max of its second derivative, at x = (3 -+ sqrt 3)/6
+
+
+def swing_peaks(along: float, across: float, lift: float, up_ratio: float) -> tuple[float, float]:
+    r"""Bounds on the swinging ankle's peak speed and acceleration, per unit swing time.
+
+    The ankle moves ``along`` [m] on the cycloid of Eq. 11 (peak speed ``2 a / T_s`` at mid-swing,
+    peak acceleration ``2 pi a / T_s^2``), ``across`` [m] on the half cosine of Eqs. 14-17
+    (``pi c / (2 T_s)``, ``pi^2 c / (2 T_s^2)``) and rises ``lift`` [m] on the quintic of Fig. 12 in
+    the shorter of ``u T_s`` and ``(1 - u) T_s`` (``15 h / (8 u T_s)``, ``10 h / (sqrt(3) u^2 T_s^2)``).
+
+    .. math::
+        |v| \le \sqrt{(2a + \tfrac{\pi}{2} c)^2 + (\tfrac{15 h}{8 u})^2} / T_s, \qquad
+        |\dot v| \le \sqrt{(2\pi a + \tfrac{\pi^2}{2} c)^2 + (\tfrac{10 h}{\sqrt 3 u^2})^2} / T_s^2
+
+    Returns:
+        ``(speed, acceleration)`` times ``T_s`` and ``T_s^2``: [m], [m].
+    """
+    shorter = min(up_ratio, 1.0 - up_ratio)
+    speed = math.hypot(2.0 * along + 0.5 * math.pi * across, SMOOTHSTEP_PEAK_SLOPE * lift / shorter)
+    acceleration = math.hypot(2.0 * math.pi * along + 0.5 * math.pi**2 * across,
+                              SMOOTHSTEP_PEAK_CURVATURE * lift / shorter**2)
+    return speed, acceleration
+
+
+def check_swing(stage: StagePlan, robot: RobotModel, command: StepCommand) -> None:
+    """Reject a swing faster than the robot's foot speed or acceleration limit, or lifted too high.
+
+    Raises:
+        InvalidParameterError: Names ``foot_lift`` (apex above :attr:`RobotModel.max_foot_lift`) or
+            ``duration`` with the shortest step time this swing allows.
+    """
+    parameters = stage.parameters
+    if parameters.foot_lift > robot.max_foot_lift:
+        raise InvalidParameterError(
+            "foot_lift", parameters.foot_lift,
+            f"a swing apex in [0, {robot.max_foot_lift:.3f}] m (half the hip's height above the ankle)")
+    dx, dy = stage.swing_end.x - stage.swing_start.x, stage.swing_end.y - stage.swing_start.y
+    c, s = math.cos(stage.support_pose.yaw), math.sin(stage.support_pose.yaw)
+    along, across = abs(c * dx + s * dy), abs(-s * dx + c * dy)
+    speed, acceleration = swing_peaks(along, across, parameters.foot_lift, parameters.up_ratio)
+    v_max, a_max = robot.max_foot_speed, robot.max_foot_acceleration
+    shortest = max(speed / v_max, math.sqrt(acceleration / a_max))  # [s] of swing
+    if stage.duration - parameters.dsp_time < shortest:
+        raise InvalidParameterError(
+            "duration", command.duration,
+            f"a step time >= {shortest + parameters.dsp_time:.3f} s for this swing ({along:.3f} m along, "
+            f"{across:.3f} m across, {parameters.foot_lift:.3f} m lift with up_ratio {parameters.up_ratio:g}, "
+            f"{parameters.dsp_time:g} s double support): the swinging foot's speed stays within {v_max:.2f} m/s "
+            f"and its acceleration within {a_max:.1f} m/s^2 (the robot's limits)")
 
 
 def _check_clearance(stage: StagePlan, robot: RobotModel, command: StepCommand) -> None:

@@ -140,6 +140,64 @@ def signed_margin(points: Array, polygon: Array) -> Array:
     return np.asarray(np.where(inside, np.min(inside_distance, axis=1), -outside_distance), dtype=np.float64)
 
 
+def hull_edges(vertices: Array) -> tuple[Array, Array, NDArray[np.bool_]]:
+    """Counter-clockwise convex-hull edges of many small vertex sets at once.
+
+    Args:
+        vertices: (p, m, 2) [m], any order, repeated points allowed, at least three not collinear per set.
+
+    Returns:
+        ``(start, edge, valid)``: each set's edges as start points (p, q, 2) [m] and edge vectors
+        (p, q, 2) [m], ``valid`` (p, q) marking the real ones (sets have different edge counts).
+
+    A directed pair (i, j) of distinct points is a hull edge when no point lies on its right
+    and none lies on the segment between them (collinear points split a side into edges).
+    """
+    p, m = vertices.shape[:2]
+    same = np.all(np.abs(vertices[:, :, None, :] - vertices[:, None, :, :]) <= 1e-12, axis=3)
+    first = np.argmax(same, axis=2) == np.arange(m)  # (p, m): the first of equal points
+    i, j = np.where(~np.eye(m, dtype=bool))
+    a, b = vertices[:, i], vertices[:, j]  # (p, pairs, 2)
+    edge = b - a
+    rel = vertices[:, None, :, :] - a[:, :, None, :]  # (p, pairs, m, 2)
+    cross = edge[..., None, 0] * rel[..., 1] - edge[..., None, 1] * rel[..., 0]
+    length = np.hypot(edge[..., 0], edge[..., 1])
+    scale = np.maximum(length, 1e-12)
+    tolerance = 1e-12 * scale[..., None]
+    along = (edge[..., None, 0] * rel[..., 0] + edge[..., None, 1] * rel[..., 1]) / scale[..., None] ** 2
+    between = (np.abs(cross) <= tolerance) & (along > 1e-12) & (along < 1.0 - 1e-12) & first[:, None, :]
+    valid = (np.all(cross >= -tolerance, axis=2) & ~np.any(between, axis=2) & (length > 1e-12)
+             & first[:, i] & first[:, j])
+    width = max(1, int(valid.sum(axis=1).max()) if p else 1)
+    order = np.argsort(~valid, axis=1, kind="stable")[:, :width]
+    start = np.take_along_axis(a, order[..., None], axis=1)
+    edge = np.take_along_axis(edge, order[..., None], axis=1)
+    return start, edge, np.take_along_axis(valid, order, axis=1)
+
+
+def edge_margin(points: Array, start: Array, edge: Array, valid: NDArray[np.bool_]) -> Array:
+    """Signed distance of each point to its own convex polygon given by edges [m] (> 0 inside).
+
+    Args:
+        points: (n, 2) [m].
+        start, edge, valid: (n, q, 2), (n, q, 2), (n, q): each point's polygon as from :func:`hull_edges`.
+
+    Inside, the margin is the smallest distance to the edges' lines; outside, minus the
+    distance to the nearest edge segment.
+    """
+    px = points[:, 0:1] - start[..., 0]
+    py = points[:, 1:2] - start[..., 1]
+    ex, ey = edge[..., 0], edge[..., 1]
+    scale = np.maximum(np.hypot(ex, ey), 1e-12)
+    line = (ex * py - ey * px) / scale
+    along = np.clip((px * ex + py * ey) / scale**2, 0.0, 1.0)
+    segment = np.hypot(px - along * ex, py - along * ey)
+    inside = np.all(line >= 0, axis=1, where=valid)
+    line_min = np.min(line, axis=1, where=valid, initial=np.inf)
+    segment_min = np.min(segment, axis=1, where=valid, initial=np.inf)
+    return np.asarray(np.where(inside, line_min, -segment_min), dtype=np.float64)
+
+
 def batch_hull_margin(points: Array, vertices: Array) -> Array:
     """:func:`signed_margin` of one point to the convex hull of its own vertex set, for many at once.
 
@@ -149,25 +207,5 @@ def batch_hull_margin(points: Array, vertices: Array) -> Array:
 
     Returns:
         (n,) signed distances [m], > 0 inside.
-
-    A directed pair (i, j) of vertices is a counter-clockwise hull edge when every other
-    vertex lies on its left; the margin is the smallest distance to those edges' lines
-    inside, and to their segments outside.
     """
-    m = vertices.shape[1]
-    i, j = np.where(~np.eye(m, dtype=bool))
-    a, b = vertices[:, i], vertices[:, j]  # (n, p, 2)
-    edge = b - a
-    rel = vertices[:, None, :, :] - a[:, :, None, :]  # (n, p, m, 2)
-    cross = edge[..., None, 0] * rel[..., 1] - edge[..., None, 1] * rel[..., 0]
-    length = np.linalg.norm(edge, axis=2)
-    scale = np.maximum(length, 1e-12)
-    on_hull = np.all(cross >= -1e-12 * scale[..., None], axis=2) & (length > 1e-12)
-    prel = points[:, None, :] - a
-    line = (edge[..., 0] * prel[..., 1] - edge[..., 1] * prel[..., 0]) / scale
-    along = np.clip(np.sum(prel * edge, axis=2) / scale**2, 0.0, 1.0)
-    segment = np.linalg.norm(prel - along[..., None] * edge, axis=2)
-    inside = np.all(np.where(on_hull, line >= 0, True), axis=1)
-    line_min = np.min(np.where(on_hull, line, np.inf), axis=1)
-    segment_min = np.min(np.where(on_hull, segment, np.inf), axis=1)
-    return np.asarray(np.where(inside, line_min, -segment_min), dtype=np.float64)
+    return edge_margin(points, *hull_edges(vertices))

@@ -38,7 +38,7 @@ cart-table ZMP of Eqs. 1-2, ``p - (l/g) p''``, computed in closed form.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -47,7 +47,7 @@ from numpy.typing import NDArray
 
 from zmpwalk import curves
 from zmpwalk.commands import StepCommand
-from zmpwalk.errors import UnreachableError, ZmpwalkError
+from zmpwalk.errors import InvalidParameterError, UnreachableError, ZmpwalkError
 from zmpwalk.footsteps import GROUNDED_STRETCH, LEFT, Pose2D, StagePlan, Stance, grounded_stage, plan_command
 from zmpwalk.kinematics import check_leg_reach
 from zmpwalk.patterns.result import (
@@ -482,6 +482,7 @@ def stage_support_phases(stage: Stage) -> list[tuple[float, float, int, tuple[Po
 # ---------------------------------------------------------------------------
 
 REACH_CHECK_POINTS = 25  # samples per stage at which the leg reach is checked
+CHUNK_STAGES = 1000  # stages evaluated in one vectorised pass on long walks (bounds the memory)
 
 
 def check_reach(stages: Sequence[Stage], robot: RobotModel) -> None:
@@ -491,19 +492,19 @@ def check_reach(stages: Sequence[Stage], robot: RobotModel) -> None:
     every stage (both ends included), in one vectorised pass. The error has the
     attribute ``stage`` (index into ``stages``).
     """
-    if not stages:
-        return
     fraction = np.linspace(0.0, 1.0, REACH_CHECK_POINTS)
-    table = StageTable(list(stages))
-    index = np.repeat(np.arange(len(stages)), REACH_CHECK_POINTS)
-    times = table.start[index] + np.tile(fraction, len(stages)) * table.duration[index]
-    samples = evaluate(table, times, robot, index)
-    pelvis = np.column_stack([samples.pelvis_xy, np.full(len(times), robot.pelvis_height)])
-    try:
-        check_leg_reach(times, pelvis, samples.pelvis_yaw, samples.left_position, samples.right_position, robot)
-    except UnreachableError as error:
-        error.stage = int(index[error.sample])
-        raise
+    for first in range(0, len(stages), CHUNK_STAGES):  # bounded memory on long walks
+        chunk = list(stages[first:first + CHUNK_STAGES])
+        table = StageTable(chunk)
+        index = np.repeat(np.arange(len(chunk)), REACH_CHECK_POINTS)
+        times = table.start[index] + np.tile(fraction, len(chunk)) * table.duration[index]
+        samples = evaluate(table, times, robot, index)
+        pelvis = np.column_stack([samples.pelvis_xy, np.full(len(times), robot.pelvis_height)])
+        try:
+            check_leg_reach(times, pelvis, samples.pelvis_yaw, samples.left_position, samples.right_position, robot)
+        except UnreachableError as error:
+            error.stage = first + int(index[error.sample])
+            raise
 
 
 def plan_next(
@@ -625,9 +626,59 @@ def generate(
     """
     check_rate(rate)
     stages, _ = plan_walk(robot, commands, schedule, labels)
-    times = sample_times(stages[-1].start, rate)
-    table = StageTable(stages)
-    return pattern_from_samples(evaluate(table, times, robot), stages, robot, rate, "polynomial")
+    return _sampled(stages, robot, rate, sample_times(stages[-1].start, rate))
+
+
+def generate_chunks(
+    robot: RobotModel,
+    commands: Sequence[StepCommand],
+    rate: float = 100.0,
+    schedule: Schedule | None = None,
+    labels: Sequence[str] | None = None,
+    chunk_stages: int = CHUNK_STAGES,
+) -> Iterator[WalkingPattern]:
+    """The pattern of :func:`generate` in consecutive pieces, for walks too long to hold at once.
+
+    The whole walk is planned and its reach checked first (so an infeasible command raises
+    before any piece is returned); then each piece of ``chunk_stages`` stages is sampled,
+    in memory that does not grow with the walk. The pieces' samples, joined, are those of
+    :func:`generate`; each piece carries the steps and support phases of its own stages.
+
+    Raises:
+        InvalidParameterError: ``chunk_stages`` < 1.
+    """
+    check_rate(rate)
+    if isinstance(chunk_stages, bool) or not isinstance(chunk_stages, int) or chunk_stages < 1:
+        raise InvalidParameterError("chunk_stages", chunk_stages, "an integer >= 1")
+    stages, _ = plan_walk(robot, commands, schedule, labels)
+    return _chunks(stages, robot, rate, chunk_stages)
+
+
+def _chunks(stages: list[Stage], robot: RobotModel, rate: float, chunk_stages: int) -> Iterator[WalkingPattern]:
+    end = stages[-1].start  # the first sample of standing still closes the walk
+    for first in range(0, len(stages), chunk_stages):
+        chunk = stages[first:first + chunk_stages]
+        last = first + len(chunk) >= len(stages)
+        begin_index = _first_sample_at(chunk[0].start, rate)
+        stop_time = stages[min(first + len(chunk), len(stages) - 1)].start
+        # the last piece ends where sample_times ends the whole walk
+        stop_index = math.ceil(end * rate - 1e-9) + 1 if last else _first_sample_at(stop_time, rate)
+        if stop_index > begin_index:
+            yield _sampled(chunk, robot, rate, np.arange(begin_index, stop_index) / rate)
+
+
+def _first_sample_at(time: float, rate: float) -> int:
+    """Index of the first sample ``k / rate`` at or after ``time``, compared exactly as the sampled times are."""
+    index = math.ceil(time * rate - 1e-9)
+    while index / rate < time:
+        index += 1
+    while index > 0 and (index - 1) / rate >= time:
+        index -= 1
+    return index
+
+
+def _sampled(stages: list[Stage], robot: RobotModel, rate: float, times: Array) -> WalkingPattern:
+    return pattern_from_samples(evaluate(StageTable(stages), times, robot), stages, robot, rate, "polynomial")
 
 
 def pattern_from_samples(

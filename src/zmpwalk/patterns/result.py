@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import csv
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -16,14 +17,15 @@ from numpy.typing import NDArray
 
 from zmpwalk.errors import InvalidParameterError
 from zmpwalk.files import atomic_output
-from zmpwalk.footsteps import Pose2D, foot_corners
+from zmpwalk.footsteps import Pose2D, foot_corners, sole_corners
 from zmpwalk.robots.model import RobotModel
-from zmpwalk.zmp import convex_hull, signed_margin
+from zmpwalk.zmp import convex_hull, edge_margin, hull_edges
 
 Array = NDArray[np.float64]
 
 SUPPORT_DOUBLE, SUPPORT_LEFT, SUPPORT_RIGHT = 0, 1, 2  # codes of WalkingPattern.support
 SUPPORT_NAMES = ("double", "left", "right")  # indexed by the codes
+MARGIN_CHUNK = 2048  # support phases whose ZMP margins are computed in one vectorised pass
 
 def check_rate(rate: float) -> None:
     """Raise unless ``rate`` is a sampling rate zmpwalk supports (1 Hz .. 10 kHz)."""
@@ -174,14 +176,22 @@ class WalkingPattern:
         return self._polygons
 
     def zmp_margin(self) -> Array:
-        """Signed distance of the ZMP to the support polygon per sample [m] (> 0 inside)."""
+        """Signed distance of the ZMP to the support polygon per sample [m] (> 0 inside).
+
+        Linear in the walk's length and in bounded memory: the polygons' edges are found for
+        :data:`MARGIN_CHUNK` phases at a time, and the samples of those phases measured together.
+        """
         margin = np.full(len(self.time), np.nan)
-        begins = np.array([phase.begin for phase in self.support_phases])
-        which = np.clip(np.searchsorted(begins, self.time, side="right") - 1, 0, len(begins) - 1)
-        polygons = self.support_polygons()
-        for index in np.unique(which):
-            mask = which == index
-            margin[mask] = signed_margin(self.zmp_in_world[mask], polygons[index])
+        phases = self.support_phases
+        begins = np.array([phase.begin for phase in phases])
+        # the samples of each phase are one slice of the (sorted) times
+        cuts = np.r_[0, np.searchsorted(self.time, begins[1:], side="left"), len(self.time)]
+        for first in range(0, len(phases), MARGIN_CHUNK):
+            last = min(first + MARGIN_CHUNK, len(phases))
+            start, edge, valid = hull_edges(_phase_vertices(phases[first:last], self.robot))
+            which = np.repeat(np.arange(last - first), np.diff(cuts[first:last + 1]))
+            rows = slice(cuts[first], cuts[last])
+            margin[rows] = edge_margin(self.zmp_in_world[rows], start[which], edge[which], valid[which])
         return margin
 
     def min_zmp_margin(self) -> tuple[float, float]:
@@ -204,18 +214,34 @@ class WalkingPattern:
 
     def write_csv(self, path: Path, extra: dict[str, Array] | None = None) -> None:
         """Write one row per sample with :data:`CSV_COLUMNS` (then ``extra`` columns) in SI units."""
-        columns = self.columns()
-        if extra:
-            columns.update(extra)
-        names = list(columns)
-        data = [columns[name] for name in names]
-        with atomic_output(path) as temporary, temporary.open("w", newline="", encoding="utf-8") as handle:
-            writer = csv.writer(handle)
-            writer.writerow(names)
-            for i in range(len(self.time)):
+        write_pieces_csv(path, [(self, extra)])
+
+
+def write_pieces_csv(path: Path, pieces: Iterable[tuple[WalkingPattern, dict[str, Array] | None]]) -> None:
+    """Write consecutive pieces of one walk as one CSV file, a piece at a time (bounded memory).
+
+    The header comes from the first piece; the file appears only once every row is written.
+    """
+    with atomic_output(path) as temporary, temporary.open("w", newline="", encoding="utf-8") as handle:
+        writer = csv.writer(handle)
+        for number, (pattern, extra) in enumerate(pieces):
+            columns = pattern.columns()
+            if extra:
+                columns.update(extra)
+            data = list(columns.values())
+            if number == 0:
+                writer.writerow(list(columns))
+            for i in range(len(pattern.time)):
                 writer.writerow([
                     value[i] if isinstance(value[i], str) else _fmt(float(value[i])) for value in data
                 ])
+
+
+def _phase_vertices(phases: list[SupportPhase], robot: RobotModel) -> Array:
+    """The sole corners of each phase's feet, shape (p, 8, 2) [m] (a single sole twice)."""
+    feet = [(phase.feet * 2)[:2] for phase in phases]
+    x, y, yaw, side = np.array([[pose.x, pose.y, pose.yaw, foot] for pair in feet for pose, foot in pair]).T
+    return sole_corners(x, y, yaw, side, robot).reshape(len(phases), 8, 2)
 
 
 def _fmt(value: float) -> str:

@@ -420,6 +420,7 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
         **fields_, joint_limits=limits, hip_x=hip_x, com_offset=(float(com_offset[0]), float(com_offset[1])),
         legs=(chains_ready[0], chains_ready[1]), plant=plant,
         schedule_scale=(time_scale, length_scale, lateral_scale),
+        foot_speed_limit=values.get("foot_speed_limit"), foot_acceleration_limit=values.get("foot_acceleration_limit"),
     )
 
 

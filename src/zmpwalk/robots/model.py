@@ -29,6 +29,8 @@ JOINT_NAMES = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle
 HUBO_PENDULUM = 0.62  # [m] pendulum length the HUBO tables were tuned for (robots/data/hubo.toml)
 HUBO_HIP_SPACING = 0.17  # [m] HUBO's hip spacing (robots/data/hubo.toml)
 LINK_NAMES = ("torso", "thigh", "shank", "foot")
+FOOT_SPEED_FROUDE = 1.6  # [-] default swing-foot speed limit over sqrt(g l)
+FOOT_ACCELERATION_G = 5.0  # [-] default swing-foot acceleration limit over g
 
 
 @dataclass(frozen=True)
@@ -125,6 +127,9 @@ class RobotModel:
         schedule_scale: Factors (time, stride, lateral) [-] mapping this robot's steps onto the HUBO
             tables: times with ``sqrt(l / l_HUBO)``, strides and foot lift with ``l / l_HUBO``, sway with
             the hip spacing (``zmpwalk.schedule``).
+        foot_speed_limit: Fastest the swinging ankle may move [m/s]; None: :attr:`max_foot_speed`'s
+            size-scaled default.
+        foot_acceleration_limit: Largest acceleration of the swinging ankle [m/s^2]; None: 5 g.
     """
 
     name: str
@@ -156,6 +161,8 @@ class RobotModel:
     legs: tuple[LegChain, LegChain] | None = None
     plant: ModelPlant | None = None
     schedule_scale: tuple[float, float, float] = (1.0, 1.0, 1.0)  # [-] time, stride, lateral
+    foot_speed_limit: float | None = None  # [m/s]
+    foot_acceleration_limit: float | None = None  # [m/s^2]
 
     def hip_in_pelvis(self, side: int) -> tuple[float, float, float]:
         """Hip joint centre of the left (``side = +1``) or right (-1) leg relative to the pattern's pelvis
@@ -183,6 +190,28 @@ class RobotModel:
         return math.sqrt(a * a + b * b + 2 * a * b * math.cos(self.min_knee))
 
     @property
+    def max_foot_speed(self) -> float:
+        """Fastest the swinging ankle may move [m/s]: :attr:`foot_speed_limit`, by default
+        ``1.6 sqrt(g l)`` (4 m/s for HUBO's l = 0.62 m: dynamically similar robots, equal Froude number)."""
+        if self.foot_speed_limit is not None:
+            return self.foot_speed_limit
+        return FOOT_SPEED_FROUDE * math.sqrt(self.gravity * self.pendulum_length)
+
+    @property
+    def max_foot_acceleration(self) -> float:
+        """Largest acceleration of the swinging ankle [m/s^2]: :attr:`foot_acceleration_limit`, by default
+        5 g (equal for dynamically similar robots)."""
+        if self.foot_acceleration_limit is not None:
+            return self.foot_acceleration_limit
+        return FOOT_ACCELERATION_G * self.gravity
+
+    @property
+    def max_foot_lift(self) -> float:
+        """Highest swing apex above the ankle's ground height [m]: half the hip's height above the ankle,
+        so the swinging ankle stays well below the hip."""
+        return 0.5 * (self.hip_height - self.ankle_height)
+
+    @property
     def hip_height(self) -> float:
         """Hip joints above the ground in the ready posture [m]."""
         return self.pelvis_height - self.hip_drop
@@ -198,12 +227,13 @@ _SECTIONS: dict[str, dict[str, str]] = {
     "posture": {"pelvis_height": "pelvis_height", "pendulum_length": "pendulum_length",
                 "min_knee": "min_knee"},
     "walking": {"dsp_time": "dsp_time", "foot_lift": "foot_lift",
-                "lateral_velocity": "lateral_velocity", "scale_schedule": "scale_schedule"},
+                "lateral_velocity": "lateral_velocity", "scale_schedule": "scale_schedule",
+                "foot_speed_limit": "foot_speed_limit", "foot_acceleration_limit": "foot_acceleration_limit"},
 }
-_OPTIONAL = {"gravity", "hip_x", "scale_schedule"}
+_OPTIONAL = {"gravity", "hip_x", "scale_schedule", "foot_speed_limit", "foot_acceleration_limit"}
 _POSITIVE = {"mass", "height", "hip_spacing", "thigh_length", "shank_length", "ankle_height",
              "foot_length", "foot_width", "pelvis_height", "pendulum_length", "gravity",
-             "dsp_time", "lateral_velocity"}
+             "dsp_time", "lateral_velocity", "foot_speed_limit", "foot_acceleration_limit"}
 # Sections a later part of zmpwalk reads (bodies, servos); kept as raw tables.
 _EXTRA_SECTIONS = {"limits", "bodies", "servos", "contact"}  # read by their own parsers
 
@@ -222,7 +252,9 @@ def robot_from_toml(path: Path) -> RobotModel:
     return robot_from_dict(data, str(path))
 
 
-_MODEL_OVERRIDES = {"posture": ("pelvis_height",), "walking": ("dsp_time", "foot_lift", "lateral_velocity")}
+_MODEL_OVERRIDES = {"posture": ("pelvis_height",),
+                    "walking": ("dsp_time", "foot_lift", "lateral_velocity", "foot_speed_limit",
+                                "foot_acceleration_limit")}
 
 
 def _robot_from_model_table(data: dict[str, Any], path: Path) -> RobotModel:
