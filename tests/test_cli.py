@@ -116,7 +116,10 @@ def test_plan_with_the_hyperbolic_generator(tmp_path, capsys):
 @pytest.mark.parametrize("step, message", [
     ("duration = 0", "duration = 0"),
     ("duration = -0.8", "duration = -0.8"),
-    ("duration = 0.08\nforward = 0.1", "longer than the double-support time"),
+    ("duration = 0.1\nforward = 0.1", "longer than the double-support time"),
+    ("duration = 0.08\nforward = 0.1", "duration = 0.08 is not allowed; expected a value in [0.1, 5] s"),
+    ("duration = 0.3\nforward = 0.3", "duration = 0.3 is not allowed; expected a step time >= 0.340 s"),
+    ("duration = 0.8\nfoot_lift = 0.5", "foot_lift = 0.5 is not allowed; expected a swing apex in [0, 0.2"),
     ("duration = nan", "duration = nan"),
     ("duration = 0.8\nforward = 0.9", "out of reach"),
     ("duration = 0.8\nup_ratio = 1.5", "up_ratio = 1.5"),
@@ -136,7 +139,9 @@ def test_planning_errors_name_the_file_the_table_and_the_walked_step(tmp_path, c
     steps = tmp_path / "walk.toml"
     steps.write_text("[[steps]]\nduration = 0.8\nforward = 0.1\nrepeat = 3\n[[steps]]\nduration = 0.8\nforward = 0.9\n")
     assert main(["plan", str(steps)]) == 2
-    assert f"{steps}: step 4 ([[steps]] 2): right ankle out of reach" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert f"{steps}: step 4 ([[steps]] 2): forward = 0.9 is not allowed" in err
+    assert "at most forward = 0.4" in err and "right ankle out of reach" in err
 
 
 @pytest.mark.parametrize("argv, message", [

@@ -8,6 +8,7 @@ import pytest
 
 from zmpwalk import (
     FileFormatError,
+    InfeasibleCommandError,
     InvalidParameterError,
     StepCommand,
     UnknownNameError,
@@ -31,6 +32,12 @@ from zmpwalk.scenarios import load_scenario, load_steps_file
     ({"duration": 0.8, "d1": 1.0}, "d1"),
     ({"duration": 0.8, "d1": -0.1}, "d1"),
     ({"duration": 0.8, "dsp_time": 0.9}, "dsp_time"),
+    ({"duration": 0.8, "dsp_time": 0.41}, "dsp_time"),
+    ({"duration": 0.8, "up_ratio": 0.05}, "up_ratio"),
+    ({"duration": 0.8, "up_ratio": 0.95}, "up_ratio"),
+    ({"duration": 0.8, "d1_recovery": 0.99}, "d1_recovery"),
+    ({"duration": 0.001}, "duration"),
+    ({"duration": 800.0}, "duration"),
     ({"duration": 0.8, "alpha": -1.0}, "alpha"),
     ({"duration": 0.8, "forward": 0.1, "stop": True}, "forward"),
     ({"duration": "0.8"}, "duration"),
@@ -44,16 +51,24 @@ def test_bad_step_commands(kwargs, parameter):
 
 
 def test_duration_shorter_than_the_double_support(hubo):
-    with pytest.raises(InvalidParameterError, match=r"step 2: duration = 0.08 .*double-support time d = 0.1 s"):
-        generate(hubo, [StepCommand(0.8, 0.1), StepCommand(0.08, 0.1)])
+    with pytest.raises(InvalidParameterError, match=r"step 2: duration = 0.1 .*double-support time d = 0.1 s"):
+        generate(hubo, [StepCommand(0.8, 0.1), StepCommand(0.1, 0.1)])
 
 
-def test_stride_beyond_reach_names_leg_time_and_excess(hubo):
-    with pytest.raises(UnreachableError) as info:
+def test_stride_beyond_reach_names_the_stride_the_largest_that_fits_leg_time_and_excess(hubo):
+    with pytest.raises(InfeasibleCommandError) as info:
         generate(hubo, [StepCommand(0.8, 0.2), StepCommand(0.8, 0.9)])
     error = info.value
-    assert "step 2" in str(error) and error.excess > 0 and error.leg in ("left", "right")
-    assert "out of reach from t =" in str(error) and "by up to" in str(error) and error.time > 0
+    assert error.parameter == "forward" and error.value == 0.9
+    assert "step 2: forward = 0.9 is not allowed" in str(error) and "at most forward = " in str(error)
+    cause = error.cause
+    assert isinstance(cause, UnreachableError) and cause.excess > 0 and cause.leg in ("left", "right")
+    assert "out of reach from t =" in str(error) and "by up to" in str(error) and cause.time > 0
+    # the largest stride that fits does fit, and 1 % more does not
+    largest = error.largest["forward"]
+    generate(hubo, [StepCommand(0.8, 0.2), StepCommand(0.8, largest)])
+    with pytest.raises(InfeasibleCommandError):
+        generate(hubo, [StepCommand(0.8, 0.2), StepCommand(0.8, largest * 1.01)])
 
 
 def test_feet_that_would_overlap(hubo):
@@ -115,7 +130,7 @@ def test_unknown_generator_lists_the_known_ones():
     ({"duration": None}, "duration = None is not allowed; expected a finite number"),
     ({"duration": 0.8, "forward": None}, "forward = None"),
     ({"duration": 0.8, "forward": 10**400}, "forward = an integer of 401 digits"),
-    ({"duration": 1e300}, r"duration = 1e\+300 is not allowed; expected a value in \(0, 5\] s \(seconds\)"),
+    ({"duration": 1e300}, r"duration = 1e\+300 is not allowed; expected a value in \[0.1, 5\] s \(seconds\)"),
     ({"duration": 800}, r"\(seconds\)"),  # milliseconds by mistake
     ({"duration": 0.8, "forward": 20}, r"forward = 20 is not allowed; expected a value in \[-2, 2\] m \(metres\)"),
     ({"duration": 0.8, "side": -3.0}, r"side = -3"),

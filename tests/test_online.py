@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from zmpwalk import (
@@ -86,7 +88,7 @@ def test_rejected_command_leaves_the_walker_exactly_as_it_was(hubo):
             walker.command(pending.pop(0))
         if tick % 97 == 0:
             queued = walker.queued
-            for bad in (StepCommand(0.8, 0.9), StepCommand(0.08, 0.1)):
+            for bad in (StepCommand(0.8, 0.9), StepCommand(0.1, 0.1), StepCommand(0.3, 0.3)):
                 with pytest.raises((UnreachableError, InvalidParameterError)):
                     walker.command(bad)
             with pytest.raises(InvalidParameterError):
@@ -158,7 +160,6 @@ def test_commands_at_any_tick_keep_the_motion_continuous(hubo, actions):
 
 @pytest.mark.parametrize(("joints", "command", "error"), [
     (True, StepCommand(duration=1.0, forward=0.3, foot_lift=0.15), "right_ankle_pitch"),
-    (False, StepCommand(duration=0.78, side=-0.039, d1_recovery=0.99), "out of reach"),
 ])
 def test_a_command_whose_stop_is_infeasible_is_rejected_by_command_not_by_a_later_tick(joints, command, error):
     walker = OnlineWalker(load_robot("hubo"), rate=100, joints=joints)
@@ -184,3 +185,63 @@ def test_samples_do_not_alias_the_walkers_buffers():
     assert np.array_equal(second.position_pelvis_in_world, expected[0])
     assert np.array_equal(second.joint_angles, expected[1])
     assert np.all(second.zmp_in_world != 99.0)
+
+
+# --------------------------------------------------------------------- hostile command sequences
+
+_HOSTILE_NUMBERS = st.sampled_from([
+    None, math.nan, math.inf, -math.inf, 10**400, 1e300, -1e-300, 800.0, 0.0, True, "0.8",
+    np.float32(0.5), np.int64(1), np.float64(-2.5), 1e-7, -0.0,
+])
+_FIELD_NAMES = ("forward", "side", "turn", "alpha", "alpha1", "beta1", "d1", "d1_recovery", "up_ratio", "sway",
+                "lateral_velocity", "dsp_time", "foot_lift")
+_PLAUSIBLE = {"forward": st.floats(-0.3, 0.6), "side": st.floats(-0.15, 0.15), "turn": st.floats(-0.8, 0.8)}
+
+
+@st.composite
+def _hostile_fields(draw: st.DrawFn) -> dict[str, object]:
+    def value(plausible: st.SearchStrategy[float]) -> object:  # three times in four a plausible number
+        return draw(st.one_of(plausible, plausible, plausible, _HOSTILE_NUMBERS))
+
+    fields: dict[str, object] = {"duration": value(st.floats(0.5, 1.2))}
+    for name in draw(st.lists(st.sampled_from(_FIELD_NAMES), max_size=3, unique=True)):
+        fields[name] = value(_PLAUSIBLE.get(name, st.floats(0.0, 1.0)))
+    if draw(st.booleans()):
+        fields["stop"] = draw(st.sampled_from([True, False, 1, None]))
+    return fields
+
+
+@pytest.mark.parametrize("joints", [False, True])
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(actions=st.lists(st.tuples(st.integers(0, 150), _hostile_fields()), min_size=1, max_size=8))
+def test_hostile_commands_are_rejected_by_command_never_by_tick(hubo, joints, actions):
+    """Random commands, hostile values and None included: every error is a ZmpwalkError naming a parameter,
+    raised when the command is made or given, never by a tick; a rejection changes nothing (the walk equals
+    that of a walker given only the accepted commands, sample for sample)."""
+    rate = 100.0
+    walker = OnlineWalker(hubo, rate=rate, joints=joints)
+    reference = OnlineWalker(hubo, rate=rate, joints=joints)
+    for wait, fields in [*actions, (800, None)]:  # then 8 s more: the last walk's stop included
+        for _ in range(wait):
+            a, b = walker.tick(), reference.tick()  # a tick never raises
+            np.testing.assert_array_equal(_rows(a), _rows(b))
+            if joints:
+                np.testing.assert_array_equal(a.joint_angles, b.joint_angles)
+        if fields is None:
+            break
+        try:
+            command = StepCommand(**fields)  # type: ignore[arg-type]
+            queued = walker.queued
+            try:
+                walker.command(command)
+            except ZmpwalkError as error:
+                assert walker.queued == queued
+                event("rejected by command()")
+                raise error
+        except ZmpwalkError as error:
+            assert isinstance(error, InvalidParameterError) and error.parameter  # names a parameter
+            assert error.parameter in str(error) and "expected" in str(error)
+            continue
+        event("accepted")
+        reference.command(command)
+    assert not walker.walking  # every accepted walk ended standing

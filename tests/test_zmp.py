@@ -107,7 +107,7 @@ def test_convex_hull_of_two_feet_is_counter_clockwise():
 
 
 def test_hull_edges_margin_equals_the_hull_polygons_margin():
-    """Many vertex sets at once (two soles, one sole given twice, collinear sides) against convex_hull + signed_margin."""
+    """Many vertex sets at once (two soles, one sole twice, collinear sides) against convex_hull + signed_margin."""
     rng = np.random.default_rng(7)
     square = np.array([[0.0, 0.0], [0.2, 0.0], [0.2, 0.1], [0.0, 0.1]])
     sets = []

@@ -11,6 +11,7 @@ from zmpwalk.balance import BalanceMeasurement, Stabilizer, StabilizerGains
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import (
     FileFormatError,
+    InfeasibleCommandError,
     InfeasiblePatternError,
     InvalidParameterError,
     UnknownNameError,
@@ -29,6 +30,7 @@ from zmpwalk.schedule import Schedule, ShapeParameters
 __all__ = [
     "BalanceMeasurement",
     "FileFormatError",
+    "InfeasibleCommandError",
     "InfeasiblePatternError",
     "InvalidParameterError",
     "JointLimitError",

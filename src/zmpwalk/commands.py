@@ -28,7 +28,10 @@ from dataclasses import dataclass, fields
 from zmpwalk.errors import InvalidParameterError
 
 MAX_TURN = math.pi / 2  # [rad] largest turn of one step
+MIN_DURATION = 0.1  # [s] shortest step time: no biped shifts its weight faster; 0.001 is seconds by mistake
 MAX_DURATION = 5.0  # [s] longest step time: walking steps last about a second; 800 is milliseconds by mistake
+MAX_RATIO = 0.9  # [-] up_ratio in [1 - MAX_RATIO, MAX_RATIO], staying ratios at most this: both phases take time
+MAX_DSP_FRACTION = 0.5  # [-] double support at most this part of the step time: the rest is the swing
 MAX_STRIDE = 2.0  # [m] largest |forward| and |side| before any robot's reach is checked: 20 is centimetres
 REQUIRED = ("duration", "forward", "side", "turn")  # the fields that take no None
 
@@ -41,7 +44,7 @@ class StepCommand:
         InvalidParameterError: A field is not finite or outside its range.
     """
 
-    duration: float  # [s] step time T of one swing (> 0)
+    duration: float  # [s] step time T of one swing, in [0.1, 5]
     forward: float = 0.0  # [m] stride f, swing foot ahead of the supporting foot
     side: float = 0.0  # [m] side step A, positive = left
     turn: float = 0.0  # [rad] turn theta, positive = counter-clockwise
@@ -49,13 +52,13 @@ class StepCommand:
     alpha: float | None = None  # [-] shape factor of the pelvis X velocity (Eq. 13)
     alpha1: float | None = None  # [-] multiplier of V_y (Eq. 20)
     beta1: float | None = None  # [-] multiplier of S_y (Eq. 20)
-    d1: float | None = None  # [-] staying ratio of Eq. 18, in [0, 1) (the open stance of a side or turn step)
-    d1_recovery: float | None = None  # [-] staying ratio of the recovery stage of a side or turn step, in [0, 1)
-    up_ratio: float | None = None  # [-] u of Fig. 12, lift time / swing time, in (0, 1)
+    d1: float | None = None  # [-] staying ratio of Eq. 18, in [0, 0.9] (the open stance of a side or turn step)
+    d1_recovery: float | None = None  # [-] staying ratio of the recovery stage of a side or turn step, in [0, 0.9]
+    up_ratio: float | None = None  # [-] u of Fig. 12, lift time / swing time, in [0.1, 0.9]
     sway: float | None = None  # [m] S_y of Eq. 20, >= 0
     lateral_velocity: float | None = None  # [m per unit 2*t_bar] V_y of Eq. 20, >= 0
-    dsp_time: float | None = None  # [s] double-support time d of Eq. 11, in [0, duration)
-    foot_lift: float | None = None  # [m] swing apex height, >= 0
+    dsp_time: float | None = None  # [s] double-support time d of Eq. 11, in [0, duration / 2]
+    foot_lift: float | None = None  # [m] swing apex height, in [0, 1] (and below the robot's hips)
 
     def __post_init__(self) -> None:
         for item in fields(self):
@@ -76,7 +79,7 @@ class StepCommand:
             if not math.isfinite(number):
                 raise InvalidParameterError(item.name, value, "a finite number")
             object.__setattr__(self, item.name, number)
-        _check("duration", self.duration, 0.0, MAX_DURATION, low_open=True, unit="s (seconds)")
+        _check("duration", self.duration, MIN_DURATION, MAX_DURATION, unit="s (seconds)")
         _check("forward", self.forward, -MAX_STRIDE, MAX_STRIDE, unit="m (metres)")
         _check("side", self.side, -MAX_STRIDE, MAX_STRIDE, unit="m (metres)")
         _check("turn", self.turn, -MAX_TURN, MAX_TURN, unit="rad")
@@ -91,14 +94,14 @@ class StepCommand:
                 _check(name, getattr(self, name), 0.0, 10.0)
         for name in ("d1", "d1_recovery"):
             if getattr(self, name) is not None:
-                _check(name, getattr(self, name), 0.0, 1.0, high_open=True)
+                _check(name, getattr(self, name), 0.0, MAX_RATIO)
         if self.up_ratio is not None:
-            _check("up_ratio", self.up_ratio, 0.0, 1.0, low_open=True, high_open=True)
+            _check("up_ratio", self.up_ratio, 1.0 - MAX_RATIO, MAX_RATIO)
         for name, unit in (("sway", "m"), ("lateral_velocity", "m"), ("foot_lift", "m")):
             if getattr(self, name) is not None:
                 _check(name, getattr(self, name), 0.0, 1.0, unit=unit)
         if self.dsp_time is not None:
-            _check("dsp_time", self.dsp_time, 0.0, self.duration, high_open=True, unit="s")
+            _check("dsp_time", self.dsp_time, 0.0, MAX_DSP_FRACTION * self.duration, unit="s (half the step time)")
 
     @property
     def is_two_stage(self) -> bool:

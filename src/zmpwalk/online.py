@@ -32,15 +32,15 @@ Behaviour:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk.commands import StepCommand
-from zmpwalk.errors import InvalidParameterError, ZmpwalkError
+from zmpwalk.errors import InfeasibleCommandError, InvalidParameterError, UnreachableError, ZmpwalkError
 from zmpwalk.footsteps import Stance
-from zmpwalk.kinematics import joint_trajectory
+from zmpwalk.kinematics import JointLimitError, joint_trajectory
 from zmpwalk.patterns.polynomial import (
     Boundary,
     Samples,
@@ -48,6 +48,7 @@ from zmpwalk.patterns.polynomial import (
     StageTable,
     closing_command,
     evaluate,
+    infeasible_command,
     plan_next,
 )
 from zmpwalk.patterns.result import SUPPORT_NAMES, check_rate
@@ -65,6 +66,9 @@ _JOINTS, _JOINT_RATES = slice(15, 27), slice(27, 39)
 _WIDTH = 15
 _WIDTH_WITH_JOINTS = 39
 _EPS = 1e-9
+HINT_RATE = 100.0  # [Hz] sampling of the search for the largest stride that fits, in a rejection
+HINT_CONFIRMATIONS = 5  # tries at the control rate, each HINT_SHRINK smaller
+HINT_SHRINK = 0.98
 
 
 @dataclass(frozen=True, slots=True)
@@ -164,27 +168,54 @@ class OnlineWalker:
         stance, boundary = self._stance, self._boundary
         if boundary.at_rest:
             boundary = Boundary(max(boundary.time, self.time))
-        plan = self._plan(command, stance, boundary)
+        try:
+            plan = self._checked(command, stance, boundary, self.rate)
+        except (UnreachableError, JointLimitError) as error:
+            raise self._infeasible(command, stance, boundary, error) from None
         if plan is None:  # a stop while standing
             self._pending = None
             return
-        if not command.stop:
-            # The stop this command leads to when no other follows: planned and checked now, so that no
-            # accepted command can make a later tick fail, and no tick plans.
+        self._pending = plan
+
+    def _checked(self, command: StepCommand, stance: Stance, boundary: Boundary, rate: float) -> _Plan | None:
+        """:meth:`_plan` of a command and of the stop it leads to when no other follows: planned and checked
+        together, so that no accepted command can make a later tick fail, and no tick plans."""
+        plan = self._plan(command, stance, boundary, rate)
+        if plan is not None and not command.stop:
             try:
-                plan.closing = self._plan(closing_command(command), plan.stance, plan.boundary)
+                plan.closing = self._plan(closing_command(command), plan.stance, plan.boundary, rate)
             except ZmpwalkError as error:
                 raise error.in_context("the closing step this command would end with (when no other follows)") \
                     from None
-        self._pending = plan
+        return plan
 
-    def _plan(self, command: StepCommand, stance: Stance, boundary: Boundary) -> _Plan | None:
-        """Plan, sample (and solve the legs of) one command from a stance; None for a stop while standing."""
+    def _infeasible(self, command: StepCommand, stance: Stance, boundary: Boundary,
+                    cause: ZmpwalkError) -> ZmpwalkError:
+        """The rejection of a command the legs cannot follow, naming the largest stride that fits: searched
+        at :data:`HINT_RATE` at most, then confirmed (or reduced) at the control rate."""
+        coarse = min(self.rate, HINT_RATE)
+        error = infeasible_command(command, cause, lambda c: self._checked(c, stance, boundary, coarse))
+        for _ in range(HINT_CONFIRMATIONS):
+            if not error.largest or coarse == self.rate:
+                break
+            try:
+                self._checked(replace(command, forward=error.largest.get("forward", 0.0),
+                                      side=error.largest.get("side", 0.0), turn=error.largest.get("turn", 0.0)),
+                              stance, boundary, self.rate)
+                break
+            except ZmpwalkError:
+                error = InfeasibleCommandError(error.parameter, error.value,
+                                               {k: v * HINT_SHRINK for k, v in error.largest.items()}, cause)
+        return error
+
+    def _plan(self, command: StepCommand, stance: Stance, boundary: Boundary, rate: float) -> _Plan | None:
+        """Plan, sample (and solve the legs of) one command from a stance at ``rate`` [Hz]; None for a stop
+        while standing."""
         stages, next_stance, next_boundary = plan_next(self.robot, self._schedule, stance, boundary, command)
         if not stages:
             return None
-        first_index = math.ceil(stages[0].start * self.rate - _EPS)
-        rows = self._sample(stages, first_index, next_boundary.time)
+        first_index = math.ceil(stages[0].start * rate - _EPS)
+        rows = self._sample(stages, first_index, next_boundary.time, rate)
         standing = self._standing_row(next_stance) if next_boundary.at_rest else None
         return _Plan(command, stages, next_stance, next_boundary, rows, first_index, standing=standing)
 
@@ -240,9 +271,9 @@ class OnlineWalker:
             if index < plan.first_index + len(plan.rows):
                 return plan
 
-    def _sample(self, stages: list[Stage], first_index: int, end_time: float) -> Array:
-        stop_index = math.ceil(end_time * self.rate - _EPS)
-        times = np.arange(first_index, stop_index) / self.rate
+    def _sample(self, stages: list[Stage], first_index: int, end_time: float, rate: float) -> Array:
+        stop_index = math.ceil(end_time * rate - _EPS)
+        times = np.arange(first_index, stop_index) / rate
         rows = np.empty((len(times), self._width))
         if len(times) == 0:
             return rows

@@ -38,7 +38,7 @@ cart-table ZMP of Eqs. 1-2, ``p - (l/g) p''``, computed in closed form.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -46,8 +46,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk import curves
-from zmpwalk.commands import StepCommand
-from zmpwalk.errors import InvalidParameterError, UnreachableError, ZmpwalkError
+from zmpwalk.commands import MAX_STRIDE, MAX_TURN, StepCommand
+from zmpwalk.errors import InfeasibleCommandError, InvalidParameterError, UnreachableError, ZmpwalkError
 from zmpwalk.footsteps import GROUNDED_STRETCH, LEFT, Pose2D, StagePlan, Stance, grounded_stage, plan_command
 from zmpwalk.kinematics import check_leg_reach
 from zmpwalk.patterns.result import (
@@ -544,6 +544,50 @@ def plan_next(
     return stages, next_stance, boundary
 
 
+STRIDE_FIELDS = ("forward", "side", "turn")
+STRIDE_BISECTIONS = 10  # halvings of the stride scale when looking for the largest that fits (0.1 %)
+
+
+def infeasible_command(command: StepCommand, cause: ZmpwalkError,
+                       feasible: Callable[[StepCommand], object]) -> InfeasibleCommandError:
+    """The error for a command whose legs cannot follow it, with the largest stride that fits.
+
+    The stride (``forward``, ``side``, ``turn`` together, so the direction is kept) is scaled by
+    bisection on ``feasible``, which raises :class:`~zmpwalk.errors.ZmpwalkError` for a command
+    that does not fit from the same place.
+    """
+    def fits(scale: float) -> bool:
+        try:
+            feasible(_scaled(command, scale))
+        except ZmpwalkError:
+            return False
+        return True
+
+    moving = [name for name in STRIDE_FIELDS if getattr(command, name) != 0.0]
+    if not moving:
+        return InfeasibleCommandError("foot_lift", command.foot_lift, {}, cause)
+    # the field that is largest against its own limit names the error
+    limits = {"forward": MAX_STRIDE, "side": MAX_STRIDE, "turn": MAX_TURN}
+    name = max(moving, key=lambda n: abs(getattr(command, n)) / limits[n])
+    if not fits(0.0):
+        return InfeasibleCommandError(name, getattr(command, name), {}, cause)
+    low, high = 0.0, 1.0
+    for _ in range(STRIDE_BISECTIONS):
+        middle = 0.5 * (low + high)
+        if fits(middle):
+            low = middle
+        else:
+            high = middle
+    if low == 0.0:  # only the step in place fits: the stride's direction is not the cause
+        return InfeasibleCommandError(name, getattr(command, name), {}, cause)
+    largest = _scaled(command, low)
+    return InfeasibleCommandError(name, getattr(command, name), {n: getattr(largest, n) for n in moving}, cause)
+
+
+def _scaled(command: StepCommand, scale: float) -> StepCommand:
+    return replace(command, **{name: getattr(command, name) * scale for name in STRIDE_FIELDS})
+
+
 def closing_command(last: StepCommand) -> StepCommand:
     """The stop added after ``last``: same step time and shape-factor overrides, no motion."""
     return replace(last, forward=0.0, side=0.0, turn=0.0, stop=True)
@@ -578,7 +622,9 @@ def plan_walk(
     if sequence and not sequence[-1].stop:
         sequence.append(closing_command(sequence[-1]))
     numbers: list[int] = []
+    starts: list[tuple[Stance, Boundary]] = []  # where each command starts from
     for number, command in enumerate(sequence, start=1):
+        starts.append((stance, boundary))
         try:
             new, stance, boundary = plan_next(robot, schedule, stance, boundary, command, reach=False)
         except ZmpwalkError as error:
@@ -588,7 +634,17 @@ def plan_walk(
     try:
         check_reach(stages, robot)
     except UnreachableError as error:
-        raise error.in_context(_label(labels, numbers[error.stage])) from None
+        number = numbers[error.stage]
+        if number > 1 and sequence[number - 1].stop:
+            number -= 1  # a stop fails for the stride before it
+        command, (start_stance, start_boundary) = sequence[number - 1], starts[number - 1]
+
+        def feasible(candidate: StepCommand) -> None:  # the command, and the stop after it
+            _, after, after_boundary = plan_next(robot, schedule, start_stance, start_boundary, candidate)
+            if not candidate.stop:
+                plan_next(robot, schedule, after, after_boundary, closing_command(candidate))
+
+        raise infeasible_command(command, error, feasible).in_context(_label(labels, number)) from None
     stages.append(standing_stage(_standing_plan(stance, robot, schedule), boundary.time))
     return stages, stance
 
