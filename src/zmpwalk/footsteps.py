@@ -189,19 +189,20 @@ def _stage(
     return StagePlan(swing, support, stance.pose(swing), end, forward, command.duration, parameters, stop, kind)
 
 
-def _sole_in_ankle(robot: RobotModel) -> tuple[np.ndarray, np.ndarray]:
+def _sole_in_ankle(robot: RobotModel) -> tuple[tuple[float, ...], tuple[float, ...]]:
     """Sole corners about the ankle, counter-clockwise, x (4,) and y (4,) [m], before the side offset of y."""
     half_l, half_w = robot.foot_length / 2, robot.foot_width / 2
-    return (robot.sole_center_x + np.array([-half_l, half_l, half_l, -half_l]),
-            np.array([-half_w, -half_w, half_w, half_w]))
+    x = robot.sole_center_x
+    return (x - half_l, x + half_l, x + half_l, x - half_l), (-half_w, -half_w, half_w, half_w)
 
 
 def foot_corners(pose: Pose2D, foot: int, robot: RobotModel) -> np.ndarray:
     """Sole corners of a foot in world, counter-clockwise, shape (4, 2) [m]."""
     local_x, local_y = _sole_in_ankle(robot)
-    local_y = local_y + foot * robot.sole_center_y
+    offset = foot * robot.sole_center_y
     c, s = math.cos(pose.yaw), math.sin(pose.yaw)
-    return np.column_stack([pose.x + c * local_x - s * local_y, pose.y + s * local_x + c * local_y])
+    return np.array([(pose.x + c * x - s * (y + offset), pose.y + s * x + c * (y + offset))
+                     for x, y in zip(local_x, local_y, strict=True)])
 
 
 def sole_corners(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, foot: np.ndarray, robot: RobotModel) -> np.ndarray:
@@ -211,8 +212,9 @@ def sole_corners(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, foot: np.ndarray
         x, y, yaw: Ankle poses in world [m], [m], [rad], shape (n,).
         foot: +1 left, -1 right, shape (n,).
     """
-    local_x, local_y = _sole_in_ankle(robot)
-    local_y = np.asarray(foot, dtype=float)[:, None] * robot.sole_center_y + local_y
+    corner_x, corner_y = _sole_in_ankle(robot)
+    local_x = np.array(corner_x)
+    local_y = np.asarray(foot, dtype=float)[:, None] * robot.sole_center_y + np.array(corner_y)
     c, s = np.cos(yaw)[:, None], np.sin(yaw)[:, None]
     corners = np.empty((len(x), 4, 2))
     corners[..., 0] = np.asarray(x)[:, None] + c * local_x - s * local_y
@@ -221,13 +223,15 @@ def sole_corners(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, foot: np.ndarray
 
 
 def _rectangles_overlap(a: np.ndarray, b: np.ndarray) -> bool:
-    """Separating-axis test for two convex quadrilaterals."""
-    for polygon in (a, b):
+    """Separating-axis test for two convex quadrilaterals (4, 2) [m]."""
+    pa, pb = a.tolist(), b.tolist()
+    for polygon in (pa, pb):
         for i in range(4):
-            edge = polygon[(i + 1) % 4] - polygon[i]
-            axis = np.array([-edge[1], edge[0]])
-            pa, pb = a @ axis, b @ axis
-            if pa.max() < pb.min() or pb.max() < pa.min():
+            (x0, y0), (x1, y1) = polygon[i], polygon[(i + 1) % 4]
+            nx, ny = y0 - y1, x1 - x0  # normal of the edge
+            on_a = [nx * x + ny * y for x, y in pa]
+            on_b = [nx * x + ny * y for x, y in pb]
+            if max(on_a) < min(on_b) or max(on_b) < min(on_a):
                 return False
     return True
 
