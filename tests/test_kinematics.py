@@ -154,3 +154,34 @@ def test_ready_posture_angles(hubo):
     q = leg_ik_scalar(leg, (0.0, hubo.hip_spacing / 2, -depth + hubo.hip_drop - hubo.hip_drop), 0.0)
     knee = 2 * math.acos(depth / (2 * hubo.thigh_length))
     assert q == pytest.approx((0.0, 0.0, -knee / 2, knee, -knee / 2, 0.0), abs=1e-12)
+
+
+def test_closed_form_joint_rates_equal_the_jacobian_solve_on_random_walks(hubo):
+    """The IK's own time derivative (leg_ik_yaw_rates) against J(q)^-1 twist, and its angles against the
+    rotation-matrix IK (leg_ik), on random walks mixing every mode: 1e-9 rad/s and 1e-9 rad."""
+    rng = np.random.default_rng(21)
+    commands = [StepCommand(duration=float(rng.uniform(0.7, 1.0)), forward=float(rng.uniform(-0.1, 0.25)),
+                            side=float(rng.choice([0.0, 0.05, -0.05])), turn=float(rng.choice([0.0, 0.15, -0.15])))
+                for _ in range(12)]
+    pattern = generate(hubo, commands, rate=500.0)
+    joints = pattern_joint_trajectory(pattern)
+    c, s = np.cos(pattern.yaw_pelvis_in_world), np.sin(pattern.yaw_pelvis_in_world)
+    feet = ((1, pattern.position_left_ankle_in_world, pattern.yaw_left_foot_in_world,
+             pattern.velocity_left_ankle_in_world, pattern.yaw_rate_left_foot),
+            (-1, pattern.position_right_ankle_in_world, pattern.yaw_right_foot_in_world,
+             pattern.velocity_right_ankle_in_world, pattern.yaw_rate_right_foot))
+    for index, (side, position, yaw, velocity, yaw_rate) in enumerate(feet):
+        leg = Leg.of(hubo, side)
+        rel = position - pattern.position_pelvis_in_world
+        v = velocity - pattern.velocity_pelvis_in_world
+        v[:, 0] += pattern.yaw_rate_pelvis * rel[:, 1]
+        v[:, 1] -= pattern.yaw_rate_pelvis * rel[:, 0]
+        n = len(c)
+        twist = np.column_stack([c * v[:, 0] + s * v[:, 1], -s * v[:, 0] + c * v[:, 1], v[:, 2], np.zeros(n),
+                                 np.zeros(n), yaw_rate - pattern.yaw_rate_pelvis])
+        angles = joints.angles[:, 6 * index:6 * index + 6]
+        expected_rates = np.linalg.solve(leg_jacobian(leg, angles), twist[..., None])[..., 0]
+        np.testing.assert_allclose(joints.velocities[:, 6 * index:6 * index + 6], expected_rates, atol=1e-9)
+        ankle = np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1], rel[:, 2]])
+        general = leg_ik(leg, ankle, rot_z(yaw - pattern.yaw_pelvis_in_world)).angles
+        np.testing.assert_allclose(angles, general, atol=ANGLE_TOL)

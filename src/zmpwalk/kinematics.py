@@ -194,6 +194,27 @@ def leg_ik_yaw(leg: Leg, position_ankle_in_pelvis: Array, yaw_foot_in_pelvis: Ar
         yaw_foot_in_pelvis: Foot yaw relative to the pelvis (the hip yaw of the paper's Eq. 21) [rad], (n,).
         knee_forward: Knee branch.
     """
+    return leg_ik_yaw_rates(leg, position_ankle_in_pelvis, yaw_foot_in_pelvis, None, None, knee_forward)[0]
+
+
+def leg_ik_yaw_rates(leg: Leg, position_ankle_in_pelvis: Array, yaw_foot_in_pelvis: Array,
+                     velocity_ankle_in_pelvis: Array | None, yaw_rate_foot_in_pelvis: Array | None,
+                     knee_forward: bool = True) -> tuple[LegSolution, Array | None]:
+    r""":func:`leg_ik_yaw` and, given the ankle's velocity and the foot's yaw rate relative to the pelvis, the
+    joint rates [rad/s] (n, 6) as the time derivative of the same closed form (no linear solve).
+
+    With :math:`r = R_z(\psi)^T (h - p)`, :math:`D = |r|`, :math:`u = \sqrt{r_y^2 + r_z^2}`:
+
+    .. math::
+        \dot r = R_z(\psi)^T (-\dot p) + \dot\psi\,(r_y, -r_x, 0), \quad
+        \dot q_4 = -rac{D \dot D}{a b \sin q_4}, \quad
+        \dot q_6 = rac{r_z \dot r_y - r_y \dot r_z}{u^2}, \quad
+        \dot q_3 = -(\dot q_4 + \dot q_5)
+
+    and :math:`\dot q_5, \dot q_1, \dot q_2` from the derivative of ``atan2(y, x)``,
+    :math:`(x \dot y - y \dot x) / (x^2 + y^2)`, of their own arguments. This equals
+    :math:`J^{-1}` times the ankle twist wherever the leg is not stretched (``tests/test_kinematics.py``).
+    """
     p = np.atleast_2d(position_ankle_in_pelvis)
     c, s = np.cos(yaw_foot_in_pelvis), np.sin(yaw_foot_in_pelvis)
     dx, dy, dz = leg.hip[0] - p[:, 0], leg.hip[1] - p[:, 1], leg.hip[2] - p[:, 2]
@@ -201,20 +222,51 @@ def leg_ik_yaw(leg: Leg, position_ankle_in_pelvis: Array, yaw_foot_in_pelvis: Ar
     a, b = leg.thigh, leg.shank
     distance = np.sqrt(rx * rx + ry * ry + rz * rz)
     excess = np.maximum(distance - (a + b), abs(a - b) - distance)
-    q4 = np.arccos(np.clip((distance * distance - a * a - b * b) / (2 * a * b), -1.0, 1.0))
+    cos4 = np.clip((distance * distance - a * a - b * b) / (2 * a * b), -1.0, 1.0)
+    q4 = np.arccos(cos4)
+    sin4 = np.sqrt(1.0 - cos4 * cos4)  # sin(arccos k) without trigonometry
     if not knee_forward:
-        q4 = -q4
+        q4, sin4 = -q4, -sin4
     q6 = np.arctan2(ry, rz)
     u_z = np.hypot(ry, rz)
-    q5 = np.arctan2(-a * np.sin(q4), a * np.cos(q4) + b) - np.arctan2(rx, u_z)
+    big_y, big_x = -a * sin4, a * cos4 + b
+    q5 = np.arctan2(big_y, big_x) - np.arctan2(rx, u_z)
     pitch = -(q4 + q5)
-    cp, sp = np.cos(pitch), np.sin(pitch)
     c6, s6 = rz / u_z, -ry / u_z  # cos(-q6), sin(-q6) without trigonometry: q6 = atan2(ry, rz)
     m01, m11 = -s * c6, c * c6
     q1 = np.arctan2(-m01, m11)
-    q2 = np.arctan2(s6, np.hypot(m01, m11))
-    q3 = np.arctan2(c6 * sp, c6 * cp)
-    return LegSolution(np.stack([q1, q2, q3, q4, q5, q6], axis=1), excess)
+    h = np.hypot(m01, m11)
+    q2 = np.arctan2(s6, h)
+    # q3 = atan2(c6 sin(pitch), c6 cos(pitch)): the pitch itself wherever the ankle is below the hip (c6 > 0)
+    q3 = pitch.copy()
+    odd = (c6 <= 0.0) | (np.abs(pitch) >= np.pi)
+    if np.any(odd):
+        q3[odd] = np.arctan2(c6[odd] * np.sin(pitch[odd]), c6[odd] * np.cos(pitch[odd]))
+    solution = LegSolution(np.stack([q1, q2, q3, q4, q5, q6], axis=1), excess)
+    if velocity_ankle_in_pelvis is None or yaw_rate_foot_in_pelvis is None:
+        return solution, None
+    v = np.atleast_2d(velocity_ankle_in_pelvis)
+    w = yaw_rate_foot_in_pelvis
+    drx = -(c * v[:, 0] + s * v[:, 1]) + w * ry
+    dry = -(c * v[:, 1] - s * v[:, 0]) - w * rx
+    drz = -v[:, 2]
+    d_distance = (rx * drx + ry * dry + rz * drz) / distance
+    with np.errstate(divide="ignore", invalid="ignore"):  # a stretched leg has no joint rates (J singular)
+        dq4 = -distance * d_distance / (a * b * sin4)
+    du = (ry * dry + rz * drz) / u_z
+    dq6 = (rz * dry - ry * drz) / (u_z * u_z)
+    d_big_y, d_big_x = -a * cos4 * dq4, -a * sin4 * dq4
+    dq5 = ((big_x * d_big_y - big_y * d_big_x) / (big_x * big_x + big_y * big_y)
+           - (u_z * drx - rx * du) / (rx * rx + u_z * u_z))
+    dc6 = (drz * u_z - rz * du) / (u_z * u_z)
+    ds6 = -(dry * u_z - ry * du) / (u_z * u_z)
+    dm01 = -(c * w * c6 + s * dc6)
+    dm11 = -s * w * c6 + c * dc6
+    dq1 = (m11 * -dm01 + m01 * dm11) / (m01 * m01 + m11 * m11)
+    dh = (m01 * dm01 + m11 * dm11) / h
+    dq2 = (h * ds6 - s6 * dh) / (s6 * s6 + h * h)
+    dq3 = -(dq4 + dq5)
+    return solution, np.stack([dq1, dq2, dq3, dq4, dq5, dq6], axis=1)
 
 
 def leg_ik_scalar(leg: Leg, ankle: tuple[float, float, float], foot_yaw: float,
@@ -412,22 +464,23 @@ def joint_trajectory(
                                  np.zeros(n), np.zeros(n), yaw_rate - yaw_rate_pelvis])
         label = "left" if side > 0 else "right"
         if robot.legs is None:
-            leg = Leg.of(robot, side)
-            solution = leg_ik_yaw(leg, ankle_in_pelvis, yaw - yaw_pelvis_in_world, knee_forward)
+            # closed form: the joint rates are the time derivative of the IK, no linear solve
+            solution, rates = leg_ik_yaw_rates(Leg.of(robot, side), ankle_in_pelvis, yaw - yaw_pelvis_in_world,
+                                               twist[:, :3], twist[:, 5], knee_forward)
             leg_angles, excess = solution.angles, solution.excess
-            jacobian = leg_jacobian(leg, leg_angles)
             order = list(range(6))
             detail = "inverse kinematics"
         else:
             chain = robot.legs[index]
             leg_angles, excess = solutions[index]
-            jacobian = chain.jacobian(leg_angles)
             order = list(chain.role_order)
             detail = "inverse kinematics, " + ("closed form" if chain.closed_form else "numeric")
+            rates = None
         if np.any(excess > 0):
             first = int(np.argmax(excess > 0))
             raise UnreachableError(label, float(time[first]), float(excess.max()), detail)
-        rates = np.linalg.solve(jacobian, twist[..., None])[..., 0]
+        if rates is None:  # an imported leg: J q' = twist
+            rates = np.linalg.solve(robot.legs[index].jacobian(leg_angles), twist[..., None])[..., 0]  # type: ignore[index]
         angles[:, 6 * index:6 * index + 6] = leg_angles[:, order]
         velocities[:, 6 * index:6 * index + 6] = rates[:, order]
     if check_limits:
