@@ -185,3 +185,30 @@ def test_closed_form_joint_rates_equal_the_jacobian_solve_on_random_walks(hubo):
         ankle = np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1], rel[:, 2]])
         general = leg_ik(leg, ankle, rot_z(yaw - pattern.yaw_pelvis_in_world)).angles
         np.testing.assert_allclose(angles, general, atol=ANGLE_TOL)
+
+
+def test_flat_foot_ik_and_rates_everywhere_in_reach_ankle_above_the_hip_included(hubo):
+    """leg_ik_yaw_rates against the rotation-matrix IK and J^-1 twist on random reachable targets all around the
+    hip (above it too, where q1 and q3 turn by pi), random foot yaws up to +-3 rad and random twists."""
+    from zmpwalk.kinematics import leg_ik_yaw_rates
+
+    rng = np.random.default_rng(33)
+    leg = Leg.of(hubo, 1)
+    n = 2000
+    direction = rng.normal(size=(n, 3))
+    direction /= np.linalg.norm(direction, axis=1)[:, None]
+    targets = np.asarray(leg.hip) + direction * rng.uniform(0.1, 0.58, n)[:, None]  # reach 0.6 m
+    yaw = rng.uniform(-3.0, 3.0, n)
+    velocity, yaw_rate = rng.normal(size=(n, 3)), rng.normal(size=n)
+    solution, rates = leg_ik_yaw_rates(leg, targets, yaw, velocity, yaw_rate)
+    assert np.any(targets[:, 2] > leg.hip[2])  # the ankle above the hip occurs
+    general = leg_ik(leg, targets, rot_z(yaw)).angles
+    np.testing.assert_allclose(solution.angles, general, atol=ANGLE_TOL)
+    position, rotation = leg_fk(leg, solution.angles)
+    np.testing.assert_allclose(position, targets, atol=POSITION_TOL)
+    np.testing.assert_allclose(rotation, rot_z(yaw), atol=ANGLE_TOL)
+    twist = np.column_stack([velocity, np.zeros(n), np.zeros(n), yaw_rate])
+    jacobian = leg_jacobian(leg, solution.angles)
+    well_posed = np.linalg.cond(jacobian) < 1e4  # away from the stretched and folded leg
+    expected = np.linalg.solve(jacobian[well_posed], twist[well_posed][..., None])[..., 0]
+    np.testing.assert_allclose(rates[well_posed], expected, rtol=1e-7, atol=1e-7)  # [rad/s]

@@ -207,8 +207,8 @@ def leg_ik_yaw_rates(leg: Leg, position_ankle_in_pelvis: Array, yaw_foot_in_pelv
 
     .. math::
         \dot r = R_z(\psi)^T (-\dot p) + \dot\psi\,(r_y, -r_x, 0), \quad
-        \dot q_4 = -rac{D \dot D}{a b \sin q_4}, \quad
-        \dot q_6 = rac{r_z \dot r_y - r_y \dot r_z}{u^2}, \quad
+        \dot q_4 = -\frac{D \dot D}{a b \sin q_4}, \quad
+        \dot q_6 = \frac{r_z \dot r_y - r_y \dot r_z}{u^2}, \quad
         \dot q_3 = -(\dot q_4 + \dot q_5)
 
     and :math:`\dot q_5, \dot q_1, \dot q_2` from the derivative of ``atan2(y, x)``,
@@ -216,8 +216,26 @@ def leg_ik_yaw_rates(leg: Leg, position_ankle_in_pelvis: Array, yaw_foot_in_pelv
     :math:`J^{-1}` times the ankle twist wherever the leg is not stretched (``tests/test_kinematics.py``).
     """
     p = np.atleast_2d(position_ankle_in_pelvis)
-    c, s = np.cos(yaw_foot_in_pelvis), np.sin(yaw_foot_in_pelvis)
-    dx, dy, dz = leg.hip[0] - p[:, 0], leg.hip[1] - p[:, 1], leg.hip[2] - p[:, 2]
+    n = len(p)
+    angles = np.empty((6, n))
+    rates: Array | None = None
+    velocity: tuple[Array, Array, Array, Array] | None = None
+    if velocity_ankle_in_pelvis is not None and yaw_rate_foot_in_pelvis is not None:
+        rates = np.empty((6, n))
+        v = np.atleast_2d(velocity_ankle_in_pelvis)
+        velocity = (v[:, 0], v[:, 1], v[:, 2], np.asarray(yaw_rate_foot_in_pelvis))
+    excess = _leg_ik_yaw_rates(leg, p[:, 0], p[:, 1], p[:, 2], np.asarray(yaw_foot_in_pelvis), velocity,
+                               knee_forward, angles, rates)
+    return LegSolution(angles.T, excess), (None if rates is None else rates.T)
+
+
+def _leg_ik_yaw_rates(leg: Leg, px: Array, py: Array, pz: Array, yaw: Array,
+                      velocity: tuple[Array, Array, Array, Array] | None, knee_forward: bool,
+                      angles: Array, rates: Array | None) -> Array:
+    """:func:`leg_ik_yaw_rates` on component arrays (n,), writing the rows of ``angles`` and ``rates`` (6, n);
+    returns the reach excess [m] (n,)."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    dx, dy, dz = leg.hip[0] - px, leg.hip[1] - py, leg.hip[2] - pz
     rx, ry, rz = c * dx + s * dy, c * dy - s * dx, dz
     a, b = leg.thigh, leg.shank
     distance = np.sqrt(rx * rx + ry * ry + rz * rz)
@@ -228,45 +246,42 @@ def leg_ik_yaw_rates(leg: Leg, position_ankle_in_pelvis: Array, yaw_foot_in_pelv
     if not knee_forward:
         q4, sin4 = -q4, -sin4
     q6 = np.arctan2(ry, rz)
-    u_z = np.hypot(ry, rz)
+    u_squared = ry * ry + rz * rz
+    u_z = np.sqrt(u_squared)
     big_y, big_x = -a * sin4, a * cos4 + b
     q5 = np.arctan2(big_y, big_x) - np.arctan2(rx, u_z)
-    pitch = -(q4 + q5)
-    c6, s6 = rz / u_z, -ry / u_z  # cos(-q6), sin(-q6) without trigonometry: q6 = atan2(ry, rz)
-    m01, m11 = -s * c6, c * c6
-    q1 = np.arctan2(-m01, m11)
-    h = np.hypot(m01, m11)
-    q2 = np.arctan2(s6, h)
-    # q3 = atan2(c6 sin(pitch), c6 cos(pitch)): the pitch itself wherever the ankle is below the hip (c6 > 0)
-    q3 = pitch.copy()
-    odd = (c6 <= 0.0) | (np.abs(pitch) >= np.pi)
-    if np.any(odd):
-        q3[odd] = np.arctan2(c6[odd] * np.sin(pitch[odd]), c6[odd] * np.cos(pitch[odd]))
-    solution = LegSolution(np.stack([q1, q2, q3, q4, q5, q6], axis=1), excess)
-    if velocity_ankle_in_pelvis is None or yaw_rate_foot_in_pelvis is None:
-        return solution, None
-    v = np.atleast_2d(velocity_ankle_in_pelvis)
-    w = yaw_rate_foot_in_pelvis
-    drx = -(c * v[:, 0] + s * v[:, 1]) + w * ry
-    dry = -(c * v[:, 1] - s * v[:, 0]) - w * rx
-    drz = -v[:, 2]
+    # The hip rotation Rz(q1) Rx(q2) Ry(q3) = Rz(yaw) Rx(-q6) Ry(-(q4 + q5)) of a flat foot, in closed form
+    # (Eq. 2 of Lim et al.): with the ankle below the hip (r_z > 0) q1 = yaw, q2 = -q6, q3 = -(q4 + q5);
+    # above it (r_z < 0, not a walking posture) both q1 and q3 turn by pi and q2 = atan2(-r_y, |r_z|).
+    flipped = rz < 0.0
+    q1, q2, q3 = yaw.copy(), -q6, -(q4 + q5)
+    if np.any(flipped):
+        q1, q3 = q1 + np.pi * flipped, q3 + np.pi * flipped
+        q2 = np.where(flipped, np.arctan2(-ry, -rz), q2)
+    for angle in (q1, q3):  # into (-pi, pi], as atan2 returns them
+        outside = np.abs(angle) > np.pi
+        if np.any(outside):
+            angle[outside] = np.arctan2(np.sin(angle[outside]), np.cos(angle[outside]))
+    angles[0], angles[1], angles[2], angles[3], angles[4], angles[5] = q1, q2, q3, q4, q5, q6
+    if velocity is None or rates is None:
+        return excess
+    vx, vy, vz, w = velocity
+    drx = -(c * vx + s * vy) + w * ry
+    dry = -(c * vy - s * vx) - w * rx
+    drz = -vz
     d_distance = (rx * drx + ry * dry + rz * drz) / distance
     with np.errstate(divide="ignore", invalid="ignore"):  # a stretched leg has no joint rates (J singular)
         dq4 = -distance * d_distance / (a * b * sin4)
     du = (ry * dry + rz * drz) / u_z
-    dq6 = (rz * dry - ry * drz) / (u_z * u_z)
+    dq6 = (rz * dry - ry * drz) / u_squared
     d_big_y, d_big_x = -a * cos4 * dq4, -a * sin4 * dq4
     dq5 = ((big_x * d_big_y - big_y * d_big_x) / (big_x * big_x + big_y * big_y)
-           - (u_z * drx - rx * du) / (rx * rx + u_z * u_z))
-    dc6 = (drz * u_z - rz * du) / (u_z * u_z)
-    ds6 = -(dry * u_z - ry * du) / (u_z * u_z)
-    dm01 = -(c * w * c6 + s * dc6)
-    dm11 = -s * w * c6 + c * dc6
-    dq1 = (m11 * -dm01 + m01 * dm11) / (m01 * m01 + m11 * m11)
-    dh = (m01 * dm01 + m11 * dm11) / h
-    dq2 = (h * ds6 - s6 * dh) / (s6 * s6 + h * h)
+           - (u_z * drx - rx * du) / (rx * rx + u_squared))
+    dq1 = w
+    dq2 = np.where(flipped, dq6, -dq6)
     dq3 = -(dq4 + dq5)
-    return solution, np.stack([dq1, dq2, dq3, dq4, dq5, dq6], axis=1)
+    rates[0], rates[1], rates[2], rates[3], rates[4], rates[5] = dq1, dq2, dq3, dq4, dq5, dq6
+    return excess
 
 
 def leg_ik_scalar(leg: Leg, ankle: tuple[float, float, float], foot_yaw: float,
@@ -441,8 +456,7 @@ def joint_trajectory(
     """
     n = len(time)
     c, s = np.cos(yaw_pelvis_in_world), np.sin(yaw_pelvis_in_world)
-    angles = np.empty((n, 12))
-    velocities = np.empty((n, 12))
+    angles, velocities = np.empty((n, 12)), np.empty((n, 12))
     base: Array | None = None
     solutions: list[tuple[Array, Array]] = []
     if robot.legs is not None:
@@ -453,39 +467,46 @@ def joint_trajectory(
             velocity_pelvis_in_world = velocity_pelvis_in_world + np.gradient(base - position_pelvis_in_world,
                                                                               time, axis=0)
         position_pelvis_in_world = base
-    for index, (side, (position, yaw, velocity, yaw_rate)) in enumerate(zip((1, -1), feet, strict=True)):
-        rel = position - position_pelvis_in_world
-        ankle_in_pelvis = np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1], rel[:, 2]])
-        # Relative velocity of the ankle in the (rotating) pelvis frame.
-        v = velocity - velocity_pelvis_in_world
-        v[:, 0] += yaw_rate_pelvis * rel[:, 1]
-        v[:, 1] -= yaw_rate_pelvis * rel[:, 0]
-        twist = np.column_stack([c * v[:, 0] + s * v[:, 1], -s * v[:, 0] + c * v[:, 1], v[:, 2],
-                                 np.zeros(n), np.zeros(n), yaw_rate - yaw_rate_pelvis])
-        label = "left" if side > 0 else "right"
-        if robot.legs is None:
-            # closed form: the joint rates are the time derivative of the IK, no linear solve
-            solution, rates = leg_ik_yaw_rates(Leg.of(robot, side), ankle_in_pelvis, yaw - yaw_pelvis_in_world,
-                                               twist[:, :3], twist[:, 5], knee_forward)
-            leg_angles, excess = solution.angles, solution.excess
-            order = list(range(6))
-            detail = "inverse kinematics"
-        else:
+    if robot.legs is None:  # closed form, written row by row into (12, n) and returned transposed
+        rows_angles, rows_rates = np.empty((12, n)), np.empty((12, n))
+        for index, (side, (position, yaw, velocity, yaw_rate)) in enumerate(zip((1, -1), feet, strict=True)):
+            rx, ry = position[:, 0] - position_pelvis_in_world[:, 0], position[:, 1] - position_pelvis_in_world[:, 1]
+            vx = velocity[:, 0] - velocity_pelvis_in_world[:, 0] + yaw_rate_pelvis * ry  # in the rotating frame
+            vy = velocity[:, 1] - velocity_pelvis_in_world[:, 1] - yaw_rate_pelvis * rx
+            rows = slice(6 * index, 6 * index + 6)
+            excess = _leg_ik_yaw_rates(
+                Leg.of(robot, side), c * rx + s * ry, c * ry - s * rx, position[:, 2] - position_pelvis_in_world[:, 2],
+                yaw - yaw_pelvis_in_world,
+                (c * vx + s * vy, c * vy - s * vx, velocity[:, 2] - velocity_pelvis_in_world[:, 2],
+                 yaw_rate - yaw_rate_pelvis),
+                knee_forward, rows_angles[rows], rows_rates[rows])
+            _check_reach(excess, time, "left" if side > 0 else "right", "inverse kinematics")
+        angles, velocities = rows_angles.T, rows_rates.T
+    else:  # an imported robot's legs: angles from _base_under_com, rates from J q' = twist
+        for index, (side, (position, _, velocity, yaw_rate)) in enumerate(zip((1, -1), feet, strict=True)):
+            rel = position - position_pelvis_in_world
+            v = velocity - velocity_pelvis_in_world  # relative velocity in the (rotating) pelvis frame
+            v[:, 0] += yaw_rate_pelvis * rel[:, 1]
+            v[:, 1] -= yaw_rate_pelvis * rel[:, 0]
+            twist = np.column_stack([c * v[:, 0] + s * v[:, 1], -s * v[:, 0] + c * v[:, 1], v[:, 2],
+                                     np.zeros(n), np.zeros(n), yaw_rate - yaw_rate_pelvis])
             chain = robot.legs[index]
             leg_angles, excess = solutions[index]
+            _check_reach(excess, time, "left" if side > 0 else "right",
+                         "inverse kinematics, " + ("closed form" if chain.closed_form else "numeric"))
+            rates = np.linalg.solve(chain.jacobian(leg_angles), twist[..., None])[..., 0]
             order = list(chain.role_order)
-            detail = "inverse kinematics, " + ("closed form" if chain.closed_form else "numeric")
-            rates = None
-        if np.any(excess > 0):
-            first = int(np.argmax(excess > 0))
-            raise UnreachableError(label, float(time[first]), float(excess.max()), detail)
-        if rates is None:  # an imported leg: J q' = twist
-            rates = np.linalg.solve(robot.legs[index].jacobian(leg_angles), twist[..., None])[..., 0]  # type: ignore[index]
-        angles[:, 6 * index:6 * index + 6] = leg_angles[:, order]
-        velocities[:, 6 * index:6 * index + 6] = rates[:, order]
+            angles[:, 6 * index:6 * index + 6] = leg_angles[:, order]
+            velocities[:, 6 * index:6 * index + 6] = rates[:, order]
     if check_limits:
         check_joint_limits(time, angles, robot)
     return JointTrajectory(time, angles, velocities, position_base_in_world=base)
+
+
+def _check_reach(excess: Array, time: Array, label: str, detail: str) -> None:
+    if np.any(excess > 0):
+        first = int(np.argmax(excess > 0))
+        raise UnreachableError(label, float(time[first]), float(excess.max()), detail)
 
 
 COM_TOLERANCE = 1e-6  # [m] the base is placed until the whole-body CoM is this close to the pattern's
