@@ -32,22 +32,34 @@ def tick_times(rate: float, seconds: float) -> np.ndarray:
     return np.array(durations) / 1e3  # [us]
 
 
-def control_loop(rate: float, walks: int, joints: bool) -> tuple[np.ndarray, np.ndarray]:
-    """What a robot's loop sees: every tick timed, each walk started from standstill by a command issued
-    inside the loop (timed as part of its tick) and left to stop by itself (automatic stop, standing).
-    Returns the loop iterations' and the commands' times [us]."""
+def control_loop(rate: float, seconds: float, joints: bool, use_submit: bool) -> tuple[np.ndarray, np.ndarray]:
+    """What a robot's loop sees: every iteration timed (tick plus any command given in it). Walks of five
+    steps, each step commanded in the loop as the one before it starts (the first from standstill), then
+    the automatic stop and 1 s of standing. Returns the iterations' and the commands' times [us]."""
     walker = OnlineWalker(load_robot("hubo"), rate=rate, joints=joints)
-    period = round(4.0 * rate)  # 4 s per walk: start, one step, the automatic stop, standing
+    steps = [StepCommand(0.8, 0.2), StepCommand(0.8, 0.1, turn=0.1), StepCommand(0.8, side=0.05),
+             StepCommand(0.7, 0.15), StepCommand(0.95, 0.1)]
+    give = walker.submit if use_submit else walker.command
     iterations, commands = [], []
-    for _ in range(walks):
-        for k in range(period):
-            start = time.perf_counter()
-            if k == 0:
-                walker.command(StepCommand(0.8, 0.2))
-                commands.append(time.perf_counter() - start)
-            walker.tick()
-            iterations.append(time.perf_counter() - start)
+    given, standing = 0, 0
+    for _ in range(round(seconds * rate)):
+        start = time.perf_counter()
+        if given < len(steps) and walker.queued is None and walker.checking is None and not standing:
+            give(steps[given])
+            commands.append(time.perf_counter() - start)
+            given += 1
+        walker.tick()
+        iterations.append(time.perf_counter() - start)
+        if given == len(steps) and not walker.walking and walker.checking is None:
+            standing += 1
+            if standing >= rate:  # 1 s standing, then the next walk
+                given, standing = 0, 0
     return np.array(iterations) * 1e6, np.array(commands) * 1e6
+
+
+def _figures(us: np.ndarray) -> str:
+    return (f"median {np.median(us):6.2f} us, p99 {np.percentile(us, 99):7.1f} us, p99.9 "
+            f"{np.percentile(us, 99.9):7.1f} us, max {us.max():8.1f} us, over 1 ms: {(us > 1000).sum()} of {len(us)}")
 
 
 def main() -> None:
@@ -80,15 +92,14 @@ def main() -> None:
         command_times.append(time.perf_counter() - start)
     print(f"OnlineWalker.command() at 1 kHz (plan + sample one step): median "
           f"{statistics.median(command_times) * 1e3:.2f} ms")
-    print("Control loop at 1 kHz with joints, every iteration timed (first commands from standstill and "
-          "automatic stops included)")
-    loop, firsts = control_loop(1000.0, 6, True)
-    ticks = np.delete(loop, np.arange(0, len(loop), 4000))  # the iterations without a command
-    print(f"  ticks alone: median {np.median(ticks):.1f} us, p99 {np.percentile(ticks, 99):.1f} us, p99.9 "
-          f"{np.percentile(ticks, 99.9):.1f} us, max {ticks.max():.1f} us, over 1 ms: {(ticks > 1000).sum()} "
-          f"of {len(ticks)}")
-    print(f"  iterations with a first command: median {np.median(firsts) / 1e3:.2f} ms, max "
-          f"{firsts.max() / 1e3:.2f} ms ({len(firsts)} of {len(loop)}; over 1 ms: {(loop > 1000).sum()})")
+    print("Control loop at 1 kHz with joints, 60 s, every iteration timed (commands given inside the loop, "
+          "first commands from standstill and automatic stops included)")
+    for use_submit in (True, False):
+        loop, given = control_loop(1000.0, 60.0, True, use_submit)
+        name = "submit()" if use_submit else "command()"
+        print(f"  with {name:9}: iterations {_figures(loop)}")
+        print(f"  {'':15}{name} alone: median {np.median(given):.1f} us, max {given.max():.1f} us "
+              f"({len(given)} commands)")
 
 
 if __name__ == "__main__":

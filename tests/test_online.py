@@ -10,6 +10,7 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from zmpwalk import (
+    InfeasibleCommandError,
     InvalidParameterError,
     OnlineWalker,  # the public API: from zmpwalk import OnlineWalker, StepCommand, load_robot
     StepCommand,
@@ -245,3 +246,79 @@ def test_hostile_commands_are_rejected_by_command_never_by_tick(hubo, joints, ac
         event("accepted")
         reference.command(command)
     assert not walker.walking  # every accepted walk ended standing
+
+
+# --------------------------------------------------------------------- submit(): the check in slices
+
+def _sample_row(sample):
+    return np.concatenate([_rows(sample), sample.joint_angles, sample.joint_velocities])
+
+
+@pytest.mark.parametrize("rate", [100.0, 1000.0])
+def test_submitted_commands_give_the_same_walk_as_commands(hubo, rate):
+    """submit() (checked one slice per tick) against command() (checked at once): sample for sample, joint
+    angles and rates included; the walk from standstill starts START_DELAY later, as documented."""
+    from zmpwalk.online import START_DELAY
+
+    commands = [StepCommand(0.8, 0.2), StepCommand(0.7, 0.1, turn=0.1), StepCommand(0.8, side=0.05),
+                StepCommand(0.95, -0.1)]
+    delay = round(START_DELAY * rate)
+    direct, sliced = OnlineWalker(hubo, rate=rate, joints=True), OnlineWalker(hubo, rate=rate, joints=True)
+    sliced.submit(commands[0])
+    for _ in range(delay):
+        direct.tick(), sliced.tick()
+    direct.command(commands[0])
+    pending = commands[1:]
+    direct_rows, sliced_rows = [], []
+    for tick in range(round(9.0 * rate)):
+        if pending and direct.queued is None and tick % 7 == 3:  # a command soon after each step starts
+            direct.command(pending[0])
+            sliced.submit(pending.pop(0))
+        direct_rows.append(_sample_row(direct.tick()))
+        sliced_rows.append(_sample_row(sliced.tick()))
+    np.testing.assert_array_equal(np.array(sliced_rows), np.array(direct_rows))
+    assert not direct.walking and not sliced.walking and sliced.rejection is None
+
+
+def test_a_submitted_command_that_fails_its_check_is_kept_as_the_rejection_and_changes_nothing(hubo):
+    reference, walker = OnlineWalker(hubo, rate=1000, joints=True), OnlineWalker(hubo, rate=1000, joints=True)
+    reference.command(StepCommand(0.8, 0.1))
+    walker.command(StepCommand(0.8, 0.1))
+    for tick in range(4000):
+        if tick == 100:
+            walker.submit(StepCommand(1.0, 0.3, foot_lift=0.15))  # its stop leaves the ankle pitch range
+            assert walker.checking is not None
+        np.testing.assert_array_equal(_sample_row(walker.tick()), _sample_row(reference.tick()))
+    error = walker.rejection
+    assert isinstance(error, InfeasibleCommandError) and error.parameter == "forward"
+    assert "closing step" in str(error) and "ankle_pitch" in str(error) and error.largest["forward"] < 0.3
+    assert walker.checking is None and not walker.walking
+
+
+def test_a_command_submitted_in_the_last_tick_of_a_step_is_still_taken(hubo):
+    walker = OnlineWalker(hubo, rate=1000, joints=True)
+    walker.command(StepCommand(0.8, 0.1))
+    while walker.queued is not None or walker._current is None:  # the first step under way
+        walker.tick()
+    current = walker._current
+    while walker._index < current.first_index + len(current.rows) - 1:
+        walker.tick()
+    walker.submit(StepCommand(0.8, 0.15))  # one tick before its step begins: checked in that tick
+    walker.tick()
+    walker.tick()
+    assert walker._current.command == StepCommand(0.8, 0.15) and walker.rejection is None
+
+
+def test_stop_while_walking_takes_the_stop_planned_with_the_step(hubo):
+    walker = OnlineWalker(hubo, rate=200)
+    walker.command(StepCommand(0.8, 0.2))
+    for _ in range(300):
+        walker.tick()
+    walker.command(StepCommand(0.8, 0.2))
+    walker.stop()  # replaces the queued step with the stop of the step under way
+    assert walker.queued is not None and walker.queued.stop
+    for _ in range(2000):
+        sample = walker.tick()
+    assert not walker.walking
+    np.testing.assert_allclose(sample.position_left_ankle_in_world[0], sample.position_right_ankle_in_world[0],
+                               atol=1e-12)  # feet side by side

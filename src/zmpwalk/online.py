@@ -27,11 +27,24 @@ Behaviour:
   infeasible is rejected, so no accepted command makes a later tick fail.
 * The trajectories of a command (and of its stop) are sampled when the command
   is queued, so a :meth:`~OnlineWalker.tick` only reads a row.
+
+**Inside a hard real-time loop** use :meth:`OnlineWalker.submit` instead of
+:meth:`~OnlineWalker.command`: it only stores the command (microseconds), and
+the same whole check (the step and its stop, every sample at the control rate)
+runs in slices of :data:`SLICE_ROWS` samples, one slice per tick, while the
+step under way goes on. The command is queued when its check completes, or its
+rejection is kept in :attr:`OnlineWalker.rejection` (no tick ever raises). A
+walk submitted from standstill starts :data:`START_DELAY` later, by which time
+it is checked. Should a step end before the check of the next command is done
+(a command submitted in the last ticks of a step), the rest of the check runs in
+that tick. :meth:`OnlineWalker.stop` costs nothing while walking: the stop of the
+step under way was planned with it.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Generator
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -46,6 +59,7 @@ from zmpwalk.patterns.polynomial import (
     Samples,
     Stage,
     StageTable,
+    check_reach,
     closing_command,
     evaluate,
     infeasible_command,
@@ -66,6 +80,8 @@ _JOINTS, _JOINT_RATES = slice(15, 27), slice(27, 39)
 _WIDTH = 15
 _WIDTH_WITH_JOINTS = 39
 _EPS = 1e-9
+SLICE_ROWS = 100  # samples planned per tick by submit()'s check (one vectorised pass, about 0.5 ms)
+START_DELAY = 0.1  # [s] a walk submitted from standstill starts this much later (its check is done by then)
 HINT_RATE = 100.0  # [Hz] sampling of the search for the largest stride that fits, in a rejection
 HINT_CONFIRMATIONS = 5  # tries at the control rate, each HINT_SHRINK smaller
 HINT_SHRINK = 0.98
@@ -113,6 +129,39 @@ class _Plan:
     standing: Array | None = None  # the row of standing still after it, where it ends at rest
 
 
+@dataclass
+class _Job:
+    """A submitted command under check: where it starts and its planning, one slice per tick."""
+
+    command: StepCommand
+    stance: Stance
+    boundary: Boundary
+    start: int  # index of the tick at which its step begins
+    planning: Generator[None, None, _Plan | None]
+
+
+_UNFINISHED = object()
+
+
+def _step(planning: Generator[None, None, _Plan | None]) -> object:
+    """One slice of a planning; its result when done, else :data:`_UNFINISHED`."""
+    try:
+        next(planning)
+    except StopIteration as done:
+        return done.value
+    return _UNFINISHED
+
+
+def _finish(planning: Generator[None, None, _Plan | None]) -> _Plan | None:
+    """Run a planning to its end."""
+    while True:
+        try:
+            next(planning)
+        except StopIteration as done:
+            result: _Plan | None = done.value
+            return result
+
+
 class OnlineWalker:
     """Step-by-step generator of the HUBO pattern for a control loop.
 
@@ -138,7 +187,8 @@ class OnlineWalker:
         self._boundary = Boundary(0.0)
         self._current: _Plan | None = None
         self._pending: _Plan | None = None
-        self._last_command = StepCommand(duration=0.8)
+        self._job: _Job | None = None
+        self._rejection: tuple[StepCommand, ZmpwalkError, Stance, Boundary] | None = None
         self._standing = self._standing_row(self._stance)
 
     @property
@@ -169,21 +219,76 @@ class OnlineWalker:
         if boundary.at_rest:
             boundary = Boundary(max(boundary.time, self.time))
         try:
-            plan = self._checked(command, stance, boundary, self.rate)
+            plan = _finish(self._checked(command, stance, boundary, self.rate))
         except (UnreachableError, JointLimitError) as error:
             raise self._infeasible(command, stance, boundary, error) from None
-        if plan is None:  # a stop while standing
-            self._pending = None
-            return
-        self._pending = plan
+        self._job = None  # a command given now supersedes one still being checked
+        self._pending = plan  # None: a stop while standing
 
-    def _checked(self, command: StepCommand, stance: Stance, boundary: Boundary, rate: float) -> _Plan | None:
-        """:meth:`_plan` of a command and of the stop it leads to when no other follows: planned and checked
-        together, so that no accepted command can make a later tick fail, and no tick plans."""
-        plan = self._plan(command, stance, boundary, rate)
+    def submit(self, command: StepCommand) -> None:
+        """Queue ``command`` like :meth:`command`, without planning in the caller's tick.
+
+        Only the command's type is checked here; its whole check runs one slice per :meth:`tick`
+        (module docstring). When it completes the command is :attr:`queued`; when it fails the
+        error is in :attr:`rejection` and the walker goes on as if the command had not been given.
+        A later :meth:`submit` or :meth:`command` replaces one still being checked.
+
+        Raises:
+            InvalidParameterError: ``command`` is not a :class:`StepCommand`.
+        """
+        if not isinstance(command, StepCommand):
+            raise InvalidParameterError("command", command, "a StepCommand")
+        stance, boundary = self._stance, self._boundary
+        if boundary.at_rest:
+            boundary = Boundary(max(boundary.time, self.time + START_DELAY))
+        start = math.ceil(boundary.time * self.rate - _EPS)
+        self._job = _Job(command, stance, boundary, start,
+                         self._checked(command, stance, boundary, self.rate, sliced=True))
+
+    @property
+    def checking(self) -> StepCommand | None:
+        """The submitted command whose check is under way, if any."""
+        return self._job.command if self._job is not None else None
+
+    @property
+    def rejection(self) -> ZmpwalkError | None:
+        """Why the last submitted command was rejected (None: no rejection since the last submit),
+        with the largest stride that fits where the legs are the cause (computed when read)."""
+        if self._rejection is None:
+            return None
+        command, error, stance, boundary = self._rejection
+        if isinstance(error, (UnreachableError, JointLimitError)):
+            error = self._infeasible(command, stance, boundary, error)
+            self._rejection = (command, error, stance, boundary)
+        return error
+
+    def _work(self, finish: bool) -> None:
+        """One slice of the submitted command's check (all of it when ``finish``)."""
+        job = self._job
+        if job is None:
+            return
+        try:
+            plan = _finish(job.planning) if finish else _step(job.planning)
+        except ZmpwalkError as error:
+            self._job = None
+            self._rejection = (job.command, error, job.stance, job.boundary)
+            return
+        if plan is _UNFINISHED:
+            return
+        self._job = None
+        self._rejection = None
+        self._pending = plan if isinstance(plan, _Plan) else None
+
+    def _checked(self, command: StepCommand, stance: Stance, boundary: Boundary, rate: float,
+                 sliced: bool = False) -> Generator[None, None, _Plan | None]:
+        """Plan a command and the stop it leads to when no other follows, sampled (and the legs solved) at
+        ``rate``, yielding between slices: planned and checked together, so that no accepted command can make
+        a later tick fail, and no tick plans. Returns None for a stop while standing."""
+        plan = yield from self._plan(command, stance, boundary, rate, sliced)
         if plan is not None and not command.stop:
             try:
-                plan.closing = self._plan(closing_command(command), plan.stance, plan.boundary, rate)
+                plan.closing = yield from self._plan(closing_command(command), plan.stance, plan.boundary, rate,
+                                                     sliced)
             except ZmpwalkError as error:
                 raise error.in_context("the closing step this command would end with (when no other follows)") \
                     from None
@@ -194,37 +299,60 @@ class OnlineWalker:
         """The rejection of a command the legs cannot follow, naming the largest stride that fits: searched
         at :data:`HINT_RATE` at most, then confirmed (or reduced) at the control rate."""
         coarse = min(self.rate, HINT_RATE)
-        error = infeasible_command(command, cause, lambda c: self._checked(c, stance, boundary, coarse))
+        error = infeasible_command(command, cause, lambda c: _finish(self._checked(c, stance, boundary, coarse)))
         for _ in range(HINT_CONFIRMATIONS):
             if not error.largest or coarse == self.rate:
                 break
             try:
-                self._checked(replace(command, forward=error.largest.get("forward", 0.0),
-                                      side=error.largest.get("side", 0.0), turn=error.largest.get("turn", 0.0)),
-                              stance, boundary, self.rate)
+                _finish(self._checked(replace(command, forward=error.largest.get("forward", 0.0),
+                                              side=error.largest.get("side", 0.0),
+                                              turn=error.largest.get("turn", 0.0)), stance, boundary, self.rate))
                 break
             except ZmpwalkError:
                 error = InfeasibleCommandError(error.parameter, error.value,
                                                {k: v * HINT_SHRINK for k, v in error.largest.items()}, cause)
         return error
 
-    def _plan(self, command: StepCommand, stance: Stance, boundary: Boundary, rate: float) -> _Plan | None:
-        """Plan, sample (and solve the legs of) one command from a stance at ``rate`` [Hz]; None for a stop
-        while standing."""
-        stages, next_stance, next_boundary = plan_next(self.robot, self._schedule, stance, boundary, command)
+    def _plan(self, command: StepCommand, stance: Stance, boundary: Boundary, rate: float,
+              sliced: bool) -> Generator[None, None, _Plan | None]:
+        """Plan, sample (and solve the legs of) one command from a stance at ``rate`` [Hz], yielding after the
+        plan, after the reach check and after every :data:`SLICE_ROWS` samples; None for a stop while standing."""
+        stages, next_stance, next_boundary = plan_next(self.robot, self._schedule, stance, boundary, command,
+                                                       reach=False)
         if not stages:
             return None
+        yield
+        check_reach(stages, self.robot)
+        yield
         first_index = math.ceil(stages[0].start * rate - _EPS)
-        rows = self._sample(stages, first_index, next_boundary.time, rate)
+        stop_index = math.ceil(next_boundary.time * rate - _EPS)
+        rows = np.empty((max(stop_index - first_index, 0), self._width))
+        table = StageTable(stages)
+        # in slices for submit(); an imported robot's legs in one pass (its base velocities are differences
+        # along the step)
+        size = SLICE_ROWS if sliced and self.robot.legs is None else max(len(rows), 1)
+        for begin in range(0, len(rows), size):
+            end = min(begin + size, len(rows))
+            self._sample(table, np.arange(first_index + begin, first_index + end) / rate, rows[begin:end])
+            yield
         standing = self._standing_row(next_stance) if next_boundary.at_rest else None
         return _Plan(command, stages, next_stance, next_boundary, rows, first_index, standing=standing)
 
     def stop(self) -> None:
         """Queue a closing step into the ready posture (nothing happens when standing).
 
-        The closing step has the step time and shape-factor overrides of the last command.
+        The closing step has the step time and shape-factor overrides of the step under way; it was
+        planned and checked with that step, so asking for it costs nothing. A command queued or being
+        checked is dropped.
         """
-        self.command(closing_command(self._last_command))
+        self._job = None
+        current = self._current
+        if current is not None and not current.command.stop:
+            self._pending = current.closing
+        elif current is None and self._pending is not None and self._boundary.at_rest:
+            self._pending = None  # a walk queued from standstill that has not started
+        elif current is not None:
+            self._pending = None  # the step under way is a stop already
 
     def tick(self) -> WalkingSample:
         """The sample at :attr:`time`, then advance by one control period."""
@@ -235,6 +363,8 @@ class OnlineWalker:
         self._index = index + 1
         # one copy per tick: the caller's arrays never alias the walker's buffers
         row = (self._standing if current is None else current.rows[index - current.first_index]).copy()
+        if self._job is not None:
+            self._work(finish=False)
         return WalkingSample(
             time=index / self.rate,
             support=SUPPORT_NAMES[int(row[_SUPPORT])],
@@ -251,12 +381,12 @@ class OnlineWalker:
 
     def _advance(self, index: int) -> _Plan | None:
         """Make the queued (or an automatic stop) command current; None when standing."""
+        if self._job is not None and index >= self._job.start:
+            self._work(finish=True)  # its step begins now: the rest of its check cannot wait
         while True:
-            if self._pending is None and not self._boundary.at_rest:
-                # the automatic stop, planned when its step was commanded
-                self._pending = self._current.closing if self._current is not None else None
-                if self._pending is None:
-                    self.stop()
+            if self._pending is None and not self._boundary.at_rest and self._current is not None:
+                # the automatic stop, planned and checked when its step was commanded
+                self._pending = self._current.closing
             plan = self._pending
             self._pending = None
             if plan is None:
@@ -264,20 +394,16 @@ class OnlineWalker:
                 return None
             self._current = plan
             self._stance, self._boundary = plan.stance, plan.boundary
-            if not plan.command.stop:
-                self._last_command = plan.command
             if plan.boundary.at_rest:
                 self._standing = plan.standing if plan.standing is not None else self._standing_row(plan.stance)
             if index < plan.first_index + len(plan.rows):
                 return plan
 
-    def _sample(self, stages: list[Stage], first_index: int, end_time: float, rate: float) -> Array:
-        stop_index = math.ceil(end_time * rate - _EPS)
-        times = np.arange(first_index, stop_index) / rate
-        rows = np.empty((len(times), self._width))
+    def _sample(self, table: StageTable, times: Array, rows: Array) -> None:
+        """Fill ``rows`` with the pattern (and the legs) at ``times`` [s]."""
         if len(times) == 0:
-            return rows
-        samples = evaluate(StageTable(stages), times, self.robot)
+            return
+        samples = evaluate(table, times, self.robot)
         if self.joints:
             self._fill_joints(rows, samples)
         rows[:, 0:2] = samples.pelvis_xy
@@ -289,7 +415,6 @@ class OnlineWalker:
         rows[:, _RIGHT_YAW] = samples.right_yaw
         rows[:, _ZMP] = samples.zmp_xy
         rows[:, _SUPPORT] = samples.support
-        return rows
 
     def _fill_joints(self, rows: Array, samples: Samples) -> None:
         n = len(samples.time)
