@@ -172,3 +172,27 @@ def test_noisy_delayed_sensors_reach_the_stabilizer_and_bad_noise_is_rejected():
     assert np.array_equal(runs[0].joint_angles, runs[1].joint_angles)  # seeded: the same walk again
     assert not np.array_equal(runs[0].joint_angles, runs[3].joint_angles)  # the delay reaches the loop
     assert not np.array_equal(runs[0].joint_angles, runs[2].joint_angles)  # the noise reaches the loop
+
+
+def test_a_sweep_on_two_processes_gives_the_walks_of_one():
+    """zmpwalk.sim.sweep: the same figures whether the walks run in a process pool or one after the other."""
+    from zmpwalk.sim.sweep import sweep
+
+    pooled = sweep("hubo", ["fig10", "turn45"], workers=2)
+    inline = sweep("hubo", ["fig10", "turn45"], workers=1)
+    assert [r.scenario for r in pooled] == ["fig10", "turn45"]
+    for a, b in zip(pooled, inline, strict=True):
+        assert (a.passed, a.failed, a.fell) == (b.passed, b.failed, b.fell)
+        assert a.distance == pytest.approx(b.distance, abs=1e-12)  # [m] deterministic simulation
+        assert a.cop_error_rms == pytest.approx(b.cop_error_rms, abs=1e-12)  # [m]
+        assert a.simulated > 5.0 and a.passed  # both walks stand at the end (verdict)
+
+
+def test_sweep_cli_exit_status_follows_the_verdicts(capsys):
+    from zmpwalk.cli import EXIT_FAILED, main
+
+    assert main(["sweep", "--scenario", "turn45", "--workers", "1"]) == 0
+    assert "turn45" in capsys.readouterr().out
+    assert main(["sweep", "--scenario", "fig27", "--workers", "1"]) == EXIT_FAILED  # open loop, box HUBO: falls
+    assert main(["sweep", "--scenario", "nope"]) == 2
+    assert "unknown scenario 'nope'" in capsys.readouterr().err

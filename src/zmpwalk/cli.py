@@ -11,6 +11,7 @@ import argparse
 import json
 import math
 import sys
+import time
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -31,6 +32,7 @@ from zmpwalk.robots.model import RobotModel
 from zmpwalk.scenarios import list_scenarios, load_scenario_with_labels, load_steps_file_with_labels
 from zmpwalk.schedule import Schedule
 from zmpwalk.sim.motors import Motor
+from zmpwalk.sim.sweep import HOLD, SETTLE
 from zmpwalk.tables import condition_margins, margins_markdown
 
 if TYPE_CHECKING:
@@ -38,8 +40,6 @@ if TYPE_CHECKING:
 
 EXIT_ERROR = 2
 EXIT_FAILED = 3  # the walk failed its verdict, or the plan's ZMP left the polygon
-SETTLE = 0.5  # [s] standing before a simulated walk
-HOLD = 2.0  # [s] standing after it (the verdict judges how it ends)
 
 
 def paper_example() -> dict[str, object]:
@@ -217,6 +217,18 @@ def _parser() -> argparse.ArgumentParser:
     _robot_options(tables)
     tables.add_argument("--steps", type=int, default=10, help="steps walked per condition (default: 10)")
     tables.add_argument("--json", action="store_true", help="print JSON instead of Markdown")
+    sweep_cmd = commands.add_parser(
+        "sweep", help="simulate many scenarios on all cores and judge each walk",
+        description="Simulate built-in scenarios on one robot, one walk per core at a time, and print each "
+        "walk's verdict. Exit status 3 when any walk fails its verdict.",
+        epilog="example: zmpwalk sweep --robot hubo --balance on   |   zmpwalk sweep --scenario fig27 fig28",
+    )
+    _robot_options(sweep_cmd)
+    sweep_cmd.add_argument("--scenario", nargs="+", help="scenarios to walk (default: every built-in one)")
+    sweep_cmd.add_argument("--workers", type=int, help="walks at a time (default: one per core)")
+    sweep_cmd.add_argument("--balance", choices=("on", "off"), default=None,
+                           help="the stabilizer (default: on for a robot's own model, off for the box models)")
+    sweep_cmd.add_argument("--json", action="store_true", help="print JSON")
     robot_cmd = commands.add_parser(
         "robot", help="import a robot from its MJCF or URDF and show what zmpwalk derived",
         description="Load a robot (its own MJCF or URDF model, a robot file or a built-in name), print what "
@@ -380,6 +392,39 @@ def _simulate(args: argparse.Namespace) -> int:
     return 0 if verdict.passed else EXIT_FAILED
 
 
+def _sweep(args: argparse.Namespace) -> int:
+    import os
+
+    from zmpwalk.sim.sweep import sweep
+
+    names = args.scenario or list(list_scenarios())
+    for name in names:
+        if name not in list_scenarios():
+            raise ZmpwalkError(f"unknown scenario {name!r}; known: {', '.join(list_scenarios())}")
+    if args.workers is not None and args.workers < 1:
+        raise _UsageError(f"--workers = {args.workers} must be >= 1")
+    workers = args.workers or os.cpu_count() or 1
+    show = None if args.json or not sys.stderr.isatty() else (lambda done, total: _progress("walks", done, total))
+    balance = None if args.balance is None else args.balance == "on"
+    started, cpu = time.perf_counter(), time.process_time()
+    results = sweep(args.robot, names, balance=balance, workers=workers, progress=show)
+    wall = time.perf_counter() - started
+    walked = sum(r.seconds for r in results)
+    if args.json:
+        print(json.dumps(_json_safe({"workers": workers, "wall_seconds": wall, "walk_seconds": walked,
+                                     "results": [vars(r) for r in results]}), indent=2, allow_nan=False))
+    else:
+        width = max(len(name) for name in names)
+        for r in results:
+            state = "PASS" if r.passed else "FAIL " + ", ".join(r.failed)
+            print(f"{r.scenario:<{width}}  {r.simulated:5.1f} s simulated in {r.seconds:5.2f} s  "
+                  f"distance {r.distance:6.3f} m  CoP RMS {r.cop_error_rms * 1e3:6.1f} mm  {state}")
+        print(f"{len(results)} walks, {sum(r.simulated for r in results):.1f} s simulated: {wall:.1f} s wall clock on "
+              f"{workers} worker(s), {walked:.1f} s of walks ({walked / wall:.2f} walks at a time; "
+              f"{time.process_time() - cpu:.1f} s CPU in this process)")
+    return 0 if all(r.passed for r in results) else EXIT_FAILED
+
+
 def _json_safe(value: object) -> object:
     """NaN and infinity (e.g. no loaded sole) become null, so the output is strict JSON."""
     if isinstance(value, float) and not math.isfinite(value):
@@ -472,6 +517,8 @@ def _run(args: argparse.Namespace) -> int:
         return _report(args)
     if args.command == "simulate":
         return _simulate(args)
+    if args.command == "sweep":
+        return _sweep(args)
     if args.command == "robot":
         from zmpwalk.robots.inspect import robot_summary, robot_table, robot_toml
 

@@ -1,0 +1,123 @@
+"""Many simulated walks on all cores: :func:`sweep` runs scenarios in a process pool.
+
+Each walk is the pipeline of ``zmpwalk simulate``: the pattern at 1 kHz, the joint angles, the
+MuJoCo walk (with the stabilizer where asked), standing :data:`SETTLE` before and :data:`HOLD`
+after, and the verdict of :func:`zmpwalk.sim.verdict.walk_verdict`. Workers load the robot
+themselves (by name or model path), so nothing heavier than a few strings crosses a process
+boundary.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from functools import cache
+
+from zmpwalk.errors import InvalidParameterError
+from zmpwalk.robots.model import RobotModel
+
+SETTLE = 0.5  # [s] standing before a simulated walk
+HOLD = 2.0  # [s] standing after it (the verdict judges how it ends)
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """One walk of a sweep.
+
+    Attributes:
+        scenario: The scenario's name.
+        robot: The robot's name.
+        passed: Every criterion of the verdict passed.
+        failed: Names of the criteria that failed.
+        fell: The robot fell.
+        distance: Distance walked [m].
+        cop_error_rms: RMS of the measured CoP against the reference ZMP [m].
+        simulated: Simulated time [s].
+        seconds: Wall-clock time of the walk in its worker [s].
+    """
+
+    scenario: str
+    robot: str
+    passed: bool
+    failed: tuple[str, ...]
+    fell: bool
+    distance: float  # [m]
+    cop_error_rms: float  # [m]
+    simulated: float  # [s]
+    seconds: float  # [s]
+
+
+@cache
+def _robot(spec: str) -> RobotModel:
+    from zmpwalk.robots import load_robot
+
+    return load_robot(spec)
+
+
+def walk_scenario(robot: str, scenario: str, balance: bool | None = None) -> SweepResult:
+    """Simulate one built-in scenario on a robot (name, robot file or model path) and judge it.
+
+    Args:
+        robot: What ``--robot`` takes.
+        scenario: A built-in scenario name.
+        balance: Close the loop with the stabilizer; None: on for a robot's own model, off for a box model.
+    """
+    from zmpwalk.balance import Stabilizer
+    from zmpwalk.kinematics import pattern_joint_trajectory
+    from zmpwalk.patterns.polynomial import generate
+    from zmpwalk.scenarios import load_scenario_with_labels
+    from zmpwalk.sim.run import simulate
+    from zmpwalk.sim.verdict import walk_verdict
+
+    start = time.perf_counter()
+    model = _robot(robot)
+    commands, labels = load_scenario_with_labels(scenario)
+    pattern = generate(model, commands, rate=1000.0, labels=labels)
+    joints = pattern_joint_trajectory(pattern, check_limits=False)
+    closed = model.plant is not None if balance is None else balance
+    stabilizer = Stabilizer(model, 1000.0) if closed else None
+    result = simulate(model, joints, pattern, stabilizer=stabilizer, settle=SETTLE, hold=HOLD)
+    verdict = walk_verdict(result, HOLD)
+    rms, _ = result.cop_error_stats()
+    return SweepResult(
+        scenario=scenario, robot=model.name, passed=verdict.passed,
+        failed=tuple(c.name for c in verdict.criteria if not c.passed), fell=result.fell,
+        distance=result.distance, cop_error_rms=rms, simulated=float(result.time[-1]),
+        seconds=time.perf_counter() - start,
+    )
+
+
+def sweep(robot: str, scenarios: Sequence[str], balance: bool | None = None, workers: int | None = None,
+          progress: Callable[[int, int], None] | None = None) -> list[SweepResult]:
+    """Simulate every scenario on ``robot``, ``workers`` walks at a time (default: one per core).
+
+    Returns:
+        The results in the order of ``scenarios``.
+
+    Raises:
+        InvalidParameterError: ``workers`` < 1.
+        ZmpwalkError: A scenario or the robot is unknown or infeasible (raised before any walk when
+            the robot does not load).
+    """
+    if workers is None:
+        workers = os.cpu_count() or 1
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise InvalidParameterError("workers", workers, "an integer >= 1")
+    _robot(robot)  # a bad robot is one error here, not one per worker
+    results: dict[int, SweepResult] = {}
+    if workers == 1 or len(scenarios) <= 1:
+        for index, name in enumerate(scenarios):
+            results[index] = walk_scenario(robot, name, balance)
+            if progress:
+                progress(len(results), len(scenarios))
+    else:
+        with ProcessPoolExecutor(max_workers=min(workers, len(scenarios))) as pool:
+            futures = {pool.submit(walk_scenario, robot, name, balance): index for index, name in enumerate(scenarios)}
+            for future in as_completed(futures):
+                results[futures[future]] = future.result()
+                if progress:
+                    progress(len(results), len(scenarios))
+    return [results[index] for index in range(len(scenarios))]
