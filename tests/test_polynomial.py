@@ -9,7 +9,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from zmpwalk import StepCommand, ZmpwalkError, generate
+from zmpwalk import OnlineWalker, StepCommand, ZmpwalkError, generate
 from zmpwalk import zmp as zmp_maps
 from zmpwalk.footsteps import Stance
 from zmpwalk.patterns.polynomial import Boundary, StageTable, evaluate, plan_next, plan_walk
@@ -354,3 +354,83 @@ def test_chunk_size_is_checked(hubo):
 
     with pytest.raises(ZmpwalkError, match="chunk_stages = 0"):
         generate_chunks(hubo, [StepCommand(0.8, 0.1)], chunk_stages=0)
+
+
+# --------------------------------------------------------------------- the quintic (jerk-continuous) pelvis
+
+ZMP_JUMP_TOL = 1e-6  # [m] one-sided limits of the cart-table ZMP at every breakpoint
+
+
+def _zmp_and_acceleration(samples):
+    return np.hstack([samples.zmp_xy, samples.pelvis_acceleration_xy])
+
+
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(step_commands(), min_size=10, max_size=16))
+def test_quintic_pelvis_keeps_the_cart_table_zmp_continuous_for_random_command_sequences(hubo, schedule,
+                                                                                           commands):
+    """pelvis="quintic": positions and velocities continuous as with the cubics, and the pelvis acceleration
+    and the cart-table ZMP continuous too, at every stage boundary and every breakpoint inside a stage."""
+    try:
+        stages, _ = plan_walk(hubo, commands, schedule, pelvis="quintic")
+    except ZmpwalkError:
+        return
+    assert_continuous(hubo, stages)
+    table = StageTable(stages)
+    k = np.arange(len(stages) - 1)
+    before = _zmp_and_acceleration(evaluate(table, table.start[1:], hubo, k))
+    after = _zmp_and_acceleration(evaluate(table, table.start[1:], hubo, k + 1))
+    np.testing.assert_allclose(before, after, atol=ZMP_JUMP_TOL, rtol=0)
+    times, index = [], []
+    for i, stage in enumerate(stages[:-1]):
+        for point in _breakpoints(stage):
+            times.append(point)
+            index.append(i)
+    index_a = np.array(index, dtype=np.intp)
+    left = _zmp_and_acceleration(evaluate(table, np.array(times) - EPS, hubo, index_a))
+    right = _zmp_and_acceleration(evaluate(table, np.array(times) + EPS, hubo, index_a))
+    np.testing.assert_allclose(left, right, atol=ZMP_JUMP_TOL, rtol=0)
+
+
+def test_quintic_pelvis_changes_only_the_pelvis_between_the_same_boundary_states(hubo):
+    """Same feet, same pelvis positions and velocities at every stage boundary; the cubic's ZMP jumps there.
+    (Side steps keep their shift's timing and amplitude, but its speed at the step change is 2 S'(1/2) = 3.75
+    instead of the cosine's pi, per unit step time: forward and backward steps here.)"""
+    commands = [StepCommand(0.8, 0.2), StepCommand(0.8, 0.05), StepCommand(0.95, 0.1),
+                StepCommand(0.7, -0.1)]
+    cubic, quintic = generate(hubo, commands, rate=1000.0), generate(hubo, commands, rate=1000.0, pelvis="quintic")
+    for name in ("position_left_ankle_in_world", "position_right_ankle_in_world", "yaw_left_foot_in_world",
+                 "yaw_right_foot_in_world", "yaw_pelvis_in_world"):
+        np.testing.assert_array_equal(getattr(cubic, name), getattr(quintic, name))
+    stages, _ = plan_walk(hubo, commands, pelvis="quintic")
+    boundaries = np.array([round(s.start * 1000.0) for s in stages[1:]])
+    np.testing.assert_allclose(quintic.position_pelvis_in_world[boundaries], cubic.position_pelvis_in_world[boundaries],
+                               atol=POSITION_TOL)
+    np.testing.assert_allclose(quintic.velocity_pelvis_in_world[boundaries],
+                               cubic.velocity_pelvis_in_world[boundaries], atol=VELOCITY_TOL)
+    cubic_steps = np.linalg.norm(np.diff(cubic.zmp_in_world, axis=0), axis=1)
+    quintic_steps = np.linalg.norm(np.diff(quintic.zmp_in_world, axis=0), axis=1)
+    assert cubic_steps.max() > 0.1  # [m] the cubic's ZMP jumps by decimetres between two 1 kHz samples
+    assert quintic_steps.max() < 0.01  # [m] the quintic's moves by millimetres at most
+
+
+def test_online_walker_with_the_quintic_pelvis_reproduces_the_offline_pattern(hubo):
+    commands = [StepCommand(0.95, 0.0), StepCommand(0.8, 0.2), StepCommand(0.7, 0.1, turn=0.1),
+                StepCommand(0.8, side=0.05)]
+    pattern = generate(hubo, commands, rate=200.0, pelvis="quintic")
+    walker = OnlineWalker(hubo, rate=200.0, pelvis="quintic")
+    pending, rows = list(commands), []
+    for _ in range(len(pattern.time)):
+        if pending and walker.queued is None:
+            walker.command(pending.pop(0))
+        sample = walker.tick()
+        rows.append(np.concatenate([sample.position_pelvis_in_world, sample.zmp_in_world]))
+    expected = np.column_stack([pattern.position_pelvis_in_world, pattern.zmp_in_world])
+    np.testing.assert_allclose(np.array(rows), expected, atol=1e-12)
+
+
+def test_pelvis_option_is_checked(hubo):
+    with pytest.raises(ZmpwalkError, match="pelvis = 'septic' is not allowed; expected one of cubic, quintic"):
+        generate(hubo, [StepCommand(0.8, 0.1)], pelvis="septic")
+    with pytest.raises(ZmpwalkError, match="pelvis"):
+        OnlineWalker(hubo, pelvis="quartic")

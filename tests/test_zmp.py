@@ -121,3 +121,25 @@ def test_hull_edges_margin_equals_the_hull_polygons_margin():
     points = rng.uniform(-0.4, 0.6, (60, 2))
     expected = [zmp_maps.signed_margin(points[k:k + 1], zmp_maps.convex_hull(vertices[k]))[0] for k in range(60)]
     np.testing.assert_allclose(zmp_maps.batch_hull_margin(points, vertices), expected, atol=1e-12)  # [m]
+
+
+@pytest.mark.parametrize("duration", [0.35, 0.7, 1.0, 1.6])
+def test_quintic_boundary_map_against_the_sampled_curve(duration):
+    """zmp_from_pelvis_boundary_quintic against z = x - (l/g) x'' of hermite_quintic, differentiated numerically."""
+    from zmpwalk.curves import hermite_quintic
+
+    length = 0.62  # [m]
+    l_over_g = length / 9.81
+    rng = np.random.default_rng(8)
+    for _ in range(20):
+        x0, v0, x1, v1 = rng.uniform(-0.2, 0.2, 4)  # [m], [m/s]
+
+        def zmp(t, x0=x0, v0=v0, x1=x1, v1=v1):
+            value, _, curvature = hermite_quintic(x0, v0 * duration, x1, v1 * duration, t / duration)
+            return value - l_over_g * curvature / duration**2
+
+        h = 1e-6
+        measured = np.array([zmp(0.0), (zmp(h) - zmp(0.0)) / h, zmp(duration), (zmp(duration) - zmp(duration - h)) / h])
+        predicted = zmp_maps.zmp_from_pelvis_boundary_quintic(duration, length) @ np.array([x0, v0, x1, v1])
+        np.testing.assert_allclose(measured[[0, 2]], predicted[[0, 2]], atol=1e-12)  # [m]: z = x at the ends
+        np.testing.assert_allclose(measured[[1, 3]], predicted[[1, 3]], rtol=1e-3, atol=1e-4)  # [m/s]

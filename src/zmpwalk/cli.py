@@ -94,6 +94,24 @@ def _schedule(args: argparse.Namespace) -> Schedule | None:
     return Schedule.from_file(path)
 
 
+def _pelvis(args: argparse.Namespace) -> str:
+    pelvis = str(getattr(args, "pelvis", "cubic"))
+    if pelvis != "cubic" and getattr(args, "generator", "polynomial") != "polynomial":
+        raise _UsageError(f"--pelvis {pelvis} applies to the polynomial generator")
+    return pelvis
+
+
+def _pattern_options(args: argparse.Namespace) -> dict[str, object]:
+    """The generator's keyword options from --schedule and --pelvis (only those given)."""
+    options: dict[str, object] = {}
+    schedule = _schedule(args)
+    if schedule is not None:
+        options["schedule"] = schedule
+    if _pelvis(args) != "cubic":
+        options["pelvis"] = _pelvis(args)
+    return options
+
+
 def _motors(args: argparse.Namespace) -> list[Motor] | None:
     from zmpwalk.sim.motors import load_motors
 
@@ -141,6 +159,8 @@ def _parser() -> argparse.ArgumentParser:
     plan.add_argument("--scenario", help="a built-in scenario instead of a steps file (see 'zmpwalk scenarios')")
     _robot_options(plan)
     plan.add_argument("--schedule", type=Path, help="your own parameter tables (TOML, the format of Tables 2-3)")
+    plan.add_argument("--pelvis", choices=("cubic", "quintic"), default="cubic",
+                        help="pelvis curves: the paper's cubics, or quintics with a continuous cart-table ZMP")
     plan.add_argument("--rate", type=float, default=1000.0,
                       help="samples per second [Hz] (default: 1000, as report and simulate)")
     plan.add_argument("--allow-outside", action="store_true",
@@ -176,6 +196,8 @@ def _parser() -> argparse.ArgumentParser:
     simulate_cmd.add_argument("--steady-steps", type=int, default=2, help="steady steps of --paper-example")
     _robot_options(simulate_cmd)
     simulate_cmd.add_argument("--schedule", type=Path, help="your own parameter tables (TOML)")
+    simulate_cmd.add_argument("--pelvis", choices=("cubic", "quintic"), default="cubic",
+                        help="pelvis curves: the paper's cubics, or quintics with a continuous cart-table ZMP")
     _balance_options(simulate_cmd)
     simulate_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
     simulate_cmd.add_argument("--mass-scale", type=float, default=1.0, help="multiply every mass (default 1)")
@@ -200,6 +222,8 @@ def _parser() -> argparse.ArgumentParser:
         report_cmd.add_argument("--steps", type=Path, help="steps file (TOML) instead of a scenario")
         _robot_options(report_cmd)
         report_cmd.add_argument("--schedule", type=Path, help="your own parameter tables (TOML)")
+        report_cmd.add_argument("--pelvis", choices=("cubic", "quintic"), default="cubic",
+                            help="pelvis curves: the paper's cubics, or quintics with a continuous cart-table ZMP")
         _balance_options(report_cmd, default="on")
         report_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
         default_out = Path("zmpwalk-demo" if name == "demo" else "zmpwalk-report")
@@ -296,7 +320,7 @@ def _report(args: argparse.Namespace) -> int:
                               generator=args.generator, animate=not args.no_animation,
                               progress=None if quiet else _progress, labels=labels,
                               balance=_balance(args, robot), latency=args.latency, schedule=_schedule(args),
-                              motors=_motors(args))
+                              motors=_motors(args), pelvis=_pelvis(args))
     verdict = report.verdict
     if args.json:
         summary = {**report.summary, "index": str(report.index), "seconds": report.seconds}
@@ -332,8 +356,7 @@ def _simulate(args: argparse.Namespace) -> int:
     else:
         commands, labels = _commands(args)
         make = generator(args.generator)
-        schedule = _schedule(args)
-        options = {"schedule": schedule} if schedule else {}
+        options = _pattern_options(args)
         with _source(_label(args)):
             pattern = make(robot, commands, rate=1000.0, labels=labels, **options)
     if show:
@@ -487,10 +510,11 @@ def _run(args: argparse.Namespace) -> int:
         robot = _load_robot(args)
         make = generator(args.generator)
         schedule = _schedule(args)
-        options = {"schedule": schedule} if schedule else {}
+        options = _pattern_options(args)
         with _source(_label(args)):
             if args.generator == "polynomial":  # long walks: planned whole, sampled and written piece by piece
-                pieces = generate_chunks(robot, commands, rate=args.rate, schedule=schedule, labels=labels)
+                pieces = generate_chunks(robot, commands, rate=args.rate, schedule=schedule, labels=labels,
+                                         pelvis=_pelvis(args))
             else:
                 pieces = iter([make(robot, commands, rate=args.rate, labels=labels, **options)])
             summary = _PlanSummary()

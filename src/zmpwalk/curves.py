@@ -41,6 +41,32 @@ def hermite_cubic(p0: Array, m0: Array, p1: Array, m1: Array, s: Array) -> Curve
     return value, slope, curvature
 
 
+def hermite_quintic(p0: Array, m0: Array, p1: Array, m1: Array, s: Array) -> Curve:
+    r"""Quintic with end values ``p0, p1``, end slopes ``m0, m1`` (per unit ``s``) and zero curvature at both
+    ends: the jerk-continuous counterpart of :func:`hermite_cubic` (the pelvis option ``"quintic"``).
+
+    .. math::
+        x(s) = p_0 + (p_1 - p_0)(10s^3 - 15s^4 + 6s^5) + (s - 6s^3 + 8s^4 - 3s^5) m_0
+             + (-4s^3 + 7s^4 - 3s^5) m_1
+
+    Joined end to end with the same slopes, such curves have continuous value, slope and curvature,
+    so the cart-table ZMP :math:`x - (l/g)\ddot x` is continuous too.
+
+    Returns:
+        Value, first and second derivative with respect to ``s``.
+    """
+    s2 = s * s
+    s3 = s2 * s
+    rise, rise1, rise2 = smoothstep5(s)
+    span = p1 - p0
+    value = (p0 + span * rise + (s - 6 * s3 + 8 * s2 * s2 - 3 * s3 * s2) * m0
+             + (-4 * s3 + 7 * s2 * s2 - 3 * s3 * s2) * m1)
+    slope = (span * rise1 + (1 - 18 * s2 + 32 * s3 - 15 * s2 * s2) * m0
+             + (-12 * s2 + 28 * s3 - 15 * s2 * s2) * m1)
+    curvature = span * rise2 + (-36 * s + 96 * s2 - 60 * s3) * m0 + (-24 * s + 84 * s2 - 60 * s3) * m1
+    return value, slope, curvature
+
+
 def cycloid(s: Array) -> Curve:
     """Unit cycloid of Eq. 11 (Park 2008): ``s - sin(2 pi s) / (2 pi)``.
 

@@ -63,6 +63,7 @@ from zmpwalk.patterns.polynomial import (
     closing_command,
     evaluate,
     infeasible_command,
+    pelvis_is_quintic,
     plan_next,
 )
 from zmpwalk.patterns.result import SUPPORT_NAMES, check_rate
@@ -172,11 +173,14 @@ class OnlineWalker:
         joints: Also return the 12 joint angles and velocities at every tick
             (closed-form IK, computed when a command is queued; a command whose
             pattern leaves the legs' reach or joint ranges is rejected).
+        pelvis: ``"cubic"`` (the paper's curves) or ``"quintic"`` (jerk-continuous: the cart-table ZMP
+            is continuous at every stage boundary).
     """
 
     def __init__(self, robot: RobotModel, rate: float = 100.0, schedule: Schedule | None = None,
-                 joints: bool = False) -> None:
+                 joints: bool = False, pelvis: str = "cubic") -> None:
         check_rate(rate)
+        self._quintic = pelvis_is_quintic(pelvis)
         self.robot = robot
         self.rate = float(rate)
         self.joints = bool(joints)
@@ -318,7 +322,7 @@ class OnlineWalker:
         """Plan, sample (and solve the legs of) one command from a stance at ``rate`` [Hz], yielding after the
         plan, after the reach check and after every :data:`SLICE_ROWS` samples; None for a stop while standing."""
         stages, next_stance, next_boundary = plan_next(self.robot, self._schedule, stance, boundary, command,
-                                                       reach=False)
+                                                       reach=False, quintic=self._quintic)
         if not stages:
             return None
         yield

@@ -37,9 +37,11 @@ class ConditionMargin:
 
 
 def condition_margins(
-    robot: RobotModel, schedule: Schedule | None = None, steps: int = 10, rate: float = 1000.0
+    robot: RobotModel, schedule: Schedule | None = None, steps: int = 10, rate: float = 1000.0,
+    pelvis: str = "cubic",
 ) -> list[ConditionMargin]:
-    """Walk ``steps`` commands of every tabulated condition and report the smallest ZMP margin of each."""
+    """Walk ``steps`` commands of every tabulated condition and report the smallest ZMP margin of each
+    (``pelvis``: the cubic or quintic pelvis curves of :func:`zmpwalk.patterns.polynomial.plan_walk`)."""
     schedule = schedule or Schedule.hubo()
     results = []
     for mode, duration, stride in schedule.conditions():
@@ -47,7 +49,7 @@ def condition_margins(
             command = StepCommand(duration=duration, forward=stride)
         else:
             command = StepCommand(duration=duration, side=stride)
-        pattern = generate(robot, [command] * steps, rate=rate, schedule=schedule)
+        pattern = generate(robot, [command] * steps, rate=rate, schedule=schedule, pelvis=pelvis)
         margin = pattern.zmp_margin()
         index = int(np.nanargmin(margin))
         results.append(ConditionMargin(mode, duration, stride, steps, float(margin[index]),

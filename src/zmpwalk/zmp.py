@@ -74,6 +74,42 @@ def zmp_from_pelvis_boundary(duration: float, pendulum_length: float, gravity: f
     return np.asarray(np.linalg.solve(scale, normalized_zmp_map(kappa) @ scale), dtype=np.float64)
 
 
+def zmp_from_pelvis_boundary_quintic(duration: float, pendulum_length: float, gravity: float = 9.81) -> Array:
+    r"""The boundary map of Eq. 7 for the quintic pelvis (:func:`zmpwalk.curves.hermite_quintic`), any step time.
+
+    With zero pelvis acceleration at both ends the ZMP there is the pelvis itself; its slope is
+    :math:`\dot z = \dot x - (l/g)\dddot x` with the quintic's end jerks (per unit normalised time
+    :math:`60\Delta - 36 m_0 - 24 m_1` at the start and :math:`60\Delta - 24 m_0 - 36 m_1` at the end,
+    :math:`\Delta = x_1 - x_0`). With :math:`\kappa = l / (g T^2)`, per unit normalised time:
+
+    .. math::
+        \begin{bmatrix} z_0 \\ z_0' \\ z_1 \\ z_1' \end{bmatrix} =
+        \begin{bmatrix} 1 & 0 & 0 & 0 \\ 60\kappa & 1 + 36\kappa & -60\kappa & 24\kappa \\
+        0 & 0 & 1 & 0 \\ 60\kappa & 24\kappa & -60\kappa & 1 + 36\kappa \end{bmatrix}
+        \begin{bmatrix} x_0 \\ x_0' \\ x_1 \\ x_1' \end{bmatrix}
+
+    Args:
+        duration: Step time ``T`` [s] (> 0).
+        pendulum_length: ``l`` [m] (> 0).
+        gravity: [m/s^2] (> 0).
+
+    Returns:
+        (4, 4) map from ``[x0, v0, x1, v1]`` to ``[z0, z0_dot, z1, z1_dot]`` in SI ([m], [m/s]).
+    """
+    for name, value in (("duration", duration), ("pendulum_length", pendulum_length), ("gravity", gravity)):
+        if not np.isfinite(value) or value <= 0:
+            raise InvalidParameterError(name, value, "a finite value > 0")
+    kappa = pendulum_length / (gravity * duration**2)
+    normalized = np.array([
+        [1.0, 0.0, 0.0, 0.0],
+        [60.0 * kappa, 1.0 + 36.0 * kappa, -60.0 * kappa, 24.0 * kappa],
+        [0.0, 0.0, 1.0, 0.0],
+        [60.0 * kappa, 24.0 * kappa, -60.0 * kappa, 1.0 + 36.0 * kappa],
+    ])
+    scale = np.diag([1.0, duration, 1.0, duration])  # physical -> per unit normalised time
+    return np.asarray(np.linalg.solve(scale, normalized @ scale), dtype=np.float64)
+
+
 def pelvis_from_zmp_boundary(duration: float, pendulum_length: float, gravity: float = 9.81) -> Array:
     """Inverse of :func:`zmp_from_pelvis_boundary`: pelvis boundary values from a designed ZMP."""
     return np.asarray(np.linalg.inv(zmp_from_pelvis_boundary(duration, pendulum_length, gravity)), dtype=np.float64)

@@ -69,11 +69,15 @@ SHIFT_NONE = 0
 SHIFT_OPEN = 1
 SHIFT_RECOVERY = 2
 SHIFT_PROFILES = {"open": SHIFT_OPEN, "recovery": SHIFT_RECOVERY}
-# d(profile)/d(tau) at tau = 0 and tau = 1 of side_shift_profile
+# d(profile)/d(tau) at tau = 0 and tau = 1 of side_shift_profile (cubic pelvis: cosine; quintic: smoothstep)
 SHIFT_END_RATES = {SHIFT_NONE: (0.0, 0.0), SHIFT_OPEN: (0.0, math.pi), SHIFT_RECOVERY: (math.pi, 0.0)}
+QUINTIC_SHIFT_RATE = 2.0 * 15.0 / 8.0  # [-] 2 S'(1/2) of the quintic smoothstep S
+QUINTIC_SHIFT_END_RATES = {SHIFT_NONE: (0.0, 0.0), SHIFT_OPEN: (0.0, QUINTIC_SHIFT_RATE),
+                           SHIFT_RECOVERY: (QUINTIC_SHIFT_RATE, 0.0)}
+PELVIS_CURVES = ("cubic", "quintic")  # the pelvis option: the paper's cubics, or jerk-continuous quintics
 
 
-def side_shift_profile(tau: Array, profile: NDArray[np.integer]) -> curves.Curve:
+def side_shift_profile(tau: Array, profile: NDArray[np.integer], quintic: bool = False) -> curves.Curve:
     """Pelvis shift of side walking (Eqs. 15-16) as a fraction of a stage's shift, per unit ``tau``.
 
     The paper moves the pelvis sideways from the middle of the open-stance
@@ -87,11 +91,22 @@ def side_shift_profile(tau: Array, profile: NDArray[np.integer]) -> curves.Curve
     * open: ``0`` for ``tau < 1/2``, then ``1 - cos(pi (tau - 1/2))``;
     * recovery: ``sin(pi tau)`` for ``tau < 1/2``, then ``1``;
     * other stages: ``0``.
+
+    With the quintic pelvis (``quintic``) the joined curve is the smoothstep ``S(u)`` of Eq. 17 (Lim et
+    al.) over the same span, ``u`` from 0 at ``t0`` of the open stance to 1 at ``t0`` of the recovery:
+    ``2 S(tau - 1/2)`` in the open stance and ``2 S(tau + 1/2) - 1`` in the recovery, whose curvature
+    is zero where it starts and ends, so the pelvis acceleration does not jump there either.
     """
     opening = profile == SHIFT_OPEN
     recovering = profile == SHIFT_RECOVERY
     late = np.clip(tau - 0.5, 0.0, 0.5)
     early = np.clip(tau, 0.0, 0.5)
+    if quintic:  # one smoothstep S(u) from t0 of the open stance (u = 0) to t0 of the recovery (u = 1)
+        u = np.where(opening, late, early + 0.5)
+        step, step1, step2 = curves.smoothstep5(u)
+        active = (opening & (tau >= 0.5)) | (recovering & (tau < 0.5))
+        value = np.where(opening, 2.0 * step, np.where(recovering, 2.0 * step - 1.0, 0.0))
+        return value, np.where(active, 2.0 * step1, 0.0), np.where(active, 2.0 * step2, 0.0)
     value = np.where(opening, 1.0 - np.cos(np.pi * late), np.where(recovering, np.sin(np.pi * early), 0.0))
     rate = np.where(opening & (tau >= 0.5), np.pi * np.sin(np.pi * late),
                     np.where(recovering & (tau < 0.5), np.pi * np.cos(np.pi * early), 0.0))
@@ -145,14 +160,16 @@ class Stage:
     standing: bool = False
     grounded: bool = False  # no foot leaves the ground (standing, start)
     end: Boundary = field(default_factory=lambda: Boundary(0.0))
+    quintic: bool = False  # jerk-continuous pelvis curves (zero acceleration at every curve's ends)
 
     @property
     def stop_time(self) -> float:
         return self.start + self.duration
 
 
-def build_stage(plan: StagePlan, boundary: Boundary) -> Stage:
-    """Fix a stage's trajectories from its plan and the inherited boundary state."""
+def build_stage(plan: StagePlan, boundary: Boundary, quintic: bool = False) -> Stage:
+    """Fix a stage's trajectories from its plan and the inherited boundary state (``quintic``: the
+    jerk-continuous pelvis curves, same boundary positions and velocities)."""
     p = plan.parameters
     T = plan.duration
     support = plan.support_pose
@@ -176,7 +193,7 @@ def build_stage(plan: StagePlan, boundary: Boundary) -> Stage:
     profile = SHIFT_PROFILES.get(plan.kind, SHIFT_NONE)
     lateral = float(shift @ n) * n if profile != SHIFT_NONE else np.zeros(2)
     sagittal = shift - lateral
-    lateral_rate_start, lateral_rate_end = SHIFT_END_RATES[profile]
+    lateral_rate_start, lateral_rate_end = (QUINTIC_SHIFT_END_RATES if quintic else SHIFT_END_RATES)[profile]
     v0_base = v_prev - w0 * n - lateral * lateral_rate_start / T
     v_end = v1 + lateral * lateral_rate_end / T + w1 * n  # total pelvis velocity at t2
     end = Boundary(
@@ -204,6 +221,7 @@ def build_stage(plan: StagePlan, boundary: Boundary) -> Stage:
         sway_back_time=back_time,
         grounded=plan.kind in ("start", "settle"),
         end=end,
+        quintic=quintic,
     )
 
 
@@ -293,6 +311,7 @@ class StageTable:
         self.w1 = column([s.sway_slope_end for s in stages])
         self.out_time = column([s.sway_out_time for s in stages])
         self.back_time = column([s.sway_back_time for s in stages])
+        self.quintic = column([s.quintic for s in stages])
 
     def index_at(self, time: Array) -> NDArray[np.intp]:
         """Index of the stage each time belongs to (a boundary time opens the next stage)."""
@@ -361,17 +380,8 @@ def evaluate(table: StageTable, time: Array, robot: RobotModel, index: NDArray[n
     swing_yaw = table.swing_yaw0[k] + dyaw * b
     swing_yaw_rate = dyaw * b1
     # --- pelvis base: Eqs. 12-13 cubic (Hermite form of Eq. 4) plus the side-walking shift of Eqs. 15-16
-    s2 = tau * tau
-    s3 = s2 * tau
-    h10 = s3 - 2 * s2 + tau
-    h01 = 3 * s2 - 2 * s3
-    h11 = s3 - s2
-    g10 = 3 * s2 - 4 * tau + 1
-    g01 = 6 * tau - 6 * s2
-    g11 = 3 * s2 - 2 * tau
-    k10 = 6 * tau - 4
-    k01 = 6 - 12 * tau
-    k11 = 6 * tau - 2
+    quintic = table.quintic[k] if table.quintic.any() else None  # per sample, None: all cubic
+    h10, h01, h11, g10, g01, g11, k10, k01, k11 = _mixed(_cubic_basis, _quintic_basis, quintic, tau)
     components = []
     for base0, sag, m0, m1, lat in (
         (table.base0_x, table.sag_x, table.m0_x, table.m1_x, table.lat_x),
@@ -383,7 +393,8 @@ def evaluate(table: StageTable, time: Array, robot: RobotModel, index: NDArray[n
         curvature = k10 * m0k + k01 * sagk + k11 * m1k
         components.append([position, slope, curvature, lat])
     if np.any(table.lat_profile != SHIFT_NONE):
-        q, q1, q2 = side_shift_profile(tau, table.lat_profile[k])
+        q, q1, q2 = _mixed(lambda t, p: side_shift_profile(t, p, False), lambda t, p: side_shift_profile(t, p, True),
+                           quintic, tau, table.lat_profile[k])
         for component in components:
             lat_k = component[3][k]
             component[0] = component[0] + lat_k * q
@@ -400,7 +411,8 @@ def evaluate(table: StageTable, time: Array, robot: RobotModel, index: NDArray[n
     m_start = np.where(first_half, table.w0[k], 0.0)
     p_end = np.where(second_half, 0.0, amp)
     m_end = np.where(second_half, table.w1[k], 0.0)
-    sway, sway1, sway2 = curves.hermite_cubic(p_start, m_start, p_end, m_end, sigma)
+    sway, sway1, sway2 = _mixed(curves.hermite_cubic, curves.hermite_quintic, quintic,
+                                p_start, m_start, p_end, m_end, sigma)
     scale = np.where(first_half, 1.0 / out_time, np.where(second_half, 1.0 / back_time, 0.0))  # d sigma/dt
     sway = np.where(first_half | second_half, sway, amp)
     sway1 = sway1 * scale
@@ -445,6 +457,36 @@ def evaluate(table: StageTable, time: Array, robot: RobotModel, index: NDArray[n
         right_position=right_position, right_velocity=right_velocity, right_yaw=right_yaw,
         right_yaw_rate=right_rate, zmp_xy=zmp,
     )
+
+
+def _cubic_basis(tau: Array) -> tuple[Array, ...]:
+    """Hermite cubic basis (Eqs. 4 and 12): slope-0, end-value and slope-1 functions and their derivatives."""
+    s2 = tau * tau
+    s3 = s2 * tau
+    return (s3 - 2 * s2 + tau, 3 * s2 - 2 * s3, s3 - s2,
+            3 * s2 - 4 * tau + 1, 6 * tau - 6 * s2, 3 * s2 - 2 * tau,
+            6 * tau - 4, 6 - 12 * tau, 6 * tau - 2)
+
+
+def _quintic_basis(tau: Array) -> tuple[Array, ...]:
+    """The same for :func:`zmpwalk.curves.hermite_quintic` (zero curvature at both ends)."""
+    s2 = tau * tau
+    s3 = s2 * tau
+    s4 = s2 * s2
+    rise, rise1, rise2 = curves.smoothstep5(tau)
+    return (tau - 6 * s3 + 8 * s4 - 3 * s4 * tau, rise, -4 * s3 + 7 * s4 - 3 * s4 * tau,
+            1 - 18 * s2 + 32 * s3 - 15 * s4, rise1, -12 * s2 + 28 * s3 - 15 * s4,
+            -36 * tau + 96 * s2 - 60 * s3, rise2, -24 * tau + 84 * s2 - 60 * s3)
+
+
+def _mixed(cubic: Callable[..., tuple[Array, ...]], quintic: Callable[..., tuple[Array, ...]],
+           mask: NDArray[np.bool_] | None, *args: Array) -> tuple[Array, ...]:
+    """``cubic(*args)`` or ``quintic(*args)`` per sample as ``mask`` (None: every sample cubic)."""
+    if mask is None:
+        return cubic(*args)
+    if mask.all():
+        return quintic(*args)
+    return tuple(np.where(mask, q, c) for c, q in zip(cubic(*args), quintic(*args), strict=True))
 
 
 def _blend_and_cycloid(s: Array) -> tuple[Array, Array, Array, Array]:
@@ -509,7 +551,7 @@ def check_reach(stages: Sequence[Stage], robot: RobotModel) -> None:
 
 def plan_next(
     robot: RobotModel, schedule: Schedule, stance: Stance, boundary: Boundary, command: StepCommand,
-    reach: bool = True,
+    reach: bool = True, quintic: bool = False,
 ) -> tuple[list[Stage], Stance, Boundary]:
     """Stages of one command from a stance and boundary state; nothing is changed on error.
 
@@ -522,6 +564,7 @@ def plan_next(
     Args:
         reach: Check the legs' reach here (a caller that checks many commands at
             once with :func:`check_reach` passes False).
+        quintic: The jerk-continuous pelvis curves instead of the paper's cubics.
 
     Raises:
         ZmpwalkError: The command is infeasible for this robot (reach, overlap, timing).
@@ -534,7 +577,7 @@ def plan_next(
         plans = [grounded_stage(stance, first.swing, command.duration, first.parameters, "start"), *plans]
     stages: list[Stage] = []
     for plan in plans:
-        stage = build_stage(plan, boundary)
+        stage = build_stage(plan, boundary, quintic)
         stages.append(stage)
         boundary = stage.end
     if reach:
@@ -588,6 +631,17 @@ def _scaled(command: StepCommand, scale: float) -> StepCommand:
     return replace(command, **{name: getattr(command, name) * scale for name in STRIDE_FIELDS})
 
 
+def pelvis_is_quintic(pelvis: str) -> bool:
+    """True for ``"quintic"``, False for ``"cubic"``.
+
+    Raises:
+        InvalidParameterError: Any other value (the message lists both).
+    """
+    if pelvis not in PELVIS_CURVES:
+        raise InvalidParameterError("pelvis", pelvis, f"one of {', '.join(PELVIS_CURVES)}")
+    return pelvis == "quintic"
+
+
 def closing_command(last: StepCommand) -> StepCommand:
     """The stop added after ``last``: same step time and shape-factor overrides, no motion."""
     return replace(last, forward=0.0, side=0.0, turn=0.0, stop=True)
@@ -598,6 +652,7 @@ def plan_walk(
     commands: Sequence[StepCommand],
     schedule: Schedule | None = None,
     labels: Sequence[str] | None = None,
+    pelvis: str = "cubic",
 ) -> tuple[list[Stage], Stance]:
     """Stages of a whole walk from the ready posture, closed by a stop and a standing stage.
 
@@ -610,10 +665,13 @@ def plan_walk(
         commands: The step commands.
         schedule: Parameter tables.
         labels: How an error names each command (default ``step N``, 1-based).
+        pelvis: ``"cubic"`` (the paper's curves) or ``"quintic"`` (jerk-continuous, zero acceleration at
+            every curve's ends: the cart-table ZMP is continuous; the parameters keep their meaning).
 
     Raises:
         ZmpwalkError: With the command's label in front, for the first command that fails.
     """
+    quintic = pelvis_is_quintic(pelvis)
     schedule = schedule or Schedule.hubo()
     stance = Stance.ready(robot)
     boundary = Boundary(0.0)
@@ -626,7 +684,8 @@ def plan_walk(
     for number, command in enumerate(sequence, start=1):
         starts.append((stance, boundary))
         try:
-            new, stance, boundary = plan_next(robot, schedule, stance, boundary, command, reach=False)
+            new, stance, boundary = plan_next(robot, schedule, stance, boundary, command, reach=False,
+                                              quintic=quintic)
         except ZmpwalkError as error:
             raise error.in_context(_label(labels, number)) from None
         stages.extend(new)
@@ -640,9 +699,10 @@ def plan_walk(
         command, (start_stance, start_boundary) = sequence[number - 1], starts[number - 1]
 
         def feasible(candidate: StepCommand) -> None:  # the command, and the stop after it
-            _, after, after_boundary = plan_next(robot, schedule, start_stance, start_boundary, candidate)
+            _, after, after_boundary = plan_next(robot, schedule, start_stance, start_boundary, candidate,
+                                                 quintic=quintic)
             if not candidate.stop:
-                plan_next(robot, schedule, after, after_boundary, closing_command(candidate))
+                plan_next(robot, schedule, after, after_boundary, closing_command(candidate), quintic=quintic)
 
         raise infeasible_command(command, error, feasible).in_context(_label(labels, number)) from None
     stages.append(standing_stage(_standing_plan(stance, robot, schedule), boundary.time))
@@ -667,6 +727,7 @@ def generate(
     rate: float = 100.0,
     schedule: Schedule | None = None,
     labels: Sequence[str] | None = None,
+    pelvis: str = "cubic",
 ) -> WalkingPattern:
     """The HUBO walking pattern of a command sequence, sampled at ``rate`` [Hz].
 
@@ -676,12 +737,13 @@ def generate(
         rate: Samples per second (HUBO's reference rate is 100 Hz).
         schedule: Parameter tables; Tables 2-3 of the paper by default.
         labels: How an error names each command (default ``step N``).
+        pelvis: ``"cubic"`` or ``"quintic"`` (:func:`plan_walk`).
 
     Returns:
         The pattern from the ready posture at t = 0 to standing after the last step.
     """
     check_rate(rate)
-    stages, _ = plan_walk(robot, commands, schedule, labels)
+    stages, _ = plan_walk(robot, commands, schedule, labels, pelvis)
     return _sampled(stages, robot, rate, sample_times(stages[-1].start, rate))
 
 
@@ -692,6 +754,7 @@ def generate_chunks(
     schedule: Schedule | None = None,
     labels: Sequence[str] | None = None,
     chunk_stages: int = CHUNK_STAGES,
+    pelvis: str = "cubic",
 ) -> Iterator[WalkingPattern]:
     """The pattern of :func:`generate` in consecutive pieces, for walks too long to hold at once.
 
@@ -706,7 +769,7 @@ def generate_chunks(
     check_rate(rate)
     if isinstance(chunk_stages, bool) or not isinstance(chunk_stages, int) or chunk_stages < 1:
         raise InvalidParameterError("chunk_stages", chunk_stages, "an integer >= 1")
-    stages, _ = plan_walk(robot, commands, schedule, labels)
+    stages, _ = plan_walk(robot, commands, schedule, labels, pelvis)
     return _chunks(stages, robot, rate, chunk_stages)
 
 

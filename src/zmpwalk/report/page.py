@@ -92,8 +92,10 @@ def build_report(
     latency: float = 0.0,
     schedule: Schedule | None = None,
     motors: list[Motor] | None = None,
+    pelvis: str = "cubic",
 ) -> Report:
-    """Generate, check, simulate and report a walk into ``folder``.
+    """Generate, check, simulate and report a walk into ``folder`` (``pelvis``: the polynomial
+    generator's pelvis curves, ``"cubic"`` or ``"quintic"``).
 
     Raises:
         ZmpwalkError: The walk cannot be generated (the message says why).
@@ -110,7 +112,9 @@ def build_report(
         if progress:
             progress(stage, STAGES.index(stage) + 1, len(STAGES))
 
-    options = {"schedule": schedule} if schedule is not None else {}
+    options: dict[str, object] = {"schedule": schedule} if schedule is not None else {}
+    if pelvis != "cubic":
+        options["pelvis"] = pelvis
     pattern = pattern_generator(generator)(robot, commands, rate=1000.0, labels=labels, **options)
     pattern.write_csv(folder / "pattern.csv")
     done("pattern")
