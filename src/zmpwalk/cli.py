@@ -89,8 +89,9 @@ def _schedule(args: argparse.Namespace) -> Schedule | None:
     path = getattr(args, "schedule", None)
     if path is None:
         return None
-    if getattr(args, "generator", "polynomial") != "polynomial":
-        raise _UsageError("--schedule applies to the polynomial generator (the HUBO pattern's tables)")
+    if getattr(args, "generator", "polynomial") not in ("polynomial", "preview"):
+        raise _UsageError("--schedule applies to the polynomial generator (the HUBO pattern's tables) and to the "
+                          "footsteps of the preview generator")
     return Schedule.from_file(path)
 
 

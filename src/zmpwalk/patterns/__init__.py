@@ -8,7 +8,7 @@ from zmpwalk.errors import UnknownNameError
 from zmpwalk.patterns.result import WalkingPattern
 
 Generator = Callable[..., WalkingPattern]
-GENERATORS = ("polynomial", "hyperbolic")
+GENERATORS = ("polynomial", "hyperbolic", "preview")
 
 
 def generator(name: str) -> Generator:
@@ -19,8 +19,10 @@ def generator(name: str) -> Generator:
     """
     from zmpwalk.patterns.hyperbolic import generate_hyperbolic
     from zmpwalk.patterns.polynomial import generate
+    from zmpwalk.patterns.preview import generate_preview
 
-    known: dict[str, Generator] = {"polynomial": generate, "hyperbolic": generate_hyperbolic}
+    known: dict[str, Generator] = {"polynomial": generate, "hyperbolic": generate_hyperbolic,
+                                   "preview": generate_preview}
     if name not in known:
         raise UnknownNameError("generator", name, known)
     return known[name]
