@@ -196,3 +196,10 @@ def test_sweep_cli_exit_status_follows_the_verdicts(capsys):
     assert main(["sweep", "--scenario", "fig27", "--workers", "1"]) == EXIT_FAILED  # open loop, box HUBO: falls
     assert main(["sweep", "--scenario", "nope"]) == 2
     assert "unknown scenario 'nope'" in capsys.readouterr().err
+
+
+def test_a_sweep_reports_a_walk_its_generator_cannot_plan_instead_of_failing():
+    from zmpwalk.sim.sweep import sweep
+
+    (result,) = sweep("hubo", ["turn45"], workers=1, generator="hyperbolic")  # the hyperbolic one walks straight
+    assert not result.passed and result.failed == ("planned",) and "turn" in result.error

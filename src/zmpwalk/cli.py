@@ -253,6 +253,7 @@ def _parser() -> argparse.ArgumentParser:
     sweep_cmd.add_argument("--workers", type=int, help="walks at a time (default: one per core)")
     sweep_cmd.add_argument("--balance", choices=("on", "off"), default=None,
                            help="the stabilizer (default: on for a robot's own model, off for the box models)")
+    sweep_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
     sweep_cmd.add_argument("--json", action="store_true", help="print JSON")
     robot_cmd = commands.add_parser(
         "robot", help="import a robot from its MJCF or URDF and show what zmpwalk derived",
@@ -431,7 +432,7 @@ def _sweep(args: argparse.Namespace) -> int:
     show = None if args.json or not sys.stderr.isatty() else (lambda done, total: _progress("walks", done, total))
     balance = None if args.balance is None else args.balance == "on"
     started, cpu = time.perf_counter(), time.process_time()
-    results = sweep(args.robot, names, balance=balance, workers=workers, progress=show)
+    results = sweep(args.robot, names, balance=balance, workers=workers, progress=show, generator=args.generator)
     wall = time.perf_counter() - started
     walked = sum(r.seconds for r in results)
     if args.json:
@@ -440,6 +441,9 @@ def _sweep(args: argparse.Namespace) -> int:
     else:
         width = max(len(name) for name in names)
         for r in results:
+            if r.error:
+                print(f"{r.scenario:<{width}}  not planned: {r.error}")
+                continue
             state = "PASS" if r.passed else "FAIL " + ", ".join(r.failed)
             print(f"{r.scenario:<{width}}  {r.simulated:5.1f} s simulated in {r.seconds:5.2f} s  "
                   f"distance {r.distance:6.3f} m  CoP RMS {r.cop_error_rms * 1e3:6.1f} mm  {state}")

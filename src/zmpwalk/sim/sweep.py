@@ -9,6 +9,7 @@ boundary.
 
 from __future__ import annotations
 
+import math
 import os
 import time
 from collections.abc import Callable, Sequence
@@ -16,7 +17,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from functools import cache
 
-from zmpwalk.errors import InvalidParameterError
+from zmpwalk.errors import InvalidParameterError, ZmpwalkError
 from zmpwalk.robots.model import RobotModel
 
 SETTLE = 0.5  # [s] standing before a simulated walk
@@ -37,6 +38,7 @@ class SweepResult:
         cop_error_rms: RMS of the measured CoP against the reference ZMP [m].
         simulated: Simulated time [s].
         seconds: Wall-clock time of the walk in its worker [s].
+        error: Why the walk could not be planned (then nothing was simulated), else empty.
     """
 
     scenario: str
@@ -48,6 +50,7 @@ class SweepResult:
     cop_error_rms: float  # [m]
     simulated: float  # [s]
     seconds: float  # [s]
+    error: str = ""
 
 
 @cache
@@ -57,17 +60,19 @@ def _robot(spec: str) -> RobotModel:
     return load_robot(spec)
 
 
-def walk_scenario(robot: str, scenario: str, balance: bool | None = None) -> SweepResult:
+def walk_scenario(robot: str, scenario: str, balance: bool | None = None,
+                  generator: str = "polynomial") -> SweepResult:
     """Simulate one built-in scenario on a robot (name, robot file or model path) and judge it.
 
     Args:
         robot: What ``--robot`` takes.
         scenario: A built-in scenario name.
         balance: Close the loop with the stabilizer; None: on for a robot's own model, off for a box model.
+        generator: The pattern generator's name (:data:`zmpwalk.patterns.GENERATORS`).
     """
     from zmpwalk.balance import Stabilizer
     from zmpwalk.kinematics import pattern_joint_trajectory
-    from zmpwalk.patterns.polynomial import generate
+    from zmpwalk.patterns import generator as pattern_generator
     from zmpwalk.scenarios import load_scenario_with_labels
     from zmpwalk.sim.run import simulate
     from zmpwalk.sim.verdict import walk_verdict
@@ -75,7 +80,12 @@ def walk_scenario(robot: str, scenario: str, balance: bool | None = None) -> Swe
     start = time.perf_counter()
     model = _robot(robot)
     commands, labels = load_scenario_with_labels(scenario)
-    pattern = generate(model, commands, rate=1000.0, labels=labels)
+    try:
+        pattern = pattern_generator(generator)(model, commands, rate=1000.0, labels=labels)
+    except ZmpwalkError as error:  # this walk is not possible with this generator: a result, not a crash
+        return SweepResult(scenario=scenario, robot=model.name, passed=False, failed=("planned",), fell=False,
+                           distance=math.nan, cop_error_rms=math.nan, simulated=0.0,
+                           seconds=time.perf_counter() - start, error=str(error))
     joints = pattern_joint_trajectory(pattern, check_limits=False)
     closed = model.plant is not None if balance is None else balance
     stabilizer = Stabilizer(model, 1000.0) if closed else None
@@ -91,7 +101,7 @@ def walk_scenario(robot: str, scenario: str, balance: bool | None = None) -> Swe
 
 
 def sweep(robot: str, scenarios: Sequence[str], balance: bool | None = None, workers: int | None = None,
-          progress: Callable[[int, int], None] | None = None) -> list[SweepResult]:
+          progress: Callable[[int, int], None] | None = None, generator: str = "polynomial") -> list[SweepResult]:
     """Simulate every scenario on ``robot``, ``workers`` walks at a time (default: one per core).
 
     Returns:
@@ -110,12 +120,13 @@ def sweep(robot: str, scenarios: Sequence[str], balance: bool | None = None, wor
     results: dict[int, SweepResult] = {}
     if workers == 1 or len(scenarios) <= 1:
         for index, name in enumerate(scenarios):
-            results[index] = walk_scenario(robot, name, balance)
+            results[index] = walk_scenario(robot, name, balance, generator)
             if progress:
                 progress(len(results), len(scenarios))
     else:
         with ProcessPoolExecutor(max_workers=min(workers, len(scenarios))) as pool:
-            futures = {pool.submit(walk_scenario, robot, name, balance): index for index, name in enumerate(scenarios)}
+            futures = {pool.submit(walk_scenario, robot, name, balance, generator): index
+                       for index, name in enumerate(scenarios)}
             for future in as_completed(futures):
                 results[futures[future]] = future.result()
                 if progress:
