@@ -151,6 +151,12 @@ def _breakpoints(stage):
     return [p for p in points if t1 < p < t1 + T]
 
 
+def _all_breakpoints(stages):
+    """The breakpoints of every stage but the last, and the index of each one's stage."""
+    pairs = [(point, i) for i, stage in enumerate(stages[:-1]) for point in _breakpoints(stage)]
+    return np.array([p for p, _ in pairs]), np.array([i for _, i in pairs], dtype=np.intp)
+
+
 def _state(samples):
     position = np.hstack([samples.pelvis_xy, samples.left_position, samples.right_position,
                           samples.pelvis_yaw[:, None], samples.left_yaw[:, None], samples.right_yaw[:, None]])
@@ -172,13 +178,7 @@ def assert_continuous(robot, stages):
     np.testing.assert_allclose(p0, p1, atol=POSITION_TOL, rtol=0)
     np.testing.assert_allclose(v0, v1, atol=VELOCITY_TOL, rtol=0)
     # Phase boundaries inside each stage: one-sided limits.
-    times, index = [], []
-    for i, stage in enumerate(stages[:-1]):
-        for point in _breakpoints(stage):
-            times.append(point)
-            index.append(i)
-    times_a = np.array(times)
-    index_a = np.array(index, dtype=np.intp)
+    times_a, index_a = _all_breakpoints(stages)
     left = _state(evaluate(table, times_a - EPS, robot, index_a))
     right = _state(evaluate(table, times_a + EPS, robot, index_a))
     exact = _state(evaluate(table, times_a, robot, index_a))  # the breakpoint itself, where pieces meet
@@ -381,14 +381,9 @@ def test_quintic_pelvis_keeps_the_cart_table_zmp_continuous_for_random_command_s
     before = _zmp_and_acceleration(evaluate(table, table.start[1:], hubo, k))
     after = _zmp_and_acceleration(evaluate(table, table.start[1:], hubo, k + 1))
     np.testing.assert_allclose(before, after, atol=ZMP_JUMP_TOL, rtol=0)
-    times, index = [], []
-    for i, stage in enumerate(stages[:-1]):
-        for point in _breakpoints(stage):
-            times.append(point)
-            index.append(i)
-    index_a = np.array(index, dtype=np.intp)
-    left = _zmp_and_acceleration(evaluate(table, np.array(times) - EPS, hubo, index_a))
-    right = _zmp_and_acceleration(evaluate(table, np.array(times) + EPS, hubo, index_a))
+    times, index_a = _all_breakpoints(stages)
+    left = _zmp_and_acceleration(evaluate(table, times - EPS, hubo, index_a))
+    right = _zmp_and_acceleration(evaluate(table, times + EPS, hubo, index_a))
     np.testing.assert_allclose(left, right, atol=ZMP_JUMP_TOL, rtol=0)
 
 
