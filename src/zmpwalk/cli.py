@@ -255,6 +255,22 @@ def _parser() -> argparse.ArgumentParser:
                            help="the stabilizer (default: on for a robot's own model, off for the box models)")
     sweep_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
     sweep_cmd.add_argument("--json", action="store_true", help="print JSON")
+    tune_cmd = commands.add_parser(
+        "tune", help="tune the shape factors of Tables 2-3 for a robot and write them as a schedule file",
+        description="Search the shape factors of every condition of the tables (or of --schedule's) for the "
+        "largest cart-table and multibody ZMP margin, check the best candidates in MuJoCo, and write the tuned "
+        "schedule (the format --schedule reads). Exit status 3 when a condition does not walk.",
+        epilog="example: zmpwalk tune --robot hubo --out hubo_tuned.toml --storage tune.db",
+    )
+    _robot_options(tune_cmd)
+    tune_cmd.add_argument("--schedule", type=Path, help="the schedule to start from (default: Tables 2-3)")
+    tune_cmd.add_argument("--out", type=Path, required=True, help="schedule file to write (TOML)")
+    tune_cmd.add_argument("--trials", type=int, default=40, help="candidates per condition (default: 40)")
+    tune_cmd.add_argument("--steps", type=int, default=10, help="steps walked per candidate (default: 10)")
+    tune_cmd.add_argument("--seed", type=int, default=0, help="sampler seed: the same seed, the same schedule")
+    tune_cmd.add_argument("--workers", type=int, help="conditions at a time (default: one per core)")
+    tune_cmd.add_argument("--storage", type=Path, help="SQLite file of the studies: a stopped run resumes")
+    tune_cmd.add_argument("--json", action="store_true", help="print JSON")
     robot_cmd = commands.add_parser(
         "robot", help="import a robot from its MJCF or URDF and show what zmpwalk derived",
         description="Load a robot (its own MJCF or URDF model, a robot file or a built-in name), print what "
@@ -453,6 +469,39 @@ def _sweep(args: argparse.Namespace) -> int:
     return 0 if all(r.passed for r in results) else EXIT_FAILED
 
 
+def _tune(args: argparse.Namespace) -> int:
+    from zmpwalk.files import read_toml
+    from zmpwalk.tune import schedule_toml, tune
+
+    if args.workers is not None and args.workers < 1:
+        raise _UsageError(f"--workers = {args.workers} must be >= 1")
+    data = read_toml(args.schedule) if args.schedule else None
+    show = None if args.json or not sys.stderr.isatty() else (
+        lambda done, total, best: _progress(f"conditions (best {best * 1e3:+.1f} mm)", done, total))
+    started = time.perf_counter()
+    result = tune(args.robot, trials=args.trials, seed=args.seed, workers=args.workers, storage=args.storage,
+                  steps=args.steps, data=data, progress=show)
+    wall = time.perf_counter() - started
+    write_text(args.out, schedule_toml(result, args.robot) + "\n")
+    if args.json:
+        rows = [{"condition": vars(r.condition), "values": r.values, "table": r.table, "cart_margin": r.cart_margin,
+                 "multibody_margin": r.multibody_margin, "table_cart_margin": r.table_cart_margin,
+                 "table_multibody_margin": r.table_multibody_margin, "walks": r.walks, "table_walks": r.table_walks,
+                 "attitude": r.attitude, "peak_torque": r.peak_torque, "trials": r.trials, "seconds": r.seconds}
+                for r in result.results]
+        print(json.dumps(_json_safe({"seconds": wall, "out": str(args.out), "conditions": rows}), indent=2,
+                         allow_nan=False))
+    else:
+        for r in result.results:
+            values = ", ".join(f"{k} {v:.3g}" for k, v in r.values.items())
+            multibody = "" if math.isnan(r.multibody_margin) else f" / {r.multibody_margin * 1e3:+.1f}"
+            before = "" if math.isnan(r.table_multibody_margin) else f" / {r.table_multibody_margin * 1e3:+.1f}"
+            print(f"{r.condition.name}: {values}; margin {r.cart_margin * 1e3:+.1f}{multibody} mm (table "
+                  f"{r.table_cart_margin * 1e3:+.1f}{before}); {'walks' if r.walks else 'FAILS in simulation'}")
+        print(f"{len(result.results)} conditions in {wall:.1f} s -> {args.out}")
+    return 0 if all(r.walks for r in result.results) else EXIT_FAILED
+
+
 def _json_safe(value: object) -> object:
     """NaN and infinity (e.g. no loaded sole) become null, so the output is strict JSON."""
     if isinstance(value, float) and not math.isfinite(value):
@@ -548,6 +597,8 @@ def _run(args: argparse.Namespace) -> int:
         return _simulate(args)
     if args.command == "sweep":
         return _sweep(args)
+    if args.command == "tune":
+        return _tune(args)
     if args.command == "robot":
         from zmpwalk.robots.inspect import robot_summary, robot_table, robot_toml
 

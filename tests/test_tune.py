@@ -1,0 +1,63 @@
+"""Automatic tuning of the shape factors (zmpwalk.tune): margins, reproducibility, resuming, the schedule file."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from zmpwalk import StepCommand, generate, load_robot
+from zmpwalk.cli import main
+from zmpwalk.errors import ZmpwalkError
+from zmpwalk.schedule import Schedule
+from zmpwalk.tune import Condition, conditions_of, hubo_schedule_data, margins, row_values, schedule_toml, tune
+
+SLOW_ROW = Condition("forward", 0.7, 0.2)  # Table 2's 0.7 s row: its ZMP leaves the sole with the paper's values
+
+
+def test_the_grid_is_the_paper_tables():
+    grid = conditions_of(hubo_schedule_data())
+    assert len(grid) == 18 and grid[0] == Condition("forward", 0.95, 0.0) and grid[-1] == Condition("side", 0.7, 0.07)
+    assert row_values(hubo_schedule_data(), SLOW_ROW) == {"sway": 0.032, "alpha": 1.6, "up_ratio": 0.425}
+
+
+def test_the_cheap_criterion_measures_the_rows_own_steps(hubo):
+    """The margin of the paper's 0.7 s row over its own steps (the start and the stop are other rows)."""
+    cart, multibody = margins(hubo, hubo_schedule_data(), SLOW_ROW, steps=10)
+    pattern = generate(hubo, [StepCommand(0.7, 0.2)] * 10, rate=1000.0)
+    assert cart == pytest.approx(-0.0127, abs=5e-4)  # [m] as docs/zmp-margins.md, steady walking
+    assert cart >= pattern.min_zmp_margin()[0] - 1e-12
+    assert multibody < 0.0 and not math.isnan(multibody)
+
+
+def test_tuning_a_row_puts_both_zmps_inside_and_walks_and_the_same_seed_gives_the_same_row(tmp_path):
+    first = tune("hubo", trials=12, seed=3, workers=1, conditions=[SLOW_ROW], steps=6)
+    second = tune("hubo", trials=12, seed=3, workers=1, conditions=[SLOW_ROW], steps=6)
+    (result,) = first.results
+    assert result.values == second.results[0].values  # reproducible
+    assert result.cart_margin > 0.0 and result.multibody_margin > 0.0  # [m] both inside the sole
+    assert result.table_cart_margin < 0.0  # [m] where the paper's values were outside
+    assert result.walks and result.trials == 12
+    # the written file is a schedule zmpwalk reads, with the tuned row in it
+    path = tmp_path / "tuned.toml"
+    path.write_text(schedule_toml(first, "hubo"), encoding="utf-8")
+    schedule = Schedule.from_file(path)
+    parameters, _ = schedule.stage_parameters(StepCommand(0.7, 0.2), load_robot("hubo"))
+    assert parameters.sway == pytest.approx(result.values["sway"], rel=1e-5)
+    assert parameters.alpha == pytest.approx(result.values["alpha"], rel=1e-5)
+
+
+def test_a_stored_study_resumes_where_it_stopped(tmp_path):
+    storage = tmp_path / "tune.db"
+    tune("hubo", trials=4, workers=1, conditions=[SLOW_ROW], steps=4, storage=storage)
+    resumed = tune("hubo", trials=7, workers=1, conditions=[SLOW_ROW], steps=4, storage=storage)
+    assert resumed.results[0].trials == 7  # 4 kept, 3 more
+
+
+def test_bad_tuning_input_is_one_clear_error(tmp_path, capsys):
+    with pytest.raises(ZmpwalkError, match="trials = 0"):
+        tune("hubo", trials=0)
+    with pytest.raises(ZmpwalkError, match="condition"):
+        tune("hubo", conditions=[Condition("forward", 0.6, 0.2)])
+    assert main(["tune", "--robot", "hubo", "--out", str(tmp_path / "t.toml"), "--workers", "0"]) == 2
+    assert "--workers = 0" in capsys.readouterr().err
