@@ -5,18 +5,21 @@ For every condition of a grid (step time and stride or side step; the paper's Ta
 :data:`SIDE_RANGES` (table units, those of the HUBO tables; another robot walks them at its
 dynamically similar condition, :mod:`zmpwalk.schedule`) to maximise the stability score:
 
-1. **Cheap, every candidate**: the smallest margin, over every 1 kHz sample of ``steps`` steps of the
-   condition (from its second swing to its last: the start, the closing step and the settle are other
-   rows' business), of the cart-table ZMP (Eqs. 1-2) and of the multibody ZMP (Eq. 3 of Lim et al., every
-   link of the robot file's ``[bodies]``; robots without them: the cart-table ZMP only) inside the
-   support polygon [m]. The score is that margin, capped at :data:`MARGIN_CAP` (more is no safer, and
-   the cap leaves the choice among safe candidates to the simulation).
+1. **Cheap, every candidate**: the smallest margin, over every 1 kHz sample of a walk of ``steps`` steps
+   of the condition from standstill to standstill, of the cart-table ZMP (Eqs. 1-2) and of the
+   multibody ZMP (Eq. 3 of Lim et al., every link of the robot file's ``[bodies]``; robots without
+   them: the cart-table ZMP only) inside the support polygon [m]. The score is that margin, capped at
+   :data:`MARGIN_CAP` (more is no safer, and the cap leaves the choice among safe candidates to the
+   simulation).
 2. **Simulation, the best few**: the :data:`SIMULATED` best candidates (and the table's own values) walk
    the same steps in MuJoCo (the robot's own model or its box model, the stabilizer as ``simulate``
    defaults). A candidate passes when it does not fall and its CoP stays inside the loaded soles
    (the verdict's criterion); among those that pass, the best cheap score wins, then the smaller
    torso attitude (the paper's "attitude": largest roll or pitch during the walk), then the smaller
    peak torque.
+
+Every walk starts and ends with the stepping-on-the-spot row of its step time (the start stage and the
+closing step), so those rows are tuned first, and the others then with them in place: two passes.
 
 The optimiser is Optuna's TPE sampler: a handful of bounded, continuous parameters, a noisy-free but
 non-smooth objective (a minimum over samples), a few dozen evaluations per condition; TPE needs no
@@ -194,17 +197,11 @@ def margins(robot: RobotModel, data: dict[str, Any], condition: Condition, steps
                            schedule=Schedule(data, "<candidate>"))
     except ZmpwalkError:
         return -math.inf, -math.inf
-    # the condition's own steps: from its second swing (the first follows the start) to its last; the start,
-    # the closing step and the settle belong to other rows (stride 0) and are tuned there
-    swings = [s for s in pattern.steps if s.kind in ("step", "open", "recovery", "inserted")]
-    begin = swings[1].start if len(swings) > 1 else swings[0].start
-    end = swings[-1].start + swings[-1].duration
-    window = (pattern.time >= begin) & (pattern.time <= end)
-    cart = float(np.nanmin(pattern.zmp_margin()[window]))
+    cart = float(np.nanmin(pattern.zmp_margin()))
     if not robot.links or robot.plant is not None:
         return cart, math.nan
     multibody = compare_zmp(pattern).multibody
-    return cart, float(np.nanmin(replace(pattern, zmp_in_world=multibody).zmp_margin()[window]))
+    return cart, float(np.nanmin(replace(pattern, zmp_in_world=multibody).zmp_margin()))
 
 
 def score_of(cart: float, multibody: float) -> float:
@@ -328,20 +325,21 @@ def tune(robot: str, trials: int = 40, seed: int = 0, workers: int | None = None
         if progress:
             progress(len(results), len(grid), best)
 
-    arguments = [(robot, data, condition, index, trials, seed, steps, url) for index, condition in enumerate(grid)]
-    if workers == 1 or len(grid) == 1:
-        for index, args in enumerate(arguments):
-            record(index, tune_condition(*args))
-    else:
-        with ProcessPoolExecutor(max_workers=min(workers, len(grid))) as pool:
-            futures = {pool.submit(tune_condition, *args): index for index, args in enumerate(arguments)}
-            for future in as_completed(futures):
-                record(futures[future], future.result())
-    ordered = [results[index] for index in range(len(grid))]
-    tuned = data
-    for result in ordered:
-        tuned = with_row(tuned, result.condition, result.values)
-    return TuneResult(tuned, ordered)
+    # pass 1: the stride-0 rows, which start and stop every walk; pass 2: the others, walked with them
+    first_pass = [i for i, c in enumerate(grid) if c.mode == "forward" and c.stride == 0.0]
+    for indices in (first_pass, [i for i in range(len(grid)) if i not in first_pass]):
+        arguments = {i: (robot, data, grid[i], i, trials, seed, steps, url) for i in indices}
+        if workers == 1 or len(indices) <= 1:
+            for index, args in arguments.items():
+                record(index, tune_condition(*args))
+        else:
+            with ProcessPoolExecutor(max_workers=min(workers, len(indices))) as pool:
+                futures = {pool.submit(tune_condition, *args): index for index, args in arguments.items()}
+                for future in as_completed(futures):
+                    record(futures[future], future.result())
+        for index in indices:
+            data = with_row(data, grid[index], results[index].values)
+    return TuneResult(data, [results[index] for index in range(len(grid))])
 
 
 def schedule_toml(result: TuneResult, robot: str) -> str:
