@@ -23,6 +23,7 @@ from zmpwalk.leg_chain import LegChain
 from zmpwalk.online import OnlineWalker, WalkingSample
 from zmpwalk.patterns.hyperbolic import generate_hyperbolic
 from zmpwalk.patterns.polynomial import generate
+from zmpwalk.patterns.preview import generate_preview
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots import RobotModel, list_robots, load_robot
 from zmpwalk.schedule import Schedule, ShapeParameters
@@ -50,6 +51,7 @@ __all__ = [
     "ZmpwalkError",
     "generate",
     "generate_hyperbolic",
+    "generate_preview",
     "list_robots",
     "load_robot",
     "pattern_joint_trajectory",

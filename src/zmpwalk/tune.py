@@ -36,7 +36,6 @@ import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field, replace
-from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -45,6 +44,7 @@ import numpy as np
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import InvalidParameterError, ZmpwalkError
 from zmpwalk.files import read_toml
+from zmpwalk.robots import loaded_robot
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
 
@@ -235,19 +235,12 @@ def walk(robot: RobotModel, data: dict[str, Any], condition: Condition, steps: i
     return passes, attitude, peak
 
 
-@cache
-def _robot(spec: str) -> RobotModel:
-    from zmpwalk.robots import load_robot
-
-    return load_robot(spec)
-
-
 def tune_condition(robot_spec: str, data: dict[str, Any], condition: Condition, index: int, trials: int,
                    seed: int, steps: int, storage: str | None) -> ConditionResult:
     """Tune one condition (one process): the Optuna study, then the simulation of the best candidates."""
     optuna = _optuna()
     start = time.perf_counter()
-    robot = _robot(robot_spec)
+    robot = loaded_robot(robot_spec)
     ranges = tuned_columns(condition)
     table = row_values(data, condition)
     sampler = optuna.samplers.TPESampler(seed=seed * 1009 + index)
@@ -312,7 +305,7 @@ def tune(robot: str, trials: int = 40, seed: int = 0, workers: int | None = None
     grid = list(conditions) if conditions is not None else conditions_of(data)
     for condition in grid:
         _row_index(data, condition)
-    _robot(robot)
+    loaded_robot(robot)
     url = f"sqlite:///{Path(storage).resolve()}" if storage is not None else None
     workers = workers or os.cpu_count() or 1
     results: dict[int, ConditionResult] = {}

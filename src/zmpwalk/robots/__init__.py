@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+from functools import cache
 from importlib import resources
 from pathlib import Path
 
 from zmpwalk.errors import FileFormatError, UnknownNameError
 from zmpwalk.robots.model import JOINT_NAMES, RobotModel, robot_from_dict, robot_from_toml
 
-__all__ = ["JOINT_NAMES", "MODEL_SUFFIXES", "RobotModel", "list_robots", "load_robot", "robot_from_dict"]
+__all__ = ["JOINT_NAMES", "MODEL_SUFFIXES", "RobotModel", "list_robots", "load_robot", "loaded_robot",
+           "robot_from_dict"]
 
 
 def _data_dir() -> Path:
@@ -51,3 +53,10 @@ def load_robot(name_or_path: str | Path, *, feet: tuple[str, str] | None = None,
     if builtin.is_file():
         return robot_from_toml(builtin)
     raise UnknownNameError("robot", str(name_or_path), list_robots())
+
+
+@cache
+def loaded_robot(spec: str) -> RobotModel:
+    """:func:`load_robot` of a name or path, loaded once per process (workers of a sweep or a tuning run load
+    the robot themselves and reuse it)."""
+    return load_robot(spec)

@@ -15,10 +15,9 @@ import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
-from functools import cache
 
 from zmpwalk.errors import InvalidParameterError, ZmpwalkError
-from zmpwalk.robots.model import RobotModel
+from zmpwalk.robots import loaded_robot
 
 SETTLE = 0.5  # [s] standing before a simulated walk
 HOLD = 2.0  # [s] standing after it (the verdict judges how it ends)
@@ -53,13 +52,6 @@ class SweepResult:
     error: str = ""
 
 
-@cache
-def _robot(spec: str) -> RobotModel:
-    from zmpwalk.robots import load_robot
-
-    return load_robot(spec)
-
-
 def walk_scenario(robot: str, scenario: str, balance: bool | None = None,
                   generator: str = "polynomial") -> SweepResult:
     """Simulate one built-in scenario on a robot (name, robot file or model path) and judge it.
@@ -78,7 +70,7 @@ def walk_scenario(robot: str, scenario: str, balance: bool | None = None,
     from zmpwalk.sim.verdict import walk_verdict
 
     start = time.perf_counter()
-    model = _robot(robot)
+    model = loaded_robot(robot)
     commands, labels = load_scenario_with_labels(scenario)
     try:
         pattern = pattern_generator(generator)(model, commands, rate=1000.0, labels=labels)
@@ -116,7 +108,7 @@ def sweep(robot: str, scenarios: Sequence[str], balance: bool | None = None, wor
         workers = os.cpu_count() or 1
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise InvalidParameterError("workers", workers, "an integer >= 1")
-    _robot(robot)  # a bad robot is one error here, not one per worker
+    loaded_robot(robot)  # a bad robot is one error here, not one per worker
     results: dict[int, SweepResult] = {}
     if workers == 1 or len(scenarios) <= 1:
         for index, name in enumerate(scenarios):
