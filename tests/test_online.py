@@ -322,3 +322,33 @@ def test_stop_while_walking_takes_the_stop_planned_with_the_step(hubo):
     assert not walker.walking
     np.testing.assert_allclose(sample.position_left_ankle_in_world[0], sample.position_right_ankle_in_world[0],
                                atol=1e-12)  # feet side by side
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(actions=st.lists(st.tuples(st.integers(0, 150), _hostile_fields(), st.booleans()), min_size=1, max_size=8))
+def test_hostile_submitted_commands_never_make_a_tick_raise(hubo, actions):
+    """submit() and command() mixed at random ticks with hostile values: no tick raises, every rejection kept in
+    walker.rejection names a parameter, the motion stays continuous, and every walk ends standing."""
+    rate = 100.0
+    walker = OnlineWalker(hubo, rate=rate, joints=True)
+    previous, largest = None, 0.0
+    for wait, fields, use_submit in [*actions, (1500, None, False)]:
+        for _ in range(wait):
+            sample = walker.tick()
+            rows = np.concatenate([sample.position_pelvis_in_world, sample.position_left_ankle_in_world,
+                                   sample.position_right_ankle_in_world])  # positions (the cubic's ZMP jumps)
+            if previous is not None:
+                largest = max(largest, float(np.abs(rows - previous).max()))
+            previous = rows
+            error = walker.rejection
+            if error is not None:
+                assert isinstance(error, InvalidParameterError) and error.parameter in str(error)
+        if fields is None:
+            break
+        try:
+            command = StepCommand(**fields)  # type: ignore[arg-type]
+            (walker.submit if use_submit else walker.command)(command)
+        except ZmpwalkError as error:
+            assert isinstance(error, InvalidParameterError) and error.parameter
+    assert largest < 2.0 / rate  # [m] no jump between two ticks
+    assert not walker.walking and walker.checking is None
