@@ -265,11 +265,12 @@ def test_submitted_commands_give_the_same_walk_as_commands(hubo, rate):
     delay = round(START_DELAY * rate)
     direct, sliced = OnlineWalker(hubo, rate=rate, joints=True), OnlineWalker(hubo, rate=rate, joints=True)
     sliced.submit(commands[0])
-    for _ in range(delay):
-        direct.tick(), sliced.tick()
+    direct_rows, sliced_rows = [], []
+    for _ in range(delay):  # both stand still meanwhile
+        direct_rows.append(_sample_row(direct.tick()))
+        sliced_rows.append(_sample_row(sliced.tick()))
     direct.command(commands[0])
     pending = commands[1:]
-    direct_rows, sliced_rows = [], []
     for tick in range(round(9.0 * rate)):
         if pending and direct.queued is None and tick % 7 == 3:  # a command soon after each step starts
             direct.command(pending[0])
@@ -350,5 +351,36 @@ def test_hostile_submitted_commands_never_make_a_tick_raise(hubo, actions):
             (walker.submit if use_submit else walker.command)(command)
         except ZmpwalkError as error:
             assert isinstance(error, InvalidParameterError) and error.parameter
-    assert largest < 2.0 / rate  # [m] no jump between two ticks
+    assert largest < hubo.max_foot_speed / rate  # [m] nothing moves faster than the swing foot's limit: no jump
     assert not walker.walking and walker.checking is None
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_online_samples_with_joints_equal_the_batch_path_on_random_walks(hubo, seed):
+    """Positions, ZMP, joint angles and joint rates of OnlineWalker (commands given by submit() as each step
+    starts) against generate + pattern_joint_trajectory of the same commands: 1e-9."""
+    from zmpwalk.kinematics import pattern_joint_trajectory
+
+    rng = np.random.default_rng(seed)
+    commands = []
+    for _ in range(6):
+        mode = rng.integers(3)
+        duration = float(rng.choice([0.7, 0.8, 0.95]))
+        if mode == 0:
+            commands.append(StepCommand(duration, float(rng.uniform(-0.1, 0.25))))
+        elif mode == 1:
+            commands.append(StepCommand(duration, side=float(rng.uniform(-0.06, 0.06))))
+        else:
+            commands.append(StepCommand(duration, float(rng.uniform(0.0, 0.1)), turn=float(rng.uniform(-0.2, 0.2))))
+    rate = 500.0
+    pattern = generate(hubo, commands, rate=rate)
+    joints = pattern_joint_trajectory(pattern)
+    walker = OnlineWalker(hubo, rate=rate, joints=True)
+    pending, samples = list(commands), []
+    for _ in range(len(pattern.time)):
+        if pending and walker.queued is None:
+            walker.command(pending.pop(0))
+        samples.append(walker.tick())
+    np.testing.assert_allclose([_rows(s) for s in samples], _pattern_rows(pattern), atol=1e-9, rtol=0)
+    np.testing.assert_allclose([s.joint_angles for s in samples], joints.angles, atol=1e-9, rtol=0)
+    np.testing.assert_allclose([s.joint_velocities for s in samples], joints.velocities, atol=1e-9, rtol=0)

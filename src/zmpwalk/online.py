@@ -43,7 +43,6 @@ step under way was planned with it.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Generator
 from dataclasses import dataclass, replace
 
@@ -62,6 +61,7 @@ from zmpwalk.patterns.polynomial import (
     check_reach,
     closing_command,
     evaluate,
+    first_sample_at,
     infeasible_command,
     pelvis_is_quintic,
     plan_next,
@@ -139,6 +139,7 @@ class _Job:
     boundary: Boundary
     start: int  # index of the tick at which its step begins
     planning: Generator[None, None, _Plan | None]
+    origin: tuple[Stance, Boundary]  # the walker's end of plan when submitted: the job is stale once it changes
 
 
 _UNFINISHED = object()
@@ -243,11 +244,12 @@ class OnlineWalker:
         if not isinstance(command, StepCommand):
             raise InvalidParameterError("command", command, "a StepCommand")
         stance, boundary = self._stance, self._boundary
+        origin = (stance, boundary)
         if boundary.at_rest:
             boundary = Boundary(max(boundary.time, self.time + START_DELAY))
-        start = math.ceil(boundary.time * self.rate - _EPS)
+        start = first_sample_at(boundary.time, self.rate)
         self._job = _Job(command, stance, boundary, start,
-                         self._checked(command, stance, boundary, self.rate, sliced=True))
+                         self._checked(command, stance, boundary, self.rate, sliced=True), origin)
 
     @property
     def checking(self) -> StepCommand | None:
@@ -271,6 +273,13 @@ class OnlineWalker:
         job = self._job
         if job is None:
             return
+        if job.origin[0] is not self._stance or job.origin[1] is not self._boundary:
+            # the step it was to follow has changed (a queued command started meanwhile): check it again from
+            # the new end of the walk
+            self.submit(job.command)
+            job = self._job
+            if job is None:  # pragma: no cover - submit always sets a job
+                return
         try:
             plan = _finish(job.planning) if finish else _step(job.planning)
         except ZmpwalkError as error:
@@ -328,8 +337,9 @@ class OnlineWalker:
         yield
         check_reach(stages, self.robot)
         yield
-        first_index = math.ceil(stages[0].start * rate - _EPS)
-        stop_index = math.ceil(next_boundary.time * rate - _EPS)
+        # the samples of these stages, split from the neighbours' exactly as the batch path splits them
+        first_index = first_sample_at(stages[0].start, rate)
+        stop_index = first_sample_at(next_boundary.time, rate)
         rows = np.empty((max(stop_index - first_index, 0), self._width))
         table = StageTable(stages)
         # in slices for submit(); an imported robot's legs in one pass (its base velocities are differences
@@ -392,10 +402,13 @@ class OnlineWalker:
                 # the automatic stop, planned and checked when its step was commanded
                 self._pending = self._current.closing
             plan = self._pending
-            self._pending = None
             if plan is None:
                 self._current = None
                 return None
+            if index < plan.first_index:  # a walk submitted from standstill begins START_DELAY later
+                self._current = None
+                return None
+            self._pending = None
             self._current = plan
             self._stance, self._boundary = plan.stance, plan.boundary
             if plan.boundary.at_rest:

@@ -778,16 +778,17 @@ def _chunks(stages: list[Stage], robot: RobotModel, rate: float, chunk_stages: i
     for first in range(0, len(stages), chunk_stages):
         chunk = stages[first:first + chunk_stages]
         last = first + len(chunk) >= len(stages)
-        begin_index = _first_sample_at(chunk[0].start, rate)
+        begin_index = first_sample_at(chunk[0].start, rate)
         stop_time = stages[min(first + len(chunk), len(stages) - 1)].start
         # the last piece ends where sample_times ends the whole walk
-        stop_index = math.ceil(end * rate - 1e-9) + 1 if last else _first_sample_at(stop_time, rate)
+        stop_index = math.ceil(end * rate - 1e-9) + 1 if last else first_sample_at(stop_time, rate)
         if stop_index > begin_index:
             yield _sampled(chunk, robot, rate, np.arange(begin_index, stop_index) / rate)
 
 
-def _first_sample_at(time: float, rate: float) -> int:
-    """Index of the first sample ``k / rate`` at or after ``time``, compared exactly as the sampled times are."""
+def first_sample_at(time: float, rate: float) -> int:
+    """Index of the first sample ``k / rate`` at or after ``time`` [s], compared exactly as the sampled times are
+    (the sample that :meth:`StageTable.index_at` puts in the stage starting at ``time``)."""
     index = math.ceil(time * rate - 1e-9)
     while index / rate < time:
         index += 1
