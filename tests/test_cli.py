@@ -216,3 +216,9 @@ def test_an_interrupted_write_leaves_no_partial_file(tmp_path):
 def test_a_missing_robot_file_says_no_such_file(capsys):
     assert main(["plan", "--scenario", "fig10", "--robot", "no-such-robot.toml"]) == 2
     assert "no-such-robot.toml: no such file" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("command", [["sweep"], ["tune", "--out", "t.toml"]])
+def test_sweep_and_tune_take_model_options_through_a_robot_file(command, capsys):
+    assert main([*command, "--feet", "left_foot,right_foot"]) == 2
+    assert "write a robot file" in capsys.readouterr().err

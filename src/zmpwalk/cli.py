@@ -433,9 +433,18 @@ def _simulate(args: argparse.Namespace) -> int:
     return 0 if verdict.passed else EXIT_FAILED
 
 
+def _robot_by_name(args: argparse.Namespace) -> None:
+    """Workers load the robot from --robot alone: the model options go into a robot file first."""
+    if args.feet or args.keyframe or args.package_path:
+        raise _UsageError(f"{args.command} loads --robot in every worker: write a robot file with 'zmpwalk robot "
+                          "MODEL --feet ... --keyframe ... --package-path ... --write robot.toml' and give "
+                          "--robot robot.toml")
+
+
 def _sweep(args: argparse.Namespace) -> int:
     import os
 
+    _robot_by_name(args)
     from zmpwalk.sim.sweep import sweep
 
     names = args.scenario or list(list_scenarios())
@@ -473,6 +482,7 @@ def _tune(args: argparse.Namespace) -> int:
     from zmpwalk.files import read_toml
     from zmpwalk.tune import schedule_toml, tune
 
+    _robot_by_name(args)
     if args.workers is not None and args.workers < 1:
         raise _UsageError(f"--workers = {args.workers} must be >= 1")
     data = read_toml(args.schedule) if args.schedule else None
