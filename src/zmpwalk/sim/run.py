@@ -55,7 +55,7 @@ from zmpwalk.sim.plant import (
     set_initial_state,
     static_feedforward,
 )
-from zmpwalk.zmp import batch_hull_margin
+from zmpwalk.zmp import batch_hull_margin, edge_margin
 
 Array = NDArray[np.float64]
 
@@ -209,15 +209,9 @@ def _cop_margins(cop: Array, corners: Array, loaded: NDArray[np.bool_]) -> Array
     single = loaded[:, 0] ^ loaded[:, 1]
     if single.any():
         foot = np.where(loaded[single, 0], 0, 1)
-        quad = corners[single][np.arange(int(single.sum())), foot]  # (m, 4, 2)
-        point = cop[single]
+        quad = corners[single][np.arange(int(single.sum())), foot]  # (m, 4, 2), counter-clockwise
         edge = np.roll(quad, -1, axis=1) - quad
-        length = np.linalg.norm(edge, axis=2)
-        rel = point[:, None, :] - quad
-        inside = (edge[..., 0] * rel[..., 1] - edge[..., 1] * rel[..., 0]) / length
-        along = np.clip(np.sum(rel * edge, axis=2) / length**2, 0.0, 1.0)
-        outside = np.linalg.norm(rel - along[..., None] * edge, axis=2).min(axis=1)
-        margin[single] = np.where(np.all(inside >= 0, axis=1), inside.min(axis=1), -outside)
+        margin[single] = edge_margin(cop[single], quad, edge, np.ones(edge.shape[:2], dtype=bool))
     both = loaded[:, 0] & loaded[:, 1]
     if both.any():
         margin[both] = batch_hull_margin(cop[both], corners[both].reshape(-1, 8, 2))
