@@ -203,3 +203,15 @@ def test_a_sweep_reports_a_walk_its_generator_cannot_plan_instead_of_failing():
 
     (result,) = sweep("hubo", ["turn45"], workers=1, generator="hyperbolic")  # the hyperbolic one walks straight
     assert not result.passed and result.failed == ("planned",) and "turn" in result.error
+
+
+def test_a_sweep_walks_a_tuned_schedule_and_the_quintic_pelvis():
+    from pathlib import Path
+
+    from zmpwalk.sim.sweep import sweep
+
+    tuned = str(Path(__file__).parent.parent / "examples" / "schedule_hubo_tuned.toml")
+    (result,) = sweep("hubo", ["fig28"], workers=1, schedule=tuned)
+    assert result.passed  # open loop on the box model: the paper's tables fail this walk's verdict
+    (quintic,) = sweep("hubo", ["turn45"], workers=1, pelvis="quintic")
+    assert quintic.simulated > 5.0 and not quintic.fell

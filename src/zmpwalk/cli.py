@@ -254,6 +254,9 @@ def _parser() -> argparse.ArgumentParser:
     sweep_cmd.add_argument("--balance", choices=("on", "off"), default=None,
                            help="the stabilizer (default: on for a robot's own model, off for the box models)")
     sweep_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
+    sweep_cmd.add_argument("--schedule", type=Path, help="your own parameter tables (TOML), e.g. from zmpwalk tune")
+    sweep_cmd.add_argument("--pelvis", choices=("cubic", "quintic"), default="cubic",
+                           help="pelvis curves: the paper's cubics, or quintics with a continuous cart-table ZMP")
     sweep_cmd.add_argument("--json", action="store_true", help="print JSON")
     tune_cmd = commands.add_parser(
         "tune", help="tune the shape factors of Tables 2-3 for a robot and write them as a schedule file",
@@ -457,7 +460,9 @@ def _sweep(args: argparse.Namespace) -> int:
     show = None if args.json or not sys.stderr.isatty() else (lambda done, total: _progress("walks", done, total))
     balance = None if args.balance is None else args.balance == "on"
     started, cpu = time.perf_counter(), time.process_time()
-    results = sweep(args.robot, names, balance=balance, workers=workers, progress=show, generator=args.generator)
+    schedule = _schedule(args)  # read here: a bad file is one error, not one per worker
+    results = sweep(args.robot, names, balance=balance, workers=workers, progress=show, generator=args.generator,
+                    schedule=str(args.schedule.resolve()) if schedule is not None else None, pelvis=_pelvis(args))
     wall = time.perf_counter() - started
     walked = sum(r.seconds for r in results)
     if args.json:

@@ -52,8 +52,8 @@ class SweepResult:
     error: str = ""
 
 
-def walk_scenario(robot: str, scenario: str, balance: bool | None = None,
-                  generator: str = "polynomial") -> SweepResult:
+def walk_scenario(robot: str, scenario: str, balance: bool | None = None, generator: str = "polynomial",
+                  schedule: str | None = None, pelvis: str = "cubic") -> SweepResult:
     """Simulate one built-in scenario on a robot (name, robot file or model path) and judge it.
 
     Args:
@@ -61,6 +61,8 @@ def walk_scenario(robot: str, scenario: str, balance: bool | None = None,
         scenario: A built-in scenario name.
         balance: Close the loop with the stabilizer; None: on for a robot's own model, off for a box model.
         generator: The pattern generator's name (:data:`zmpwalk.patterns.GENERATORS`).
+        schedule: A schedule file (e.g. from ``zmpwalk tune``) instead of Tables 2-3.
+        pelvis: ``"cubic"`` or ``"quintic"`` (the polynomial generator's pelvis curves).
     """
     from zmpwalk.balance import Stabilizer
     from zmpwalk.kinematics import pattern_joint_trajectory
@@ -72,8 +74,17 @@ def walk_scenario(robot: str, scenario: str, balance: bool | None = None,
     start = time.perf_counter()
     model = loaded_robot(robot)
     commands, labels = load_scenario_with_labels(scenario)
+    options: dict[str, object] = {}
+    if schedule is not None:
+        from pathlib import Path
+
+        from zmpwalk.schedule import Schedule
+
+        options["schedule"] = Schedule.from_file(Path(schedule))
+    if pelvis != "cubic":
+        options["pelvis"] = pelvis
     try:
-        pattern = pattern_generator(generator)(model, commands, rate=1000.0, labels=labels)
+        pattern = pattern_generator(generator)(model, commands, rate=1000.0, labels=labels, **options)
     except ZmpwalkError as error:  # this walk is not possible with this generator: a result, not a crash
         return SweepResult(scenario=scenario, robot=model.name, passed=False, failed=("planned",), fell=False,
                            distance=math.nan, cop_error_rms=math.nan, simulated=0.0,
@@ -93,7 +104,8 @@ def walk_scenario(robot: str, scenario: str, balance: bool | None = None,
 
 
 def sweep(robot: str, scenarios: Sequence[str], balance: bool | None = None, workers: int | None = None,
-          progress: Callable[[int, int], None] | None = None, generator: str = "polynomial") -> list[SweepResult]:
+          progress: Callable[[int, int], None] | None = None, generator: str = "polynomial",
+          schedule: str | None = None, pelvis: str = "cubic") -> list[SweepResult]:
     """Simulate every scenario on ``robot``, ``workers`` walks at a time (default: one per core).
 
     Returns:
@@ -112,12 +124,12 @@ def sweep(robot: str, scenarios: Sequence[str], balance: bool | None = None, wor
     results: dict[int, SweepResult] = {}
     if workers == 1 or len(scenarios) <= 1:
         for index, name in enumerate(scenarios):
-            results[index] = walk_scenario(robot, name, balance, generator)
+            results[index] = walk_scenario(robot, name, balance, generator, schedule, pelvis)
             if progress:
                 progress(len(results), len(scenarios))
     else:
         with ProcessPoolExecutor(max_workers=min(workers, len(scenarios))) as pool:
-            futures = {pool.submit(walk_scenario, robot, name, balance, generator): index
+            futures = {pool.submit(walk_scenario, robot, name, balance, generator, schedule, pelvis): index
                        for index, name in enumerate(scenarios)}
             for future in as_completed(futures):
                 results[futures[future]] = future.result()
