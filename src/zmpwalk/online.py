@@ -44,7 +44,7 @@ step under way was planned with it.
 from __future__ import annotations
 
 from collections.abc import Generator
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -128,6 +128,13 @@ class _Plan:
     first_index: int
     closing: _Plan | None = None  # the automatic stop after this plan, planned and checked with it
     standing: Array | None = None  # the row of standing still after it, where it ends at rest
+    scalars: list[tuple[str, float, float, float]] = field(default_factory=list)  # per row: support, 3 yaws
+
+
+def _scalars(rows: Array) -> list[tuple[str, float, float, float]]:
+    """Each row's support name and pelvis, left and right yaws as Python values (a tick reads them as they are)."""
+    columns = rows[:, [_SUPPORT, _PELVIS_YAW, _LEFT_YAW, _RIGHT_YAW]].tolist()
+    return [(SUPPORT_NAMES[int(code)], pelvis, left, right) for code, pelvis, left, right in columns]
 
 
 @dataclass
@@ -194,7 +201,7 @@ class OnlineWalker:
         self._pending: _Plan | None = None
         self._job: _Job | None = None
         self._rejection: tuple[StepCommand, ZmpwalkError, Stance, Boundary] | None = None
-        self._standing = self._standing_row(self._stance)
+        self._set_standing(self._standing_row(self._stance))
 
     @property
     def time(self) -> float:
@@ -350,7 +357,8 @@ class OnlineWalker:
             self._sample(table, np.arange(first_index + begin, first_index + end) / rate, rows[begin:end])
             yield
         standing = self._standing_row(next_stance) if next_boundary.at_rest else None
-        return _Plan(command, stages, next_stance, next_boundary, rows, first_index, standing=standing)
+        return _Plan(command, stages, next_stance, next_boundary, rows, first_index, standing=standing,
+                     scalars=_scalars(rows))
 
     def stop(self) -> None:
         """Queue a closing step into the ready posture (nothing happens when standing).
@@ -376,18 +384,22 @@ class OnlineWalker:
             current = self._advance(index)
         self._index = index + 1
         # one copy per tick: the caller's arrays never alias the walker's buffers
-        row = (self._standing if current is None else current.rows[index - current.first_index]).copy()
+        if current is None:
+            row, (support, pelvis_yaw, left_yaw, right_yaw) = self._standing.copy(), self._standing_scalars
+        else:
+            offset = index - current.first_index
+            row, (support, pelvis_yaw, left_yaw, right_yaw) = current.rows[offset].copy(), current.scalars[offset]
         if self._job is not None:
             self._work(finish=False)
         return WalkingSample(
             time=index / self.rate,
-            support=SUPPORT_NAMES[int(row[_SUPPORT])],
+            support=support,
             position_pelvis_in_world=row[_PELVIS],
-            yaw_pelvis_in_world=float(row[_PELVIS_YAW]),
+            yaw_pelvis_in_world=pelvis_yaw,
             position_left_ankle_in_world=row[_LEFT],
-            yaw_left_foot_in_world=float(row[_LEFT_YAW]),
+            yaw_left_foot_in_world=left_yaw,
             position_right_ankle_in_world=row[_RIGHT],
-            yaw_right_foot_in_world=float(row[_RIGHT_YAW]),
+            yaw_right_foot_in_world=right_yaw,
             zmp_in_world=row[_ZMP],
             joint_angles=row[_JOINTS] if self.joints else None,
             joint_velocities=row[_JOINT_RATES] if self.joints else None,
@@ -412,7 +424,7 @@ class OnlineWalker:
             self._current = plan
             self._stance, self._boundary = plan.stance, plan.boundary
             if plan.boundary.at_rest:
-                self._standing = plan.standing if plan.standing is not None else self._standing_row(plan.stance)
+                self._set_standing(plan.standing if plan.standing is not None else self._standing_row(plan.stance))
             if index < plan.first_index + len(plan.rows):
                 return plan
 
@@ -444,6 +456,10 @@ class OnlineWalker:
             self.robot)
         rows[:, _JOINTS] = trajectory.angles
         rows[:, _JOINT_RATES] = trajectory.velocities
+
+    def _set_standing(self, row: Array) -> None:
+        self._standing = row
+        self._standing_scalars = _scalars(row[None, :])[0]
 
     def _standing_row(self, stance: Stance) -> Array:
         middle = np.array([(stance.left.x + stance.right.x) / 2, (stance.left.y + stance.right.y) / 2])
