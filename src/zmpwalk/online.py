@@ -31,8 +31,9 @@ Behaviour:
 **Inside a hard real-time loop** use :meth:`OnlineWalker.submit` instead of
 :meth:`~OnlineWalker.command`: it only stores the command (microseconds), and
 the same whole check (the step and its stop, every sample at the control rate)
-runs in slices of :data:`SLICE_ROWS` samples, one slice per tick, while the
-step under way goes on. The command is queued when its check completes, or its
+runs in slices (the plan, the reach check, then :data:`SLICE_ROWS` samples of the
+pattern and, in the next tick, of the legs), one slice per tick, while the step
+under way goes on. The command is queued when its check completes, or its
 rejection is kept in :attr:`OnlineWalker.rejection` (no tick ever raises). A
 walk submitted from standstill starts :data:`START_DELAY` later, by which time
 it is checked. Should a step end before the check of the next command is done
@@ -81,8 +82,8 @@ _JOINTS, _JOINT_RATES = slice(15, 27), slice(27, 39)
 _WIDTH = 15
 _WIDTH_WITH_JOINTS = 39
 _EPS = 1e-9
-SLICE_ROWS = 100  # samples planned per tick by submit()'s check (one vectorised pass, about 0.5 ms)
-START_DELAY = 0.1  # [s] a walk submitted from standstill starts this much later (its check is done by then)
+SLICE_ROWS = 100  # samples per slice of submit()'s check: the pattern in one tick, the legs in the next
+START_DELAY = 0.2  # [s] a walk submitted from standstill starts this much later (its check is done by then)
 HINT_RATE = 100.0  # [Hz] sampling of the search for the largest stride that fits, in a rejection
 HINT_CONFIRMATIONS = 5  # tries at the control rate, each HINT_SHRINK smaller
 HINT_SHRINK = 0.98
@@ -352,13 +353,21 @@ class OnlineWalker:
         # in slices for submit(); an imported robot's legs in one pass (its base velocities are differences
         # along the step)
         size = SLICE_ROWS if sliced and self.robot.legs is None else max(len(rows), 1)
+        scalars: list[tuple[str, float, float, float]] = []
         for begin in range(0, len(rows), size):
             end = min(begin + size, len(rows))
-            self._sample(table, np.arange(first_index + begin, first_index + end) / rate, rows[begin:end])
+            samples = self._sample(table, np.arange(first_index + begin, first_index + end) / rate, rows[begin:end])
+            scalars += _scalars(rows[begin:end])
+            if self.joints:  # the pattern, then the legs: two slices of about equal cost
+                yield
+                self._fill_joints(rows[begin:end], samples)
             yield
-        standing = self._standing_row(next_stance) if next_boundary.at_rest else None
+        standing = None
+        if next_boundary.at_rest:  # the row of standing still (one IK) in a slice of its own
+            standing = self._standing_row(next_stance)
+            yield
         return _Plan(command, stages, next_stance, next_boundary, rows, first_index, standing=standing,
-                     scalars=_scalars(rows))
+                     scalars=scalars)
 
     def stop(self) -> None:
         """Queue a closing step into the ready posture (nothing happens when standing).
@@ -428,13 +437,9 @@ class OnlineWalker:
             if index < plan.first_index + len(plan.rows):
                 return plan
 
-    def _sample(self, table: StageTable, times: Array, rows: Array) -> None:
-        """Fill ``rows`` with the pattern (and the legs) at ``times`` [s]."""
-        if len(times) == 0:
-            return
+    def _sample(self, table: StageTable, times: Array, rows: Array) -> Samples:
+        """Fill ``rows`` with the pattern at ``times`` [s] (the legs: :meth:`_fill_joints`)."""
         samples = evaluate(table, times, self.robot)
-        if self.joints:
-            self._fill_joints(rows, samples)
         rows[:, 0:2] = samples.pelvis_xy
         rows[:, 2] = self.robot.pelvis_height
         rows[:, _PELVIS_YAW] = samples.pelvis_yaw
@@ -444,6 +449,7 @@ class OnlineWalker:
         rows[:, _RIGHT_YAW] = samples.right_yaw
         rows[:, _ZMP] = samples.zmp_xy
         rows[:, _SUPPORT] = samples.support
+        return samples
 
     def _fill_joints(self, rows: Array, samples: Samples) -> None:
         n = len(samples.time)
