@@ -32,7 +32,7 @@ from zmpwalk.robots.model import RobotModel
 from zmpwalk.scenarios import list_scenarios, load_scenario_with_labels, load_steps_file_with_labels
 from zmpwalk.schedule import Schedule
 from zmpwalk.sim.motors import Motor
-from zmpwalk.sim.sweep import HOLD, SETTLE
+from zmpwalk.sim.verdict import HOLD, SETTLE
 from zmpwalk.tables import condition_margins, margins_markdown
 
 if TYPE_CHECKING:

@@ -217,8 +217,7 @@ def walk(robot: RobotModel, data: dict[str, Any], condition: Condition, steps: i
     from zmpwalk.patterns.polynomial import generate
     from zmpwalk.sim.actuators import actuator_table
     from zmpwalk.sim.run import simulate
-    from zmpwalk.sim.sweep import HOLD, SETTLE
-    from zmpwalk.sim.verdict import walk_verdict
+    from zmpwalk.sim.verdict import HOLD, SETTLE, walk_verdict
 
     try:
         pattern = generate(robot, [condition_command(robot, condition)] * steps, rate=RATE,

@@ -35,7 +35,7 @@ from zmpwalk.sim.actuators import (
 )
 from zmpwalk.sim.motors import Motor, MotorFit, motor_fits
 from zmpwalk.sim.run import simulate, write_result_csv
-from zmpwalk.sim.verdict import Verdict, walk_verdict
+from zmpwalk.sim.verdict import HOLD, SETTLE, Verdict, walk_verdict
 
 Progress = Callable[[str, int, int], None]
 STAGES = ("pattern", "joints", "simulation", "plots", "animation", "page")
@@ -74,8 +74,6 @@ def step_margins(pattern: WalkingPattern) -> list[tuple[int, str, str, float, fl
     return rows
 
 
-SETTLE = 0.5  # [s] standing before the walk in the report's simulation
-HOLD = 2.0  # [s] standing after it: does the robot end standing still?
 
 
 def build_report(

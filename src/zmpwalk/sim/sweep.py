@@ -18,9 +18,7 @@ from dataclasses import dataclass
 
 from zmpwalk.errors import InvalidParameterError, ZmpwalkError
 from zmpwalk.robots import loaded_robot
-
-SETTLE = 0.5  # [s] standing before a simulated walk
-HOLD = 2.0  # [s] standing after it (the verdict judges how it ends)
+from zmpwalk.sim.verdict import HOLD, SETTLE
 
 
 @dataclass(frozen=True)
