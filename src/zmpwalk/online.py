@@ -266,8 +266,12 @@ class OnlineWalker:
 
     @property
     def rejection(self) -> ZmpwalkError | None:
-        """Why the last submitted command was rejected (None: no rejection since the last submit),
-        with the largest stride that fits where the legs are the cause (computed when read)."""
+        """Why the last submitted command was rejected (None: no rejection since the last submit).
+
+        Where the legs are the cause, the error names the largest stride that fits, searched by bisection
+        the first time this is read (tens of milliseconds): read it outside the hard real-time part of the
+        loop, e.g. when :attr:`checking` has become None without the command being :attr:`queued`.
+        """
         if self._rejection is None:
             return None
         command, error, stance, boundary = self._rejection
