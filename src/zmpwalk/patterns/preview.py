@@ -148,18 +148,19 @@ def track(gains: PreviewGains, reference: Array, start: Array) -> tuple[Array, A
     x0, x1, x2 = (float(v) for v in start)
     t = gains.period
     t2, t3 = t * t / 2, t**3 / 6
-    states = np.empty((n, 3))
-    zmp = np.empty(n)
     cz = float(gains.c[2])
     error_sum = 0.0
-    for k in range(n):  # three states in plain floats: the recursion is sequential
-        states[k] = x0, x1, x2
+    states: list[tuple[float, float, float]] = []
+    zmp: list[float] = []
+    # the recursion is sequential: plain floats and lists, no numpy scalar in the loop
+    for reference_k, future_k in zip(reference.tolist(), future.tolist(), strict=True):
+        states.append((x0, x1, x2))
         p = x0 + cz * x2
-        zmp[k] = p
-        error_sum += p - reference[k]
-        u = -gi * error_sum - (gx0 * x0 + gx1 * x1 + gx2 * x2) - future[k]
+        zmp.append(p)
+        error_sum += p - reference_k
+        u = -gi * error_sum - (gx0 * x0 + gx1 * x1 + gx2 * x2) - future_k
         x0, x1, x2 = x0 + t * x1 + t2 * x2 + t3 * u, x1 + t * x2 + t2 * u, x2 + t * u
-    return states, zmp
+    return np.array(states).reshape(n, 3), np.array(zmp)
 
 
 def zmp_reference(pattern: WalkingPattern, hold: float = 0.0) -> Array:
