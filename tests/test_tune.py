@@ -63,3 +63,18 @@ def test_bad_tuning_input_is_one_clear_error(tmp_path, capsys):
         tune("hubo", conditions=[Condition("forward", 0.6, 0.2)])
     assert main(["tune", "--robot", "hubo", "--out", str(tmp_path / "t.toml"), "--workers", "0"]) == 2
     assert "--workers = 0" in capsys.readouterr().err
+
+
+def test_without_optuna_tuning_says_how_to_get_it(monkeypatch):
+    import builtins
+
+    real_import = builtins.__import__
+
+    def no_optuna(name, *args, **kwargs):
+        if name == "optuna" or name.startswith("optuna."):
+            raise ImportError(name)
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", no_optuna)
+    with pytest.raises(ZmpwalkError, match=r"pip install 'zmpwalk\[tune\]'"):
+        tune("hubo", trials=1)
