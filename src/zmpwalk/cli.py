@@ -499,11 +499,9 @@ def _tune(args: argparse.Namespace) -> int:
     wall = time.perf_counter() - started
     write_text(args.out, schedule_toml(result, args.robot) + "\n")
     if args.json:
-        rows = [{"condition": vars(r.condition), "values": r.values, "table": r.table, "cart_margin": r.cart_margin,
-                 "multibody_margin": r.multibody_margin, "table_cart_margin": r.table_cart_margin,
-                 "table_multibody_margin": r.table_multibody_margin, "walks": r.walks, "table_walks": r.table_walks,
-                 "attitude": r.attitude, "peak_torque": r.peak_torque, "trials": r.trials, "seconds": r.seconds}
-                for r in result.results]
+        from dataclasses import asdict
+
+        rows = [asdict(r) for r in result.results]
         print(json.dumps(_json_safe({"seconds": wall, "out": str(args.out), "conditions": rows}), indent=2,
                          allow_nan=False))
     else:

@@ -81,7 +81,6 @@ _ZMP, _SUPPORT = slice(12, 14), 14
 _JOINTS, _JOINT_RATES = slice(15, 27), slice(27, 39)
 _WIDTH = 15
 _WIDTH_WITH_JOINTS = 39
-_EPS = 1e-9
 SLICE_ROWS = 100  # samples per slice of submit()'s check: the pattern in one tick, the legs in the next
 START_DELAY = 0.2  # [s] a walk submitted from standstill starts this much later (its check is done by then)
 HINT_RATE = 100.0  # [Hz] sampling of the search for the largest stride that fits, in a rejection

@@ -34,7 +34,6 @@ import math
 import os
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -44,9 +43,11 @@ import numpy as np
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import InvalidParameterError, ZmpwalkError
 from zmpwalk.files import read_toml
+from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots import loaded_robot
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
+from zmpwalk.sim.sweep import in_pool
 
 FORWARD_RANGES = {"sway": (0.02, 0.06), "alpha": (1.0, 2.2), "up_ratio": (0.3, 0.6)}  # [m], [-], [-]
 SIDE_RANGES = {"sway": (0.02, 0.06), "up_ratio": (0.3, 0.6), "alpha1": (0.6, 1.2), "beta1": (0.6, 1.2),
@@ -186,15 +187,25 @@ def condition_command(robot: RobotModel, condition: Condition) -> StepCommand:
     return StepCommand(duration, side=condition.stride * lateral_scale)
 
 
+def condition_walk(robot: RobotModel, data: dict[str, Any], condition: Condition, steps: int) -> WalkingPattern:
+    """``steps`` steps of a condition from standstill to standstill at 1 kHz with the schedule ``data``.
+
+    Raises:
+        ZmpwalkError: The walk cannot be planned.
+    """
+    from zmpwalk.patterns.polynomial import generate
+
+    return generate(robot, [condition_command(robot, condition)] * steps, rate=RATE,
+                    schedule=Schedule(data, "<candidate>"))
+
+
 def margins(robot: RobotModel, data: dict[str, Any], condition: Condition, steps: int) -> tuple[float, float]:
     """Smallest cart-table and multibody ZMP margins [m] of ``steps`` steps of a condition at 1 kHz (multibody:
     nan without link masses; -inf where the walk cannot be planned)."""
     from zmpwalk.dynamics import compare_zmp
-    from zmpwalk.patterns.polynomial import generate
 
     try:
-        pattern = generate(robot, [condition_command(robot, condition)] * steps, rate=RATE,
-                           schedule=Schedule(data, "<candidate>"))
+        pattern = condition_walk(robot, data, condition, steps)
     except ZmpwalkError:
         return -math.inf, -math.inf
     cart = float(np.nanmin(pattern.zmp_margin()))
@@ -214,14 +225,12 @@ def walk(robot: RobotModel, data: dict[str, Any], condition: Condition, steps: i
     """Walk a condition in MuJoCo: (passes, largest torso roll or pitch [rad], largest held torque [N m])."""
     from zmpwalk.balance import Stabilizer
     from zmpwalk.kinematics import pattern_joint_trajectory
-    from zmpwalk.patterns.polynomial import generate
     from zmpwalk.sim.actuators import actuator_table
     from zmpwalk.sim.run import simulate
     from zmpwalk.sim.verdict import HOLD, SETTLE, walk_verdict
 
     try:
-        pattern = generate(robot, [condition_command(robot, condition)] * steps, rate=RATE,
-                           schedule=Schedule(data, "<candidate>"))
+        pattern = condition_walk(robot, data, condition, steps)
         joints = pattern_joint_trajectory(pattern, check_limits=False)
     except ZmpwalkError:
         return False, math.inf, math.inf
@@ -320,15 +329,8 @@ def tune(robot: str, trials: int = 40, seed: int = 0, workers: int | None = None
     # pass 1: the stride-0 rows, which start and stop every walk; pass 2: the others, walked with them
     first_pass = [i for i, c in enumerate(grid) if c.mode == "forward" and c.stride == 0.0]
     for indices in (first_pass, [i for i in range(len(grid)) if i not in first_pass]):
-        arguments = {i: (robot, data, grid[i], i, trials, seed, steps, url) for i in indices}
-        if workers == 1 or len(indices) <= 1:
-            for index, args in arguments.items():
-                record(index, tune_condition(*args))
-        else:
-            with ProcessPoolExecutor(max_workers=min(workers, len(indices))) as pool:
-                futures = {pool.submit(tune_condition, *args): index for index, args in arguments.items()}
-                for future in as_completed(futures):
-                    record(futures[future], future.result())
+        in_pool(tune_condition, {i: (robot, data, grid[i], i, trials, seed, steps, url) for i in indices}, workers,
+                record)
         for index in indices:
             data = with_row(data, grid[index], results[index].values)
     return TuneResult(data, [results[index] for index in range(len(grid))])

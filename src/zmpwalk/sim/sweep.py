@@ -15,10 +15,13 @@ import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
+from typing import Any, TypeVar
 
 from zmpwalk.errors import InvalidParameterError, ZmpwalkError
 from zmpwalk.robots import loaded_robot
 from zmpwalk.sim.verdict import HOLD, SETTLE
+
+T = TypeVar("T")
 
 
 @dataclass(frozen=True)
@@ -101,6 +104,20 @@ def walk_scenario(robot: str, scenario: str, balance: bool | None = None, genera
     )
 
 
+def in_pool(function: Callable[..., T], arguments: dict[int, tuple[Any, ...]], workers: int,
+            record: Callable[[int, T], None]) -> None:
+    """``function(*arguments[i])`` for every ``i``, ``workers`` at a time in worker processes (in this process
+    when one worker or one call), each result handed to ``record(i, result)`` as it comes."""
+    if workers == 1 or len(arguments) <= 1:
+        for index, args in arguments.items():
+            record(index, function(*args))
+        return
+    with ProcessPoolExecutor(max_workers=min(workers, len(arguments))) as pool:
+        futures = {pool.submit(function, *args): index for index, args in arguments.items()}
+        for future in as_completed(futures):
+            record(futures[future], future.result())
+
+
 def sweep(robot: str, scenarios: Sequence[str], balance: bool | None = None, workers: int | None = None,
           progress: Callable[[int, int], None] | None = None, generator: str = "polynomial",
           schedule: str | None = None, pelvis: str = "cubic") -> list[SweepResult]:
@@ -120,17 +137,12 @@ def sweep(robot: str, scenarios: Sequence[str], balance: bool | None = None, wor
         raise InvalidParameterError("workers", workers, "an integer >= 1")
     loaded_robot(robot)  # a bad robot is one error here, not one per worker
     results: dict[int, SweepResult] = {}
-    if workers == 1 or len(scenarios) <= 1:
-        for index, name in enumerate(scenarios):
-            results[index] = walk_scenario(robot, name, balance, generator, schedule, pelvis)
-            if progress:
-                progress(len(results), len(scenarios))
-    else:
-        with ProcessPoolExecutor(max_workers=min(workers, len(scenarios))) as pool:
-            futures = {pool.submit(walk_scenario, robot, name, balance, generator, schedule, pelvis): index
-                       for index, name in enumerate(scenarios)}
-            for future in as_completed(futures):
-                results[futures[future]] = future.result()
-                if progress:
-                    progress(len(results), len(scenarios))
+
+    def record(index: int, result: SweepResult) -> None:
+        results[index] = result
+        if progress:
+            progress(len(results), len(scenarios))
+
+    in_pool(walk_scenario, {index: (robot, name, balance, generator, schedule, pelvis)
+                            for index, name in enumerate(scenarios)}, workers, record)
     return [results[index] for index in range(len(scenarios))]
