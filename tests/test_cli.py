@@ -120,6 +120,7 @@ def test_plan_with_the_hyperbolic_generator(tmp_path, capsys):
     ("duration = 0.08\nforward = 0.1", "duration = 0.08 is not allowed; expected a value in [0.1, 5] s"),
     ("duration = 0.3\nforward = 0.3", "duration = 0.3 is not allowed; expected a step time >= 0.340 s"),
     ("duration = 0.8\nfoot_lift = 0.5", "foot_lift = 0.5 is not allowed; expected a swing apex in [0, 0.2"),
+    ("duration = 0.5\nlateral_velocity = 1.0", "lateral_velocity = 1 is not allowed; expected a V_y in [0, 0.39"),
     ("duration = nan", "duration = nan"),
     ("duration = 0.8\nforward = 0.9", "out of reach"),
     ("duration = 0.8\nup_ratio = 1.5", "up_ratio = 1.5"),

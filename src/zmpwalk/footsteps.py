@@ -236,6 +236,7 @@ def _rectangles_overlap(a: np.ndarray, b: np.ndarray) -> bool:
     return True
 
 
+SWAY_SPEED_FRACTION = 0.5  # [-] the pelvis sways at most this fraction of the swing foot's speed limit
 SMOOTHSTEP_PEAK_SLOPE = 15.0 / 8.0  # [-] max of d/dx (10x^3 - 15x^4 + 6x^5), at x = 1/2
 SMOOTHSTEP_PEAK_CURVATURE = 10.0 / math.sqrt(3.0)  # [-] max of its second derivative, at x = (3 -+ sqrt 3)/6
 
@@ -266,10 +267,20 @@ def check_swing(stage: StagePlan, robot: RobotModel, command: StepCommand) -> No
     """Reject a swing faster than the robot's foot speed or acceleration limit, or lifted too high.
 
     Raises:
-        InvalidParameterError: Names ``foot_lift`` (apex above :attr:`RobotModel.max_foot_lift`) or
-            ``duration`` with the shortest step time this swing allows.
+        InvalidParameterError: Names ``foot_lift`` (apex above :attr:`RobotModel.max_foot_lift`),
+            ``lateral_velocity`` (the pelvis swaying faster than :data:`SWAY_SPEED_FRACTION` of the foot
+            speed limit) or ``duration`` with the shortest step time this swing allows.
     """
     parameters = stage.parameters
+    # Eq. 20: the pelvis crosses the step change at alpha1 V_y over the returning sway cubic's time (1 - d1) T / 2
+    back_time = (1.0 - parameters.d1) * stage.duration / 2.0
+    sway_speed_limit = SWAY_SPEED_FRACTION * robot.max_foot_speed
+    if parameters.alpha1 * parameters.lateral_velocity > sway_speed_limit * back_time:
+        raise InvalidParameterError(
+            "lateral_velocity", parameters.lateral_velocity,
+            f"a V_y in [0, {sway_speed_limit * back_time / max(parameters.alpha1, 1e-12):.3f}] m for this step "
+            f"(alpha1 {parameters.alpha1:g}, d1 {parameters.d1:g}, {stage.duration:g} s): the pelvis sways at most "
+            f"{sway_speed_limit:.2f} m/s, half the robot's foot speed limit")
     if parameters.foot_lift > robot.max_foot_lift:
         raise InvalidParameterError(
             "foot_lift", parameters.foot_lift,
