@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, NoReturn
 import numpy as np
 
 from zmpwalk.commands import StepCommand
-from zmpwalk.errors import ZmpwalkError
+from zmpwalk.errors import InvalidParameterError, ZmpwalkError
 from zmpwalk.files import write_text
 from zmpwalk.kinematics import pattern_joint_trajectory
 from zmpwalk.patterns import GENERATORS, generator
@@ -617,12 +617,20 @@ def _run(args: argparse.Namespace) -> int:
 
         args.robot = args.model
         robot = _load_robot(args)
+        statics, no_statics = None, ""
+        if robot.plant is not None:
+            from zmpwalk.sim.statics import static_torques
+
+            try:
+                statics = static_torques(robot)
+            except InvalidParameterError as error:  # e.g. leg joints without position servos
+                no_statics = f"\nstatic torques not computed: {error}"
         if args.write:
             write_text(args.write, robot_toml(robot, args.write.parent))
         if args.json:
-            print(json.dumps(_json_safe(robot_summary(robot)), indent=2, allow_nan=False))
+            print(json.dumps(_json_safe(robot_summary(robot, statics)), indent=2, allow_nan=False))
         else:
-            print(robot_table(robot) + (f"\nwritten: {args.write}" if args.write else ""))
+            print(robot_table(robot, statics) + no_statics + (f"\nwritten: {args.write}" if args.write else ""))
         return 0
     if args.command == "hyperbolic":
         result = paper_example()

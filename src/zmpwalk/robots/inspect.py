@@ -5,14 +5,22 @@ from __future__ import annotations
 import math
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from zmpwalk.kinematics import JOINT_COLUMNS
 from zmpwalk.robots.model import RobotModel
 
+if TYPE_CHECKING:
+    from zmpwalk.sim.statics import StaticTorques
 
-def robot_summary(robot: RobotModel) -> dict[str, Any]:
-    """The derived values as plain data (SI units: m, kg, rad, N m)."""
+
+def robot_summary(robot: RobotModel, statics: StaticTorques | None = None) -> dict[str, Any]:
+    """The derived values as plain data (SI units: m, kg, rad, N m).
+
+    Args:
+        statics: The static torques of the ready posture (:func:`zmpwalk.sim.statics.static_torques`), listed
+            per joint when given.
+    """
     summary: dict[str, Any] = {
         "name": robot.name, "description": robot.description, "mass": robot.mass, "height": robot.height,
         "hips": {side: list(robot.hip_in_pelvis(s)) for side, s in (("left", 1), ("right", -1))},
@@ -47,6 +55,11 @@ def robot_summary(robot: RobotModel) -> dict[str, Any]:
                  "name": joint.actuator.name, "kind": joint.actuator.kind, "kp": joint.actuator.kp,
                  "kv": joint.actuator.kv, "force_limit": joint.actuator.force_limit}}
             for column, joint in zip(JOINT_COLUMNS, plant.joints, strict=True)]
+        if statics is not None:
+            for i, joint in enumerate(summary["joints"]):
+                joint["static_torque"] = {"both_feet": float(statics.both_feet[i]),
+                                          "on_left": float(statics.on_left[i]), "on_right": float(statics.on_right[i])}
+            summary["static_torque_over_limit"] = statics.over_limit
     return summary
 
 
@@ -54,9 +67,10 @@ def _mm(value: float) -> str:
     return f"{value * 1e3:+.1f}"
 
 
-def robot_table(robot: RobotModel) -> str:
-    """The derived values as a table (lengths in mm for reading; the files and JSON are in SI)."""
-    s = robot_summary(robot)
+def robot_table(robot: RobotModel, statics: StaticTorques | None = None) -> str:
+    """The derived values as a table (lengths in mm for reading; the files and JSON are in SI), with the static
+    torques of the ready posture where ``statics`` is given."""
+    s = robot_summary(robot, statics)
     lines = [f"{robot.name}: {robot.description}"]
     if "model" in s:
         lines.append(f"model {s['model']}; base {s['base_body']!r}; feet {s['feet'][0]!r}, {s['feet'][1]!r}; "
@@ -79,15 +93,24 @@ def robot_table(robot: RobotModel) -> str:
                                         f"{s['ankle_axes_offset'][k] * 1e3:.1f} mm)" for k, v in s["ik"].items()))
         lines.append("")
         header = (f"{'column':<18} {'model joint':<22} {'axis':<16} {'sign':>4} {'zero':>7} {'range [rad]':>17} "
-                  f"{'actuator':<9} {'kp':>8} {'kv':>7} {'max [N m]':>9}")
+                  f"{'actuator':<9} {'kp':>8} {'kv':>7} {'max [N m]':>9}"
+                  + (f" {'2 feet':>7} {'1 foot':>7}" if statics is not None else ""))
         lines += [header, "-" * len(header)]
+        first = len(lines)
         for joint in s["joints"]:
             actuator = joint["actuator"] or {"kind": "none", "kp": math.nan, "kv": math.nan, "force_limit": math.nan}
             axis = "(" + ", ".join(f"{v:+.2f}" for v in joint["axis"]) + ")"
             lines.append(f"{joint['column']:<18} {joint['name']:<22} {axis:<16} {joint['sign']:>+4d} "
                          f"{joint['zero_offset']:>+7.3f} [{joint['limits'][0]:>+7.3f}, {joint['limits'][1]:>+7.3f}] "
                          f"{actuator['kind']:<9} {actuator['kp']:>8.1f} {actuator['kv']:>7.2f} "
-                         f"{actuator['force_limit']:>9.1f}")
+                         f"{actuator['force_limit']:>9.1f}"
+                         + (f" {abs(statics.both_feet[len(lines) - first]):>7.1f} "
+                            f"{statics.one_foot[len(lines) - first]:>7.1f}" if statics is not None else ""))
+        if statics is not None:
+            lines.append("2 feet, 1 foot: static torque [N m] holding the ready posture on both feet, and on one foot "
+                         "with the centre of mass over its sole (the larger of the two feet)")
+            over = statics.over_limit
+            lines.append("over the actuator's limit standing still: " + (", ".join(over) if over else "none"))
         if s["held_joints"]:
             lines.append(f"held at the reference pose: {', '.join(s['held_joints'])}")
     return "\n".join(lines)

@@ -1,0 +1,83 @@
+"""Static joint torques of the ready posture (``zmpwalk.sim.statics``) against the moment of the bodies a joint
+holds up, summed body by body from MuJoCo's own masses and positions."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from zmpwalk.errors import InvalidParameterError
+from zmpwalk.kinematics import JOINT_COLUMNS
+from zmpwalk.robots import load_robot
+from zmpwalk.sim.plant import build_plant
+from zmpwalk.sim.statics import static_torques
+
+ROBOTS = Path(__file__).resolve().parents[2] / "shared" / "robots"
+TALOS = ROBOTS / "pal_talos" / "scene_position.xml"
+T1 = ROBOTS / "booster_t1" / "scene.xml"
+needs_robots = pytest.mark.skipif(not TALOS.is_file() or not T1.is_file(), reason="../shared/robots is absent")
+TORQUE_TOL = 1e-6  # [N m]
+
+
+def held_moments(model: mujoco.MjModel, qpos: np.ndarray, joints: list[str], stance: bool) -> np.ndarray:
+    """Torque about each joint's axis [N m]: on the stance leg, the gravity moment of every body *not* below
+    the joint (the foot carries the robot); on the unloaded leg, minus that of the bodies below it."""
+    data = mujoco.MjData(model)
+    data.qpos[:] = qpos
+    mujoco.mj_kinematics(model, data)
+    gravity = model.opt.gravity
+    result = []
+    for name in joints:
+        joint = model.joint(name).id
+        below = {b for b in range(1, model.nbody) if _descends(model, b, int(model.jnt_bodyid[joint]))}
+        bodies = [b for b in range(1, model.nbody) if (b not in below) == stance]
+        moment = sum((np.cross(data.xipos[b] - data.xanchor[joint], model.body_mass[b] * gravity)
+                      for b in bodies), np.zeros(3))
+        result.append(float((1.0 if stance else -1.0) * data.xaxis[joint] @ moment))
+    return np.array(result)
+
+
+def _descends(model: mujoco.MjModel, body: int, ancestor: int) -> bool:
+    while body > 0:
+        if body == ancestor:
+            return True
+        body = int(model.body_parentid[body])
+    return False
+
+
+@needs_robots
+@pytest.mark.parametrize("path", [TALOS, T1], ids=["talos", "t1"])
+def test_one_foot_torques_are_the_moment_of_what_each_joint_holds(path: Path) -> None:
+    robot = load_robot(path)
+    assert robot.plant is not None
+    statics = static_torques(robot)
+    model = build_plant(robot).model
+    names = [joint.name for joint in robot.plant.joints]
+    for row, torques, stance_leg in ((1, statics.on_left, 0), (2, statics.on_right, 1)):
+        for leg in (0, 1):
+            columns = slice(6 * leg, 6 * leg + 6)
+            expected = held_moments(model, statics.poses[row], names[columns], stance=leg == stance_leg)
+            assert torques[columns] == pytest.approx(expected, abs=TORQUE_TOL)
+    # standing on both feet the two legs mirror each other (the models are symmetric to 1 mm)
+    mirror = np.array([-1, -1, 1, 1, 1, -1] * 2)
+    assert statics.both_feet[6:] == pytest.approx(statics.both_feet[:6] * mirror[:6], abs=0.5)
+
+
+@needs_robots
+def test_t1_one_foot_torques_and_limits() -> None:
+    statics = static_torques(load_robot(T1))
+    column = {name: i for i, name in enumerate(JOINT_COLUMNS)}
+    # Booster T1's pitch-roll-yaw hip: the sideways moment of ~26 kg lands on its 30 N m hip roll and yaw.
+    assert abs(statics.on_right[column["right_hip_roll"]]) == pytest.approx(24.75, abs=0.05)
+    assert abs(statics.on_right[column["right_hip_yaw"]]) == pytest.approx(25.40, abs=0.05)
+    assert statics.limits[column["right_hip_roll"]] == pytest.approx(30.0)
+    assert statics.over_limit == []
+    assert statics.one_foot == pytest.approx(np.maximum(np.abs(statics.on_left), np.abs(statics.on_right)))
+
+
+def test_box_models_are_refused() -> None:
+    with pytest.raises(InvalidParameterError, match="imported from its MJCF or URDF"):
+        static_torques(load_robot("hubo"))
