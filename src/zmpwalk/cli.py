@@ -202,6 +202,9 @@ def _parser() -> argparse.ArgumentParser:
     _balance_options(simulate_cmd)
     simulate_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
     simulate_cmd.add_argument("--mass-scale", type=float, default=1.0, help="multiply every mass (default 1)")
+    simulate_cmd.add_argument("--zmp-correction", action="store_true",
+                              help="move the pelvis until the multibody ZMP (Eq. 3) follows the planned ZMP "
+                              "(box models with [bodies]; off by default: docs/balance.md)")
     simulate_cmd.add_argument("--out", type=Path, help="folder for the result files")
     simulate_cmd.add_argument("--json", action="store_true", help="print a JSON summary")
 
@@ -380,6 +383,12 @@ def _simulate(args: argparse.Namespace) -> int:
         options = _pattern_options(args)
         with _source(_label(args)):
             pattern = make(robot, commands, rate=1000.0, labels=labels, **options)
+    correction = None
+    if args.zmp_correction:
+        from zmpwalk.patterns.correction import correct_pattern
+
+        correction = correct_pattern(pattern)
+        pattern = correction.pattern
     if show:
         show(stages[1], 1, len(stages))
     joints = pattern_joint_trajectory(pattern, check_limits=False)
@@ -406,6 +415,9 @@ def _simulate(args: argparse.Namespace) -> int:
         "final_feet_error": result.final_feet_error, "final_feet_yaw_error": result.final_feet_yaw_error,
         "end_min_sole_force": result.end_min_sole_force, "end_max_speed": result.end_max_speed,
         "end_attitude_range": result.end_attitude_range, "verdict": verdict.as_dict(),
+        "zmp_correction": None if correction is None else {
+            "passes": correction.passes, "multibody_error_rms_before": correction.before.rms,
+            "multibody_error_rms_after": correction.after.rms},
         "motors": [{"joint": f.joint, "motor": f.motor, "rms_use": f.rms_use, "peak_use": f.peak_use,
                     "fits": f.fits} for f in fits],
         "actuators": [vars(row) for row in rows],
@@ -421,6 +433,9 @@ def _simulate(args: argparse.Namespace) -> int:
         state = f"FELL at t = {result.fall_time:.3f} s" if result.fell else "walked to the end without falling"
         print(f"{robot.name}: {state}; distance {result.distance:.3f} m, average speed "
               f"{result.average_speed * 1e3:.1f} mm/s, foot slip {result.foot_slip * 1e3:.1f} mm")
+        if correction is not None:
+            print(f"multibody ZMP - planned ZMP: RMS {correction.before.rms * 1e3:.1f} mm as generated, "
+                  f"{correction.after.rms * 1e3:.1f} mm corrected (passes kept: {correction.passes})")
         print(f"CoP - reference ZMP: RMS {rms * 1e3:.1f} mm, max {largest * 1e3:.1f} mm; "
               f"min CoP margin {summary['min_cop_margin'] * 1e3:+.1f} mm")  # type: ignore[operator]
         top = max(rows, key=lambda r: r.peak_torque)

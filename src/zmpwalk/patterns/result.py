@@ -115,6 +115,9 @@ class WalkingPattern:
         zmp_in_world: Cart-table ZMP (Eqs. 1-2) [m], (n, 2).
         steps: The swings, in order.
         support_phases: Support polygons over time.
+        position_com_in_world: Whole-body centre of mass [m], (n, 3), where it differs from the pelvis point
+            and is known (a box model's pattern corrected by its multibody ZMP,
+            :func:`zmpwalk.patterns.correction.correct_pattern`); None: the pelvis point stands for it.
     """
 
     robot: RobotModel
@@ -137,6 +140,7 @@ class WalkingPattern:
     zmp_in_world: Array
     steps: list[StepRecord]
     support_phases: list[SupportPhase]
+    position_com_in_world: Array | None = None  # [m]
     _polygons: list[Array] | None = field(default=None, init=False, repr=False, compare=False)
 
     @property

@@ -512,8 +512,9 @@ def _closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabi
     n = len(pattern_time)
     time = pattern_time if time is None else time
     interp = np.interp
-    com = np.column_stack([interp(pattern_time, pattern.time, pattern.position_pelvis_in_world[:, i])
-                           for i in range(3)])
+    planned_com = (pattern.position_pelvis_in_world if pattern.position_com_in_world is None
+                   else pattern.position_com_in_world)
+    com = np.column_stack([interp(pattern_time, pattern.time, planned_com[:, i]) for i in range(3)])
     yaw = interp(pattern_time, pattern.time, pattern.yaw_pelvis_in_world)
     ankles = [np.column_stack([interp(pattern_time, pattern.time, a[:, i]) for i in range(3)])
               for a in (pattern.position_left_ankle_in_world, pattern.position_right_ankle_in_world)]
