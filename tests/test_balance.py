@@ -72,6 +72,34 @@ def run(stabilizer: Stabilizer, inputs: dict[str, object], ticks: int, **changes
     return angles
 
 
+KINEMATICS_TOL = 1e-12  # [m], [-], [m/rad]
+
+
+@pytest.mark.parametrize("name", ["hubo", "talos"])
+def test_the_ticks_batched_kinematics_are_each_legs_own(name: str) -> None:
+    """The stabilizer computes both legs' kinematics (measured and reference poses) in one batch; it must be
+    each leg chain's own product of exponentials and Jacobian."""
+    if name == "talos" and not TALOS.is_file():
+        pytest.skip("../shared/robots is absent")
+    robot = load_robot(TALOS if name == "talos" else name)
+    stabilizer = Stabilizer(robot, 1000.0)
+    chains = leg_chains(robot)
+    rng = np.random.default_rng(7)
+    references = np.array([c.reference for c in (chains[0], chains[0], chains[1], chains[1])])
+    for _ in range(20):
+        poses = references + rng.normal(0, 0.3, (4, 6))
+        rotations, translations = stabilizer._kinematics(poses)
+        ankles = translations[:, 6] + (rotations[:, 6] @ stabilizer._ankles[:, :, None])[:, :, 0]
+        jacobians = stabilizer._jacobians(rotations, translations, ankles)
+        for row, chain in enumerate((chains[0], chains[0], chains[1], chains[1])):
+            own_rotations, own_translations = chain.transforms(poses[row][None])
+            assert np.abs(rotations[row] - own_rotations[0]).max() < KINEMATICS_TOL
+            assert np.abs(translations[row] - own_translations[0]).max() < KINEMATICS_TOL
+            assert np.abs(ankles[row] - chain.fk(poses[row][None])[0][0]).max() < KINEMATICS_TOL
+            if row % 2:
+                assert np.abs(jacobians[row // 2] - chain.jacobian(poses[row][None])[0]).max() < KINEMATICS_TOL
+
+
 def test_a_perfect_measurement_changes_nothing() -> None:
     stabilizer, inputs, _ = standing()
     angles = run(stabilizer, inputs, 200)

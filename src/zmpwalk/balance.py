@@ -48,6 +48,8 @@ from zmpwalk.robots.model import RobotModel
 
 Array = NDArray[np.float64]
 
+MIN_SHARE = 1e-9  # [-] a sole's share of the desired ZMP below which its CoP is not controlled
+
 
 @dataclass(frozen=True)
 class StabilizerGains:
@@ -165,30 +167,68 @@ class Stabilizer:
         self.dt = 1.0 / float(rate)
         self.omega = math.sqrt(robot.gravity / robot.pendulum_length)
         self.chains = leg_chains(robot)
-        self._orders = [list(chain.role_order) for chain in self.chains]
-        self._rest_mass, self._rest_com = rest_mass(robot)
-        self._mass = self._rest_mass + sum(float(c.link_masses.sum()) for c in self.chains)
+        rest, rest_com = rest_mass(robot)
+        self._mass = rest + sum(float(c.link_masses.sum()) for c in self.chains)
+        self._rest_moment = tuple(float(v) for v in rest * np.asarray(rest_com))  # m_rest c_rest in the base [kg m]
         self._half_length = robot.foot_length / 2
         self._half_width = robot.foot_width / 2
-        self._sole_centre = np.array([robot.sole_center_x, robot.sole_center_y])
-        self._angles = np.empty((2, 6))  # work buffer: measured and reference angles of one leg
+        # Both legs' kinematics in one batch of four poses: (left, right) x (measured, reference).
+        chains = (self.chains[0], self.chains[0], self.chains[1], self.chains[1])
+        skews = np.array([[[[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]] for w in c.axes]
+                          for c in chains])  # (4, 6, 3, 3)
+        points = np.array([c.points for c in chains])  # (4, 6, 3)
+        self._skews = skews
+        self._skews2 = skews @ skews
+        # exp(xi q) maps x -> R x + (I - R) r with (I - R) r = -(sin q) K r - (1 - cos q) K^2 r
+        self._skew_points = np.einsum("lkij,lkj->lki", skews, points)  # (4, 6, 3)
+        self._skew2_points = np.einsum("lkij,lkj->lki", self._skews2, points)
+        self._axes = np.array([c.axes for c in chains])  # (4, 6, 3)
+        self._points = points
+        self._ankles = np.array([c.ankle for c in chains])  # (4, 3)
+        self._link_masses = np.array([c.link_masses for c in self.chains])  # (2, 6)
+        self._link_coms = np.array([c.link_coms for c in self.chains])  # (2, 6, 3)
+        # gather the 12 measured and 12 reference columns into the four chain-ordered poses
+        gather = np.empty((4, 6), dtype=np.intp)
+        for leg, chain in enumerate(self.chains):
+            inverse = np.argsort(np.asarray(chain.role_order))  # chain index -> role index
+            gather[2 * leg] = 6 * leg + inverse  # measured columns are 0..11
+            gather[2 * leg + 1] = 12 + 6 * leg + inverse  # reference columns are 12..23
+        self._gather = gather
+        self._scatter = [list(chain.role_order) for chain in self.chains]
+        self._eye = np.eye(3)
         self.reset()
 
     def reset(self) -> None:
         """Forget the filters and offsets (the next update starts from the reference)."""
         self._started = False
-        self._previous_reference = np.zeros(2)
-        self._previous_relative = np.zeros((2, 3))
-        self._com_velocity = np.zeros(2)
-        self._offset = np.zeros(2)
-        self._offset_rate = np.zeros(2)
-        self._ankle = np.zeros((2, 2))
+        self._previous_reference = (0.0, 0.0)
+        self._previous_relative = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+        self._com_velocity = [0.0, 0.0]
+        self._offset = [0.0, 0.0]
+        self._offset_rate = [0.0, 0.0]
+        self._ankle = [[0.0, 0.0], [0.0, 0.0]]
         self._height = 0.0
-        self._feet = np.zeros((2, 2))  # estimated ankle positions in world (leg odometry) [m]
-        self._landing = np.zeros((2, 2))  # landing corrections of the feet in world [m]
+        self._feet = [[0.0, 0.0], [0.0, 0.0]]  # estimated ankle positions in world (leg odometry) [m]
+        self._landing = [[0.0, 0.0], [0.0, 0.0]]  # landing corrections of the feet in world [m]
         self._anchor = 0
         self.state = BalanceState(np.zeros(2), np.full(2, np.nan), np.zeros(2), np.zeros(2), np.zeros((2, 2)),
                                   0.0, np.zeros(2))
+
+    def _kinematics(self, poses: Array) -> tuple[Array, Array]:
+        """Cumulative rotations (4, 7, 3, 3) and translations (4, 7, 3) of the four chain poses (4, 6) [rad]:
+        the product of exponentials of :meth:`zmpwalk.leg_chain.LegChain.transforms`, both legs at once."""
+        sines, versines = np.sin(poses)[:, :, None], (1.0 - np.cos(poses))[:, :, None]
+        joints = self._eye + sines[..., None] * self._skews + versines[..., None] * self._skews2  # (4, 6, 3, 3)
+        rotations = np.empty((4, 7, 3, 3))
+        rotations[:, 0] = self._eye
+        rotations[:, 1] = joints[:, 0]
+        for i in range(1, 6):
+            rotations[:, i + 1] = rotations[:, i] @ joints[:, i]
+        shifts = -(sines * self._skew_points + versines * self._skew2_points)  # (I - R_i) r_i, (4, 6, 3)
+        translations = np.empty((4, 7, 3))
+        translations[:, 0] = 0.0
+        np.cumsum((rotations[:, :6] @ shifts[..., None])[..., 0], axis=1, out=translations[:, 1:])
+        return rotations, translations
 
     def update(self, *, support: int, position_com_in_world: Array, yaw_pelvis_in_world: float, zmp_in_world: Array,
                ankles_in_world: tuple[Array, Array], foot_yaws: tuple[float, float], joint_angles: Array,
@@ -204,197 +244,248 @@ class Stabilizer:
             foot_yaws: Planned foot yaws [rad].
             joint_angles: The pattern's 12 joint angles [rad].
             measurement: The sensors (:class:`BalanceMeasurement`).
+
+        The work is fixed: one batch of leg kinematics (both legs, measured and reference angles), one
+        6 x 6 solve per leg, and scalar arithmetic; nothing is planned or iterated.
         """
         g, dt, omega = self.gains, self.dt, self.omega
-        reference = np.asarray(position_com_in_world, dtype=float)[:2]
+        yaw = float(yaw_pelvis_in_world)
+        yaw_left, yaw_right = float(foot_yaws[0]), float(foot_yaws[1])
+        rx, ry = float(position_com_in_world[0]), float(position_com_in_world[1])
         if not self._started:
-            self._previous_reference = reference.copy()
-        velocity_reference = (reference - self._previous_reference) / dt
-        self._previous_reference = reference.copy()
-        # --- measured sole wrenches: CoPs in world and the total ZMP
-        forces = np.array([measurement.wrench_left[2], measurement.wrench_right[2]])
-        loaded = forces > 0.05 * self._mass * self.robot.gravity
+            self._previous_reference = (rx, ry)
+        vrx, vry = (rx - self._previous_reference[0]) / dt, (ry - self._previous_reference[1]) / dt
+        self._previous_reference = (rx, ry)
+        # --- measured sole wrenches
+        wl, wr = measurement.wrench_left, measurement.wrench_right
+        f0, f1 = float(wl[2]), float(wr[2])
+        threshold = 0.05 * self._mass * self.robot.gravity
+        loaded0, loaded1 = f0 > threshold, f1 > threshold
         # --- CoM estimate: kinematics of the measured legs, tilted by the IMU, anchored at the loaded sole
         roll, pitch = float(measurement.attitude[0]), float(measurement.attitude[1])
-        heading = yaw_pelvis_in_world if measurement.yaw is None else float(measurement.yaw)
-        rotation = _rz(heading) @ _ry(pitch) @ _rx(roll)
-        q = np.asarray(measurement.joint_angles, dtype=float)
-        com_in_base = self._rest_mass * self._rest_com
-        relative = np.empty((2, 3))
+        heading = yaw if measurement.yaw is None else float(measurement.yaw)
+        rot = _rotation_zyx(heading, pitch, roll)
         reference_angles = np.asarray(joint_angles, dtype=float)
-        kinematics = []  # per leg: transforms of (measured, reference) angles, computed once
-        for index, chain in enumerate(self.chains):
-            angles = self._angles
-            angles[0, self._orders[index]] = q[6 * index:6 * index + 6]
-            angles[1, self._orders[index]] = reference_angles[6 * index:6 * index + 6]
-            transforms = chain.transforms(angles)
-            kinematics.append((angles[1:].copy(), (transforms[0][1:], transforms[1][1:])))
-            com_in_base = com_in_base + chain.link_masses @ chain.link_com_positions(angles, transforms)[0]
-            relative[index] = chain.fk(angles, transforms)[0][0]
-        com_in_base = com_in_base / self._mass
+        columns = np.concatenate([np.asarray(measurement.joint_angles, dtype=float), reference_angles])
+        rotations, translations = self._kinematics(columns[self._gather])
+        ankles = translations[:, 6] + (rotations[:, 6] @ self._ankles[:, :, None])[:, :, 0]  # (4, 3) in the base
+        measured = rotations[0::2, 1:]  # the measured poses' segment frames (2, 6, 3, 3)
+        coms = (measured @ self._link_coms[:, :, :, None])[..., 0] + translations[0::2, 1:]  # (2, 6, 3)
+        moment = np.einsum("lk,lki->i", self._link_masses, coms)
+        com_in_base = [(self._rest_moment[i] + float(moment[i])) / self._mass for i in range(3)]
+        relative = (tuple(ankles[0].tolist()), tuple(ankles[2].tolist()))
+        planned_relative = (ankles[1].tolist(), ankles[3].tolist())
         if not self._started:
-            self._previous_relative = relative.copy()
-            self._feet = np.array([ankles_in_world[0][:2], ankles_in_world[1][:2]], dtype=float)
-            self._anchor = 0 if forces[0] >= forces[1] else 1
+            self._previous_relative = relative
+            self._feet = [[float(ankles_in_world[0][0]), float(ankles_in_world[0][1])],
+                          [float(ankles_in_world[1][0]), float(ankles_in_world[1][1])]]
+            self._anchor = 0 if f0 >= f1 else 1
             self._started = True
         # Leg odometry: when the load moves to the other sole, place it from the measured kinematics.
-        anchor = 0 if forces[0] >= forces[1] else 1
-        if anchor != self._anchor and loaded.all():
-            self._feet[anchor] = self._feet[self._anchor] + (rotation @ (relative[anchor] - relative[self._anchor]))[:2]
+        anchor = 0 if f0 >= f1 else 1
+        if anchor != self._anchor and loaded0 and loaded1:
+            d = _rotate3(rot, _sub3(relative[anchor], relative[self._anchor]))
+            self._feet[anchor] = [self._feet[self._anchor][0] + d[0], self._feet[self._anchor][1] + d[1]]
             self._anchor = anchor
         anchor = self._anchor
-        arm = rotation @ (com_in_base - relative[anchor])
-        com = self._feet[anchor] + arm[:2]
+        foot_anchor = self._feet[anchor]
+        arm = _rotate3(rot, _sub3(com_in_base, relative[anchor]))
+        cx, cy = foot_anchor[0] + arm[0], foot_anchor[1] + arm[1]
         # Where the feet are (odometry; the swing foot follows from the stance foot and the kinematics): the
         # measured CoPs, the support polygon and the wrench distribution use these places.
-        feet = [self._feet[anchor], self._feet[anchor] + (rotation @ (relative[1 - anchor] - relative[anchor]))[:2]]
+        other = _rotate3(rot, _sub3(relative[1 - anchor], relative[anchor]))
+        feet = [(foot_anchor[0], foot_anchor[1]), (foot_anchor[0] + other[0], foot_anchor[1] + other[1])]
         if anchor == 1:
             feet.reverse()
-        cops = np.zeros((2, 2))
-        for foot, wrench in enumerate((measurement.wrench_left, measurement.wrench_right)):
-            if loaded[foot]:
-                h = self.robot.ankle_height
-                local = np.array([-(wrench[4] + h * wrench[0]) / wrench[2], (wrench[3] - h * wrench[1]) / wrench[2]])
-                cops[foot] = feet[foot] + _rotate(local, foot_yaws[foot])
-        zmp_measured = np.full(2, np.nan)
-        if loaded.any():
-            weights = np.where(loaded, forces, 0.0)
-            zmp_measured = (weights @ cops) / weights.sum()
-        measured_feet = (feet[0], feet[1])
-        previous_arm = rotation @ (com_in_base - self._previous_relative[anchor])
-        spin = rotation @ np.asarray(measurement.rate, dtype=float)
-        raw_velocity = (arm[:2] - previous_arm[:2]) / dt + cross3(spin, arm)[:2]
+        h = self.robot.ankle_height
+        cops = [(0.0, 0.0), (0.0, 0.0)]
+        for foot, wrench, loaded, foot_yaw in ((0, wl, loaded0, yaw_left), (1, wr, loaded1, yaw_right)):
+            if loaded:
+                w0, w1, w2, w3, w4 = (float(wrench[i]) for i in range(5))
+                local = _rotate2(-(w4 + h * w0) / w2, (w3 - h * w1) / w2, foot_yaw)
+                cops[foot] = (feet[foot][0] + local[0], feet[foot][1] + local[1])
+        zmx = zmy = math.nan
+        if loaded0 or loaded1:
+            a0, a1 = (f0 if loaded0 else 0.0), (f1 if loaded1 else 0.0)
+            zmx = (a0 * cops[0][0] + a1 * cops[1][0]) / (a0 + a1)
+            zmy = (a0 * cops[0][1] + a1 * cops[1][1]) / (a0 + a1)
+        previous_arm = _rotate3(rot, _sub3(com_in_base, self._previous_relative[anchor]))
+        rate = measurement.rate
+        spin = _rotate3(rot, (float(rate[0]), float(rate[1]), float(rate[2])))
+        raw_vx = (arm[0] - previous_arm[0]) / dt + (spin[1] * arm[2] - spin[2] * arm[1])
+        raw_vy = (arm[1] - previous_arm[1]) / dt + (spin[2] * arm[0] - spin[0] * arm[2])
         self._previous_relative = relative
         alpha = dt / (g.velocity_filter + dt)
-        self._com_velocity += alpha * (raw_velocity - self._com_velocity)
+        velocity = self._com_velocity
+        velocity[0] += alpha * (raw_vx - velocity[0])
+        velocity[1] += alpha * (raw_vy - velocity[1])
         # --- 1. DCM feedback -> desired ZMP inside the support polygon
-        dcm_error = (com + self._com_velocity / omega) - (reference + velocity_reference / omega)
-        zmp_desired = np.asarray(zmp_in_world, dtype=float) + (1.0 + g.dcm / omega) * dcm_error
-        zmp_desired = self._clamp(zmp_desired, support, measured_feet, foot_yaws)
+        ex = (cx + velocity[0] / omega) - (rx + vrx / omega)
+        ey = (cy + velocity[1] / omega) - (ry + vry / omega)
+        gain = 1.0 + g.dcm / omega
+        pdx, pdy = self._clamp(float(zmp_in_world[0]) + gain * ex, float(zmp_in_world[1]) + gain * ey,
+                               support, feet, (yaw_left, yaw_right))
         # --- 2. CoM admittance
-        acceleration = g.com_admittance * (zmp_measured - zmp_desired) if loaded.any() else np.zeros(2)
-        acceleration -= g.com_damping * self._offset_rate + g.com_stiffness * self._offset
-        self._offset_rate += acceleration * dt
-        self._offset += self._offset_rate * dt
-        norm = float(np.hypot(*self._offset))
+        offset, offset_rate = self._offset, self._offset_rate
+        if loaded0 or loaded1:
+            ax, ay = g.com_admittance * (zmx - pdx), g.com_admittance * (zmy - pdy)
+        else:
+            ax = ay = 0.0
+        ax -= g.com_damping * offset_rate[0] + g.com_stiffness * offset[0]
+        ay -= g.com_damping * offset_rate[1] + g.com_stiffness * offset[1]
+        offset_rate[0] += ax * dt
+        offset_rate[1] += ay * dt
+        offset[0] += offset_rate[0] * dt
+        offset[1] += offset_rate[1] * dt
+        norm = math.hypot(offset[0], offset[1])
         if norm > g.com_limit:
-            self._offset *= g.com_limit / norm
-            self._offset_rate *= 0.0
+            offset[0] *= g.com_limit / norm
+            offset[1] *= g.com_limit / norm
+            offset_rate[0] = offset_rate[1] = 0.0
         # --- 3. ankle damping: each loaded sole's CoP follows its share of p_d
-        shares, targets = self._distribute(zmp_desired, support, measured_feet, foot_yaws)
+        shares, targets = self._distribute(pdx, pdy, support, feet, (yaw_left, yaw_right))
         decay = dt / g.ankle_time_constant
-        for foot in range(2):
-            if loaded[foot] and shares[foot] > 0.0:
-                error = _rotate(targets[foot] - cops[foot], -foot_yaws[foot])  # in the foot frame
-                self._ankle[foot, 0] += dt * (-g.ankle_gain * error[1])
-                self._ankle[foot, 1] += dt * (g.ankle_gain * error[0])
-            self._ankle[foot] -= decay * self._ankle[foot]
-        np.clip(self._ankle, -g.ankle_limit, g.ankle_limit, out=self._ankle)
+        limit = g.ankle_limit
+        for foot, loaded, foot_yaw in ((0, loaded0, yaw_left), (1, loaded1, yaw_right)):
+            turn_foot = self._ankle[foot]
+            if loaded and shares[foot] > MIN_SHARE:
+                error = _rotate2(targets[foot][0] - cops[foot][0], targets[foot][1] - cops[foot][1], -foot_yaw)
+                turn_foot[0] += dt * (-g.ankle_gain * error[1])
+                turn_foot[1] += dt * (g.ankle_gain * error[0])
+            turn_foot[0] = min(max(turn_foot[0] - decay * turn_foot[0], -limit), limit)
+            turn_foot[1] = min(max(turn_foot[1] - decay * turn_foot[1], -limit), limit)
         # --- 4. foot force difference (double support)
-        weight = float(forces.sum())
-        if support == 0 and loaded.all() and weight > 0:
+        weight = f0 + f1
+        if support == 0 and loaded0 and loaded1 and weight > 0:
             wanted = (shares[0] - shares[1]) * weight
-            self._height += dt * g.force_gain * (wanted - (forces[0] - forces[1])) / weight
+            self._height += dt * g.force_gain * (wanted - (f0 - f1)) / weight
         self._height -= dt / g.force_time_constant * self._height
-        self._height = float(np.clip(self._height, -g.force_limit, g.force_limit))
+        self._height = min(max(self._height, -g.force_limit), g.force_limit)
         # --- 5. torso attitude
-        turn = np.clip(-g.attitude_gain * np.array([roll, pitch])
-                       - g.attitude_damping * np.asarray(measurement.rate, dtype=float)[:2],
-                       -g.attitude_limit, g.attitude_limit)
+        turn_roll = min(max(-g.attitude_gain * roll - g.attitude_damping * float(rate[0]), -g.attitude_limit),
+                        g.attitude_limit)
+        turn_pitch = min(max(-g.attitude_gain * pitch - g.attitude_damping * float(rate[1]), -g.attitude_limit),
+                         g.attitude_limit)
         # --- 6. landing: a swinging foot aims at its planned place in world from where the base is (odometry),
         # not where the plan has it; the correction is released once the foot carries load.
-        base_estimate = self._feet[anchor] - (rotation @ relative[anchor])[:2]
-        planned_relative = [chain.fk(angles, transforms)[0][0] for chain, (angles, transforms)
-                            in zip(self.chains, kinematics, strict=True)]
-        yaw_rotation = _rz(yaw_pelvis_in_world)
-        base_planned = (np.asarray(ankles_in_world[anchor], dtype=float)[:2]
-                        - (yaw_rotation @ planned_relative[anchor])[:2])
+        stance = _rotate3(rot, relative[anchor])
+        base_ex, base_ey = foot_anchor[0] - stance[0], foot_anchor[1] - stance[1]
+        planned_stance = _rotate2(planned_relative[anchor][0], planned_relative[anchor][1], yaw)
+        base_px = float(ankles_in_world[anchor][0]) - planned_stance[0]
+        base_py = float(ankles_in_world[anchor][1]) - planned_stance[1]
+        landing_rate, release_rate = dt / g.landing_time_constant, dt / g.landing_release
+        landing_limit = g.landing_limit
         for foot in range(2):
-            swinging = (support == 1 and foot == 1) or (support == 2 and foot == 0)
-            if swinging:
-                target = base_planned + self._offset - base_estimate
-                self._landing[foot] += dt / g.landing_time_constant * (target - self._landing[foot])
+            land = self._landing[foot]
+            if (support == 1 and foot == 1) or (support == 2 and foot == 0):  # swinging
+                land[0] += landing_rate * (base_px + offset[0] - base_ex - land[0])
+                land[1] += landing_rate * (base_py + offset[1] - base_ey - land[1])
             else:
-                self._landing[foot] -= dt / g.landing_release * self._landing[foot]
-        np.clip(self._landing, -g.landing_limit, g.landing_limit, out=self._landing)
+                land[0] -= release_rate * land[0]
+                land[1] -= release_rate * land[1]
+            land[0] = min(max(land[0], -landing_limit), landing_limit)
+            land[1] = min(max(land[1], -landing_limit), landing_limit)
         # --- corrections of the feet relative to the pelvis, onto the joints through the Jacobians
+        shift = _rotate2(offset[0], offset[1], -yaw)
+        changes = np.empty((2, 6))
+        for leg, foot_yaw in ((0, yaw_left), (1, yaw_right)):
+            px, py, pz = planned_relative[leg]
+            landing = _rotate2(self._landing[leg][0], self._landing[leg][1], -yaw)
+            foot_turn = _rotate2(self._ankle[leg][0], self._ankle[leg][1], foot_yaw - yaw)
+            # minus pelvis_turn x position, pelvis_turn = (roll, pitch, 0)
+            changes[leg] = (landing[0] - shift[0] - turn_pitch * pz, landing[1] - shift[1] + turn_roll * pz,
+                            (-self._height / 2 if leg == 0 else self._height / 2) - (turn_roll * py - turn_pitch * px),
+                            foot_turn[0] - turn_roll, foot_turn[1] - turn_pitch, 0.0)
+        deltas = np.linalg.solve(self._jacobians(rotations, translations, ankles), changes[:, :, None])[:, :, 0]
         result = reference_angles.copy()
-        shift_in_pelvis = _rotate(self._offset, -yaw_pelvis_in_world)
-        pelvis_turn = np.array([turn[0], turn[1], 0.0])
-        for index, chain in enumerate(self.chains):
-            angles, transforms = kinematics[index]
-            position = planned_relative[index][None]
-            jacobian = chain.jacobian(angles, transforms)[0]
-            foot_turn = _rotate(self._ankle[index], foot_yaws[index] - yaw_pelvis_in_world)
-            change = np.empty(6)
-            change[:2] = _rotate(self._landing[index], -yaw_pelvis_in_world) - shift_in_pelvis
-            change[2] = -self._height / 2 if index == 0 else self._height / 2
-            change[:3] -= cross3(pelvis_turn, position[0])
-            change[3:5] = foot_turn
-            change[5] = 0.0
-            change[3:] -= pelvis_turn
-            delta = np.linalg.solve(jacobian, change)
-            result[6 * index:6 * index + 6] += delta[self._orders[index]]
-        self.state = BalanceState(zmp_desired, zmp_measured, dcm_error, self._offset.copy(), self._ankle.copy(),
-                                  self._height, turn)
+        result[0:6] += deltas[0, self._scatter[0]]
+        result[6:12] += deltas[1, self._scatter[1]]
+        self.state = BalanceState(np.array([pdx, pdy]), np.array([zmx, zmy]), np.array([ex, ey]),
+                                  np.array(offset), np.array(self._ankle), self._height,
+                                  np.array([turn_roll, turn_pitch]))
         return result
 
-    def _distribute(self, zmp: Array, support: int, ankles: tuple[Array, Array],
-                    yaws: tuple[float, float]) -> tuple[tuple[float, float], tuple[Array, Array]]:
-        """Load shares of the feet and each sole's CoP target [m] for a desired ZMP."""
-        centres = [ankles[f][:2] + _rotate(self._sole_centre * [1.0, 1.0 if f == 0 else -1.0], yaws[f])
-                   for f in range(2)]
-        if support == 1:
-            return (1.0, 0.0), (zmp, centres[1])
-        if support == 2:
-            return (0.0, 1.0), (centres[0], zmp)
-        span = centres[1] - centres[0]
-        ratio = float(np.clip((zmp - centres[0]) @ span / max(float(span @ span), 1e-12), 0.0, 1.0))
-        base = centres[0] + ratio * span
-        return (1.0 - ratio, ratio), (centres[0] + zmp - base, centres[1] + zmp - base)
+    def _jacobians(self, rotations: Array, translations: Array, ankles: Array) -> Array:
+        """Geometric Jacobians (2, 6, 6) of the reference poses' ankle points in the base frame, rows
+        (v, omega) (:meth:`zmpwalk.leg_chain.LegChain.jacobian`)."""
+        frames = rotations[1::2, :6]  # (2, 6, 3, 3)
+        axes = (frames @ self._axes[1::2, :, :, None])[..., 0]  # (2, 6, 3)
+        origins = (frames @ self._points[1::2, :, :, None])[..., 0] + translations[1::2, :6]
+        jacobians = np.empty((2, 6, 6))
+        jacobians[:, :3, :] = np.swapaxes(cross3(axes, ankles[1::2, None, :] - origins), 1, 2)
+        jacobians[:, 3:, :] = np.swapaxes(axes, 1, 2)
+        return jacobians
 
-    def _clamp(self, zmp: Array, support: int, ankles: tuple[Array, Array], yaws: tuple[float, float]) -> Array:
-        """``zmp`` moved into the support polygon shrunk by the margin (single support: the sole; double:
+    def _sole_centres(self, feet: list[tuple[float, float]], yaws: tuple[float, float]) -> list[tuple[float, float]]:
+        cx, cy = self.robot.sole_center_x, self.robot.sole_center_y
+        centres = []
+        for foot, side in ((0, 1.0), (1, -1.0)):
+            offset = _rotate2(cx, side * cy, yaws[foot])
+            centres.append((feet[foot][0] + offset[0], feet[foot][1] + offset[1]))
+        return centres
+
+    def _distribute(self, zx: float, zy: float, support: int, feet: list[tuple[float, float]],
+                    yaws: tuple[float, float]) -> tuple[tuple[float, float],
+                                                        tuple[tuple[float, float], tuple[float, float]]]:
+        """Load shares of the feet and each sole's CoP target [m] for a desired ZMP."""
+        centres = self._sole_centres(feet, yaws)
+        if support == 1:
+            return (1.0, 0.0), ((zx, zy), centres[1])
+        if support == 2:
+            return (0.0, 1.0), (centres[0], (zx, zy))
+        sx, sy = centres[1][0] - centres[0][0], centres[1][1] - centres[0][1]
+        ratio = min(max(((zx - centres[0][0]) * sx + (zy - centres[0][1]) * sy) / max(sx * sx + sy * sy, 1e-12),
+                        0.0), 1.0)
+        dx, dy = zx - (centres[0][0] + ratio * sx), zy - (centres[0][1] + ratio * sy)
+        targets = ((centres[0][0] + dx, centres[0][1] + dy), (centres[1][0] + dx, centres[1][1] + dy))
+        return (1.0 - ratio, ratio), targets
+
+    def _clamp(self, zx: float, zy: float, support: int, feet: list[tuple[float, float]],
+               yaws: tuple[float, float]) -> tuple[float, float]:
+        """The ZMP moved into the support polygon shrunk by the margin (single support: the sole; double:
         the segment between the soles' centres widened by the soles' half widths, a conservative hull)."""
         margin = self.gains.zmp_margin
         lx, ly = max(self._half_length - margin, 0.0), max(self._half_width - margin, 0.0)
-        centres = [ankles[f][:2] + _rotate(self._sole_centre * [1.0, 1.0 if f == 0 else -1.0], yaws[f])
-                   for f in range(2)]
+        centres = self._sole_centres(feet, yaws)
         if support in (1, 2):
             foot = support - 1
-            local = _rotate(zmp - centres[foot], -yaws[foot])
-            local = np.clip(local, [-lx, -ly], [lx, ly])
-            return centres[foot] + _rotate(local, yaws[foot])
-        span = centres[1] - centres[0]
-        length = float(np.hypot(*span))
+            local = _rotate2(zx - centres[foot][0], zy - centres[foot][1], -yaws[foot])
+            back = _rotate2(min(max(local[0], -lx), lx), min(max(local[1], -ly), ly), yaws[foot])
+            return centres[foot][0] + back[0], centres[foot][1] + back[1]
+        sx, sy = centres[1][0] - centres[0][0], centres[1][1] - centres[0][1]
+        length = math.hypot(sx, sy)
         if length < 1e-9:
-            return zmp
-        along = span / length
-        across = np.array([-along[1], along[0]])
-        rel = zmp - centres[0]
-        s = float(np.clip(rel @ along, 0.0, length))
-        d = float(np.clip(rel @ across, -lx, lx))
-        return centres[0] + s * along + d * across
+            return zx, zy
+        ax, ay = sx / length, sy / length
+        rx, ry = zx - centres[0][0], zy - centres[0][1]
+        along = min(max(rx * ax + ry * ay, 0.0), length)
+        across = min(max(-rx * ay + ry * ax, -lx), lx)
+        return centres[0][0] + along * ax - across * ay, centres[0][1] + along * ay + across * ax
 
 
-def _rotate(vector: Array, angle: float) -> Array:
+def _rotate2(x: float, y: float, angle: float) -> tuple[float, float]:
+    """``(x, y)`` turned by ``angle`` [rad] about z."""
     c, s = math.cos(angle), math.sin(angle)
-    return np.array([c * vector[0] - s * vector[1], s * vector[0] + c * vector[1]])
+    return c * x - s * y, s * x + c * y
 
 
-def _rx(angle: float) -> Array:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+def _rotation_zyx(yaw: float, pitch: float, roll: float) -> tuple[float, ...]:
+    """``Rz(yaw) Ry(pitch) Rx(roll)``, row-major (9 floats)."""
+    cz, sz, cy, sy = math.cos(yaw), math.sin(yaw), math.cos(pitch), math.sin(pitch)
+    cx, sx = math.cos(roll), math.sin(roll)
+    return (cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx,
+            sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx,
+            -sy, cy * sx, cy * cx)
 
 
-def _ry(angle: float) -> Array:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+def _rotate3(r: tuple[float, ...], v: tuple[float, ...] | list[float]) -> tuple[float, float, float]:
+    """The row-major rotation ``r`` applied to ``v``."""
+    x, y, z = v[0], v[1], v[2]
+    return (r[0] * x + r[1] * y + r[2] * z, r[3] * x + r[4] * y + r[5] * z, r[6] * x + r[7] * y + r[8] * z)
 
 
-def _rz(angle: float) -> Array:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+def _sub3(a: tuple[float, ...] | list[float], b: tuple[float, ...] | list[float]) -> tuple[float, float, float]:
+    return a[0] - b[0], a[1] - b[1], a[2] - b[2]
 
 
 __all__ = ["BalanceMeasurement", "BalanceState", "Stabilizer", "StabilizerGains"]
