@@ -4,6 +4,7 @@ bad gains are rejected, and in MuJoCo it carries walks that fall or drift open l
 from __future__ import annotations
 
 import dataclasses
+import math
 from pathlib import Path
 
 import numpy as np
@@ -140,6 +141,20 @@ def test_left_foot_under_loaded_in_double_support_is_lowered() -> None:
     stabilizer, inputs, _ = standing()
     run(stabilizer, inputs, 100, loads=(0.6, 1.4))
     assert stabilizer.state.height_difference > 0.0  # left foot lowered by half of it [m]
+
+
+def test_a_floor_rising_ahead_moves_the_com_uphill_by_l_tan_slope() -> None:
+    """Standing on a floor that rises 2 degrees ahead, the torso square to it (pitched back by the slope), the
+    soles' normal is the floor's; the CoM offset's target is l tan(slope) uphill (forward)."""
+    stabilizer, inputs, _ = standing()
+    slope = math.radians(2.0)
+    run(stabilizer, inputs, 3000, attitude=np.array([0.0, -slope]))
+    expected = stabilizer.robot.pendulum_length * math.tan(slope)
+    assert stabilizer.state.slope_offset[0] == pytest.approx(expected, rel=0.01)  # 5 filter time constants
+    assert abs(stabilizer.state.slope_offset[1]) < 1e-3 * expected
+    off = Stabilizer(stabilizer.robot, 1000.0, dataclasses.replace(stabilizer.gains, slope_time_constant=0.0))
+    run(off, inputs, 100, attitude=np.array([0.0, -slope]))
+    assert np.all(off.state.slope_offset == 0.0)
 
 
 @pytest.mark.parametrize("field", ["dcm", "ankle_gain", "com_limit"])

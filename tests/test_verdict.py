@@ -40,3 +40,28 @@ def test_the_papers_walk_passes_every_criterion(capsys: pytest.CaptureFixture[st
     assert len(verdict["criteria"]) == 7
     for criterion in verdict["criteria"]:
         assert criterion["figure"] is not None and criterion["passed"] is True
+
+
+def test_the_cop_criterion_skips_each_touchdown_the_first_sample_included() -> None:
+    """The robot is set on the floor at the first sample: its first 50 ms are a touchdown like any other."""
+    import types
+
+    import numpy as np
+
+    from zmpwalk.robots import load_robot
+    from zmpwalk.sim.verdict import TOUCHDOWN_WINDOW, cop_margin_outside_touchdowns
+
+    robot = load_robot("hubo")
+    time = np.arange(0.0, 1.0, 0.001)
+    weight = robot.mass * robot.gravity
+    left = np.full(len(time), weight / 2)
+    right = left.copy()
+    right[400:600] = 0.0  # the right foot swings from 0.4 to 0.6 s and lands again
+    margin = np.full(len(time), 0.02)
+    margin[:10] = -0.010  # placed on a tilted floor: 10 ms beyond a sole edge
+    result = types.SimpleNamespace(robot=robot, time=time, force_left=left, force_right=right, cop_margin=margin)
+    assert cop_margin_outside_touchdowns(result) == pytest.approx(0.02, abs=1e-12)  # type: ignore[arg-type]
+    margin[600 + round(TOUCHDOWN_WINDOW / 0.001) + 5] = -0.007  # after the landing's window: judged
+    assert cop_margin_outside_touchdowns(result) == pytest.approx(-0.007, abs=1e-12)  # type: ignore[arg-type]
+    margin[600 + 3] = -0.030  # inside it: not judged
+    assert cop_margin_outside_touchdowns(result) == pytest.approx(-0.007, abs=1e-12)  # type: ignore[arg-type]

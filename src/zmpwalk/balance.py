@@ -27,6 +27,9 @@ separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega 
 4. **Foot force difference control** (Kajita et al. 2010): in double support the feet's heights move apart
    until the measured force difference is the desired one.
 5. **Torso attitude**: the pelvis is turned against the measured roll and pitch (and their rates).
+6. **Floor slope**: the loaded sole lies on the floor, so its attitude (IMU and measured leg kinematics)
+   is the floor's; with unit normal ``n`` the CoM must stand ``l (n_x, n_y) / n_z`` uphill of its plan for
+   the ZMP to stay where planned, and the CoM admittance is pulled to that offset instead of to zero.
 
 All corrections are small offsets of the feet relative to the pelvis, mapped onto the joints through each
 leg's Jacobian at the pattern's angles (``Delta q = J^{-1} Delta x``): nothing is planned or solved
@@ -36,7 +39,7 @@ iteratively on the control path, and the work per tick is fixed.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -75,6 +78,8 @@ class StabilizerGains:
         landing_time_constant: How fast a swinging foot's aim moves to its planned place in world [s].
         landing_release: How fast that correction is released once the foot carries load [s].
         landing_limit: Largest landing correction [m].
+        slope_time_constant: Low-pass filter of the floor normal measured under the loaded sole [s]; 0 turns
+            the slope compensation off.
     """
 
     dcm: float = 3.0  # [1/s]
@@ -96,6 +101,7 @@ class StabilizerGains:
     landing_time_constant: float = 0.2  # [s]
     landing_release: float = 0.3  # [s]
     landing_limit: float = 0.1  # [m]
+    slope_time_constant: float = 0.5  # [s]
 
     def __post_init__(self) -> None:
         for name, value in vars(self).items():
@@ -137,6 +143,7 @@ class BalanceState:
         ankle_offsets: Foot turns (roll, pitch) of the left and right foot [rad], (2, 2).
         height_difference: Left foot lowered, right raised by half of this [m].
         pelvis_turn: Roll and pitch of the pelvis correction [rad], (2,).
+        slope_offset: Where the floor's slope puts the CoM offset [m], (2,).
     """
 
     zmp_desired: Array
@@ -146,6 +153,7 @@ class BalanceState:
     ankle_offsets: Array
     height_difference: float
     pelvis_turn: Array
+    slope_offset: Array = field(default_factory=lambda: np.zeros(2))
 
 
 class Stabilizer:
@@ -211,6 +219,7 @@ class Stabilizer:
         self._feet = [[0.0, 0.0], [0.0, 0.0]]  # estimated ankle positions in world (leg odometry) [m]
         self._landing = [[0.0, 0.0], [0.0, 0.0]]  # landing corrections of the feet in world [m]
         self._anchor = 0
+        self._floor_normal = [0.0, 0.0, 1.0]  # filtered, in world (gravity up)
         self.state = BalanceState(np.zeros(2), np.full(2, np.nan), np.zeros(2), np.zeros(2), np.zeros((2, 2)),
                                   0.0, np.zeros(2))
 
@@ -289,6 +298,19 @@ class Stabilizer:
             self._anchor = anchor
         anchor = self._anchor
         foot_anchor = self._feet[anchor]
+        # --- 6. floor slope: the loaded sole's normal in world (IMU and measured kinematics), low-pass filtered
+        normal = self._floor_normal
+        if g.slope_time_constant > 0.0 and (loaded0 if anchor == 0 else loaded1):
+            sole = rotations[2 * anchor, 6]
+            measured_normal = _rotate3(rot, (float(sole[0, 2]), float(sole[1, 2]), float(sole[2, 2])))
+            beta = dt / (g.slope_time_constant + dt)
+            for i in range(3):
+                normal[i] += beta * (measured_normal[i] - normal[i])
+        slope_x = self.robot.pendulum_length * normal[0] / normal[2] if g.slope_time_constant > 0.0 else 0.0
+        slope_y = self.robot.pendulum_length * normal[1] / normal[2] if g.slope_time_constant > 0.0 else 0.0
+        slope_norm = math.hypot(slope_x, slope_y)
+        if slope_norm > g.com_limit:
+            slope_x, slope_y = slope_x * g.com_limit / slope_norm, slope_y * g.com_limit / slope_norm
         arm = _rotate3(rot, _sub3(com_in_base, relative[anchor]))
         cx, cy = foot_anchor[0] + arm[0], foot_anchor[1] + arm[1]
         # Where the feet are (odometry; the swing foot follows from the stance foot and the kinematics): the
@@ -331,8 +353,8 @@ class Stabilizer:
             ax, ay = g.com_admittance * (zmx - pdx), g.com_admittance * (zmy - pdy)
         else:
             ax = ay = 0.0
-        ax -= g.com_damping * offset_rate[0] + g.com_stiffness * offset[0]
-        ay -= g.com_damping * offset_rate[1] + g.com_stiffness * offset[1]
+        ax -= g.com_damping * offset_rate[0] + g.com_stiffness * (offset[0] + slope_x)
+        ay -= g.com_damping * offset_rate[1] + g.com_stiffness * (offset[1] + slope_y)
         offset_rate[0] += ax * dt
         offset_rate[1] += ay * dt
         offset[0] += offset_rate[0] * dt
@@ -366,7 +388,7 @@ class Stabilizer:
                         g.attitude_limit)
         turn_pitch = min(max(-g.attitude_gain * pitch - g.attitude_damping * float(rate[1]), -g.attitude_limit),
                          g.attitude_limit)
-        # --- 6. landing: a swinging foot aims at its planned place in world from where the base is (odometry),
+        # --- 7. landing: a swinging foot aims at its planned place in world from where the base is (odometry),
         # not where the plan has it; the correction is released once the foot carries load.
         stance = _rotate3(rot, relative[anchor])
         base_ex, base_ey = foot_anchor[0] - stance[0], foot_anchor[1] - stance[1]
@@ -402,7 +424,7 @@ class Stabilizer:
         result[6:12] += deltas[1, self._scatter[1]]
         self.state = BalanceState(np.array([pdx, pdy]), np.array([zmx, zmy]), np.array([ex, ey]),
                                   np.array(offset), np.array(self._ankle), self._height,
-                                  np.array([turn_roll, turn_pitch]))
+                                  np.array([turn_roll, turn_pitch]), np.array([-slope_x, -slope_y]))
         return result
 
     def _jacobians(self, rotations: Array, translations: Array, ankles: Array) -> Array:

@@ -127,13 +127,17 @@ def walk_verdict(result: SimulationResult, hold: float) -> Verdict:
 
 
 def cop_margin_outside_touchdowns(result: SimulationResult) -> float:
-    """Least CoP margin [m] over the samples not within :data:`TOUCHDOWN_WINDOW` after a sole became loaded."""
+    """Least CoP margin [m] over the samples not within :data:`TOUCHDOWN_WINDOW` after a sole became loaded.
+
+    The robot is set on the floor at the first sample: a sole loaded there has just touched down too.
+    """
     weight = result.robot.mass * result.robot.gravity
     loaded = np.column_stack([result.force_left, result.force_right]) > LOADED_FRACTION * weight
     touchdown = np.zeros(len(result.time), dtype=bool)
     window = max(1, round(TOUCHDOWN_WINDOW / max(float(np.median(np.diff(result.time))), 1e-6)))
     for foot in range(2):
-        starts = np.flatnonzero(loaded[1:, foot] & ~loaded[:-1, foot]) + 1
+        became = np.concatenate([[True], ~loaded[:-1, foot]])  # nothing is loaded before the first sample
+        starts = np.flatnonzero(loaded[:, foot] & became)
         for start in starts:
             touchdown[start:start + window] = True
     judged = result.cop_margin[~touchdown]
