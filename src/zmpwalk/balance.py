@@ -27,9 +27,10 @@ separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega 
 4. **Foot force difference control** (Kajita et al. 2010): in double support the feet's heights move apart
    until the measured force difference is the desired one.
 5. **Torso attitude**: the pelvis is turned against the measured roll and pitch (and their rates).
-6. **Floor slope**: the loaded sole lies on the floor, so its attitude (IMU and measured leg kinematics)
-   is the floor's; with unit normal ``n`` the CoM must stand ``l (n_x, n_y) / n_z`` uphill of its plan for
-   the ZMP to stay where planned, and the CoM admittance is pulled to that offset instead of to zero.
+6. **Floor slope**: in double support both soles lie on the floor, so their attitude (IMU and measured leg
+   kinematics) is the floor's; with unit normal ``n`` the CoM must stand ``l (n_x, n_y) / n_z`` uphill of
+   its plan for the ZMP to stay where planned, and the CoM admittance is pulled to that offset instead of
+   to zero.
 
 All corrections are small offsets of the feet relative to the pelvis, mapped onto the joints through each
 leg's Jacobian at the pattern's angles (``Delta q = J^{-1} Delta x``): nothing is planned or solved
@@ -78,8 +79,8 @@ class StabilizerGains:
         landing_time_constant: How fast a swinging foot's aim moves to its planned place in world [s].
         landing_release: How fast that correction is released once the foot carries load [s].
         landing_limit: Largest landing correction [m].
-        slope_time_constant: Low-pass filter of the floor normal measured under the loaded sole [s]; 0 turns
-            the slope compensation off.
+        slope_time_constant: Low-pass filter of the floor normal measured under both soles in double support
+            [s]; 0 turns the slope compensation off.
     """
 
     dcm: float = 3.0  # [1/s]
@@ -298,11 +299,11 @@ class Stabilizer:
             self._anchor = anchor
         anchor = self._anchor
         foot_anchor = self._feet[anchor]
-        # --- 6. floor slope: the loaded sole's normal in world (IMU and measured kinematics), low-pass filtered
+        # --- 6. floor slope: the soles' normal in world (IMU and measured kinematics), low-pass filtered
         normal = self._floor_normal
-        if g.slope_time_constant > 0.0 and (loaded0 if anchor == 0 else loaded1):
-            sole = rotations[2 * anchor, 6]
-            measured_normal = _rotate3(rot, (float(sole[0, 2]), float(sole[1, 2]), float(sole[2, 2])))
+        if g.slope_time_constant > 0.0 and loaded0 and loaded1:  # both soles down: both flat on the floor
+            soles = rotations[0::2, 6, :, 2].sum(axis=0)
+            measured_normal = _rotate3(rot, (float(soles[0]) / 2, float(soles[1]) / 2, float(soles[2]) / 2))
             beta = dt / (g.slope_time_constant + dt)
             for i in range(3):
                 normal[i] += beta * (measured_normal[i] - normal[i])
