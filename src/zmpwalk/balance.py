@@ -291,13 +291,15 @@ class Stabilizer:
                           [float(ankles_in_world[1][0]), float(ankles_in_world[1][1])]]
             self._anchor = 0 if f0 >= f1 else 1
             self._started = True
-        # Leg odometry: when the load moves to the other sole, place it from the measured kinematics.
-        anchor = 0 if f0 >= f1 else 1
-        if anchor != self._anchor and loaded0 and loaded1:
-            d = _rotate3(rot, _sub3(relative[anchor], relative[self._anchor]))
-            self._feet[anchor] = [self._feet[self._anchor][0] + d[0], self._feet[self._anchor][1] + d[1]]
-            self._anchor = anchor
+        # Leg odometry: the sole that has carried load the longest is the reference. While the other carries
+        # load too, it is placed from the reference by the measured kinematics at every tick, so a foot that
+        # lands heel first and rolls flat is followed; when the reference unloads, the other one takes over.
         anchor = self._anchor
+        if loaded0 and loaded1:
+            d = _rotate3(rot, _sub3(relative[1 - anchor], relative[anchor]))
+            self._feet[1 - anchor] = [self._feet[anchor][0] + d[0], self._feet[anchor][1] + d[1]]
+        elif loaded0 != loaded1:
+            anchor = self._anchor = 0 if loaded0 else 1
         foot_anchor = self._feet[anchor]
         # --- 6. floor slope: the soles' normal in world (IMU and measured kinematics), low-pass filtered
         normal = self._floor_normal
