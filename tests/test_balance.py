@@ -157,6 +157,26 @@ def test_a_floor_rising_ahead_moves_the_com_uphill_by_l_tan_slope() -> None:
     assert np.all(off.state.slope_offset == 0.0)
 
 
+def test_odometry_follows_the_newer_foot_through_double_support() -> None:
+    """While both soles carry load, the newer one is placed from the reference by the measured kinematics at
+    every tick (a foot landing heel first rolls flat after the load has passed to it); once the reference
+    unloads, the other foot becomes the reference."""
+    stabilizer, inputs, _ = standing()
+    run(stabilizer, inputs, 5)
+    assert stabilizer._anchor == 0
+    before = list(stabilizer._feet[1])
+    angles = np.asarray(inputs["joint_angles"]).copy()
+    angles[6 + 2] += 0.02  # the right hip pitch: the right ankle moves relative to the base
+    run(stabilizer, inputs, 1, joint_angles=angles, loads=(1.5, 0.5))
+    chains = leg_chains(stabilizer.robot)
+    left, right = (chain.fk(a[None])[0][0] for chain, a in zip(chains, (angles[:6], angles[6:]), strict=True))
+    expected = np.asarray(stabilizer._feet[0]) + (right - left)[:2]  # upright torso, heading 0
+    assert np.asarray(stabilizer._feet[1]) == pytest.approx(expected, abs=1e-12)
+    assert abs(stabilizer._feet[1][0] - before[0]) > 1e-3
+    run(stabilizer, inputs, 1, joint_angles=angles, loads=(0.0, 2.0))  # the left foot lifts
+    assert stabilizer._anchor == 1
+
+
 @pytest.mark.parametrize("field", ["dcm", "ankle_gain", "com_limit"])
 def test_bad_gains_are_rejected(field: str) -> None:
     with pytest.raises(InvalidParameterError, match=f"gains.{field}"):
