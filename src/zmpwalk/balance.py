@@ -9,11 +9,11 @@ stabilization of the HRP-4 humanoid robot using whole-body admittance control*, 
 needs only what a position-controlled robot has (no torque control) and each of its parts is a small,
 separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega = sqrt(g / l)``:
 
-1. **DCM tracking.** The CoM ``c`` is estimated from the encoders and the IMU, anchored at the loaded sole,
-   whose place in world comes from leg odometry (when the load passes to the other sole, that sole is
-   placed from the measured kinematics), so a step landed short shows as a DCM error; the divergent
-   component of motion ``xi = c + c' / omega`` must follow the
-   pattern's. Its error ``e = xi - xi_ref`` decays at rate ``k_xi`` when the ZMP is
+1. **DCM tracking.** The CoM ``c`` is estimated from the encoders and the IMU, anchored at the sole that
+   has carried load the longest, whose place in world comes from leg odometry (while both soles carry load
+   the newer one is placed from it by the measured kinematics, tick by tick), so a step landed short shows
+   as a DCM error; the divergent component of motion ``xi = c + c' / omega`` must follow the pattern's.
+   Its error ``e = xi - xi_ref`` decays at rate ``k_xi`` when the ZMP is
 
    .. math:: p_d = p_{ref} + (1 + k_\xi / \omega)\, e, \qquad \dot e = -k_\xi e
 
