@@ -197,6 +197,32 @@ def test_a_sweep_on_two_processes_gives_the_walks_of_one():
         assert a.simulated > 5.0 and a.passed  # both walks stand at the end (verdict)
 
 
+def test_a_sweep_on_a_local_dask_cluster_gives_the_walks_of_one_process():
+    """Past one machine the same jobs run on Dask (here a local cluster of two processes)."""
+    pytest.importorskip("dask.distributed")
+    from zmpwalk.sim.sweep import sweep
+
+    on_dask = sweep("hubo", ["fig10", "turn45"], workers=2, scheduler="local")
+    inline = sweep("hubo", ["fig10", "turn45"], workers=1)
+    assert [r.scenario for r in on_dask] == ["fig10", "turn45"]
+    for a, b in zip(on_dask, inline, strict=True):
+        assert (a.passed, a.failed, a.fell) == (b.passed, b.failed, b.fell)
+        assert a.distance == pytest.approx(b.distance, abs=1e-12)  # [m] deterministic simulation
+
+
+def test_a_bad_dask_scheduler_or_no_dask_is_one_clear_error(monkeypatch):
+    import sys
+
+    from zmpwalk.sim.sweep import sweep
+
+    pytest.importorskip("dask.distributed")
+    with pytest.raises(InvalidParameterError, match=r"scheduler = 'not an address'.*Dask scheduler reachable"):
+        sweep("hubo", ["fig10", "turn45"], workers=2, scheduler="not an address")
+    monkeypatch.setitem(sys.modules, "dask.distributed", None)  # as if Dask were not installed
+    with pytest.raises(InvalidParameterError, match=r'pip install "zmpwalk\[distributed\]"'):
+        sweep("hubo", ["fig10", "turn45"], workers=2, scheduler="local")
+
+
 def test_sweep_cli_exit_status_follows_the_verdicts(capsys):
     from zmpwalk.cli import EXIT_FAILED, main
 

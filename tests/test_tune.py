@@ -49,6 +49,14 @@ def test_tuning_a_row_puts_both_zmps_inside_and_walks_and_the_same_seed_gives_th
     assert parameters.alpha == pytest.approx(result.values["alpha"], rel=1e-5)
 
 
+def test_tuning_on_a_local_dask_cluster_gives_the_rows_of_one_process():
+    pytest.importorskip("dask.distributed")
+    rows = [Condition("forward", 0.7, 0.0), SLOW_ROW]
+    on_dask = tune("hubo", trials=4, seed=5, workers=2, conditions=rows, steps=4, scheduler="local")
+    inline = tune("hubo", trials=4, seed=5, workers=1, conditions=rows, steps=4)
+    assert [r.values for r in on_dask.results] == [r.values for r in inline.results]  # seeded per row
+
+
 def test_a_stored_study_resumes_where_it_stopped(tmp_path):
     storage = tmp_path / "tune.db"
     tune("hubo", trials=4, workers=1, conditions=[SLOW_ROW], steps=4, storage=storage)

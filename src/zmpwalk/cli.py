@@ -95,6 +95,10 @@ def _schedule(args: argparse.Namespace) -> Schedule | None:
     return Schedule.from_file(path)
 
 
+DASK_HELP = ("run on a Dask cluster: its scheduler's address (tcp://host:8786), or local "
+             '(pip install "zmpwalk[distributed]")')
+
+
 def _pelvis(args: argparse.Namespace) -> str:
     pelvis = str(getattr(args, "pelvis", "cubic"))
     if pelvis != "cubic" and getattr(args, "generator", "polynomial") != "polynomial":
@@ -254,6 +258,7 @@ def _parser() -> argparse.ArgumentParser:
     _robot_options(sweep_cmd)
     sweep_cmd.add_argument("--scenario", nargs="+", help="scenarios to walk (default: every built-in one)")
     sweep_cmd.add_argument("--workers", type=int, help="walks at a time (default: one per core)")
+    sweep_cmd.add_argument("--dask", metavar="SCHEDULER", help=DASK_HELP)
     sweep_cmd.add_argument("--balance", choices=("on", "off"), default=None,
                            help="the stabilizer (default: on for a robot's own model, off for the box models)")
     sweep_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
@@ -275,6 +280,7 @@ def _parser() -> argparse.ArgumentParser:
     tune_cmd.add_argument("--steps", type=int, default=10, help="steps walked per candidate (default: 10)")
     tune_cmd.add_argument("--seed", type=int, default=0, help="sampler seed: the same seed, the same schedule")
     tune_cmd.add_argument("--workers", type=int, help="conditions at a time (default: one per core)")
+    tune_cmd.add_argument("--dask", metavar="SCHEDULER", help=DASK_HELP)
     tune_cmd.add_argument("--storage", type=Path, help="SQLite file of the studies: a stopped run resumes")
     tune_cmd.add_argument("--json", action="store_true", help="print JSON")
     robot_cmd = commands.add_parser(
@@ -477,7 +483,8 @@ def _sweep(args: argparse.Namespace) -> int:
     started, cpu = time.perf_counter(), time.process_time()
     schedule = _schedule(args)  # read here: a bad file is one error, not one per worker
     results = sweep(args.robot, names, balance=balance, workers=workers, progress=show, generator=args.generator,
-                    schedule=str(args.schedule.resolve()) if schedule is not None else None, pelvis=_pelvis(args))
+                    schedule=str(args.schedule.resolve()) if schedule is not None else None, pelvis=_pelvis(args),
+                    scheduler=args.dask)
     wall = time.perf_counter() - started
     walked = sum(r.seconds for r in results)
     if args.json:
@@ -510,7 +517,7 @@ def _tune(args: argparse.Namespace) -> int:
         lambda done, total, best: _progress(f"conditions (best {best * 1e3:+.1f} mm)", done, total))
     started = time.perf_counter()
     result = tune(args.robot, trials=args.trials, seed=args.seed, workers=args.workers, storage=args.storage,
-                  steps=args.steps, data=data, progress=show)
+                  steps=args.steps, data=data, progress=show, scheduler=args.dask)
     wall = time.perf_counter() - started
     write_text(args.out, schedule_toml(result, args.robot) + "\n")
     if args.json:

@@ -287,7 +287,7 @@ def tune_condition(robot_spec: str, data: dict[str, Any], condition: Condition, 
 
 def tune(robot: str, trials: int = 40, seed: int = 0, workers: int | None = None, storage: Path | None = None,
          steps: int = 10, data: dict[str, Any] | None = None, conditions: Sequence[Condition] | None = None,
-         progress: Callable[[int, int, float], None] | None = None) -> TuneResult:
+         progress: Callable[[int, int, float], None] | None = None, scheduler: str | None = None) -> TuneResult:
     """Tune the shape factors of every condition of a schedule for a robot.
 
     Args:
@@ -300,6 +300,8 @@ def tune(robot: str, trials: int = 40, seed: int = 0, workers: int | None = None
         data: The schedule to start from (default: Tables 2-3); its rows are the grid.
         conditions: Only these rows (default: every row).
         progress: Called with (conditions done, of, best score so far [m]).
+        scheduler: Tune the conditions on a Dask cluster (its scheduler's address, or ``"local"``;
+            :func:`zmpwalk.sim.sweep.in_pool`). With ``storage``, every worker must reach the same file.
 
     Raises:
         InvalidParameterError: A bad count or a condition that is not a row.
@@ -330,7 +332,7 @@ def tune(robot: str, trials: int = 40, seed: int = 0, workers: int | None = None
     first_pass = [i for i, c in enumerate(grid) if c.mode == "forward" and c.stride == 0.0]
     for indices in (first_pass, [i for i in range(len(grid)) if i not in first_pass]):
         in_pool(tune_condition, {i: (robot, data, grid[i], i, trials, seed, steps, url) for i in indices}, workers,
-                record)
+                record, scheduler)
         for index in indices:
             data = with_row(data, grid[index], results[index].values)
     return TuneResult(data, [results[index] for index in range(len(grid))])

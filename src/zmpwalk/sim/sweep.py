@@ -5,6 +5,10 @@ MuJoCo walk (with the stabilizer where asked), standing :data:`SETTLE` before an
 after, and the verdict of :func:`zmpwalk.sim.verdict.walk_verdict`. Workers load the robot
 themselves (by name or model path), so nothing heavier than a few strings crosses a process
 boundary.
+
+Past one machine, the same jobs run on a Dask cluster (``scheduler``: a scheduler's address, or
+``"local"`` for a local cluster of ``workers`` processes; ``pip install "zmpwalk[distributed]"``). Dask
+schedules and moves the jobs; every worker needs zmpwalk and the robot's files at the same paths.
 """
 
 from __future__ import annotations
@@ -22,6 +26,8 @@ from zmpwalk.robots import loaded_robot
 from zmpwalk.sim.verdict import HOLD, SETTLE
 
 T = TypeVar("T")
+
+DASK_CONNECT_TIMEOUT = 10.0  # [s] to reach a Dask scheduler
 
 
 @dataclass(frozen=True)
@@ -105,9 +111,20 @@ def walk_scenario(robot: str, scenario: str, balance: bool | None = None, genera
 
 
 def in_pool(function: Callable[..., T], arguments: dict[int, tuple[Any, ...]], workers: int,
-            record: Callable[[int, T], None]) -> None:
+            record: Callable[[int, T], None], scheduler: str | None = None) -> None:
     """``function(*arguments[i])`` for every ``i``, ``workers`` at a time in worker processes (in this process
-    when one worker or one call), each result handed to ``record(i, result)`` as it comes."""
+    when one worker or one call), each result handed to ``record(i, result)`` as it comes.
+
+    Args:
+        scheduler: Run the calls on a Dask cluster instead: a scheduler's address (``tcp://host:8786``), or
+            ``"local"`` for a local cluster of ``workers`` processes.
+
+    Raises:
+        InvalidParameterError: ``scheduler`` given without Dask installed.
+    """
+    if scheduler is not None:
+        _on_dask(function, arguments, workers, record, scheduler)
+        return
     if workers == 1 or len(arguments) <= 1:
         for index, args in arguments.items():
             record(index, function(*args))
@@ -118,10 +135,37 @@ def in_pool(function: Callable[..., T], arguments: dict[int, tuple[Any, ...]], w
             record(futures[future], future.result())
 
 
+def _on_dask(function: Callable[..., T], arguments: dict[int, tuple[Any, ...]], workers: int,
+             record: Callable[[int, T], None], scheduler: str) -> None:
+    try:
+        from dask.distributed import Client, LocalCluster
+        from dask.distributed import as_completed as dask_completed
+    except ImportError:
+        raise InvalidParameterError("scheduler", scheduler, 'a Dask scheduler with Dask installed: '
+                                    'pip install "zmpwalk[distributed]"') from None
+    cluster = (LocalCluster(n_workers=workers, threads_per_worker=1, processes=True)  # type: ignore[no-untyped-call]
+               if scheduler == "local" else None)
+    try:
+        try:
+            client = Client(cluster if cluster is not None else scheduler,  # type: ignore[no-untyped-call]
+                            timeout=DASK_CONNECT_TIMEOUT)
+        except (OSError, ValueError, TypeError) as error:
+            raise InvalidParameterError("scheduler", scheduler, f"a Dask scheduler reachable within "
+                                        f"{DASK_CONNECT_TIMEOUT:g} s, or 'local' ({error})") from None
+        with client:
+            futures = {client.submit(function, *args, pure=False): index for index, args in arguments.items()}
+            for future in dask_completed(list(futures)):  # type: ignore[no-untyped-call]
+                record(futures[future], future.result())
+    finally:
+        if cluster is not None:
+            cluster.close()
+
+
 def sweep(robot: str, scenarios: Sequence[str], balance: bool | None = None, workers: int | None = None,
           progress: Callable[[int, int], None] | None = None, generator: str = "polynomial",
-          schedule: str | None = None, pelvis: str = "cubic") -> list[SweepResult]:
-    """Simulate every scenario on ``robot``, ``workers`` walks at a time (default: one per core).
+          schedule: str | None = None, pelvis: str = "cubic", scheduler: str | None = None) -> list[SweepResult]:
+    """Simulate every scenario on ``robot``, ``workers`` walks at a time (default: one per core), or on a
+    Dask cluster (``scheduler``, see the module docstring).
 
     Returns:
         The results in the order of ``scenarios``.
@@ -144,5 +188,5 @@ def sweep(robot: str, scenarios: Sequence[str], balance: bool | None = None, wor
             progress(len(results), len(scenarios))
 
     in_pool(walk_scenario, {index: (robot, name, balance, generator, schedule, pelvis)
-                            for index, name in enumerate(scenarios)}, workers, record)
+                            for index, name in enumerate(scenarios)}, workers, record, scheduler)
     return [results[index] for index in range(len(scenarios))]
