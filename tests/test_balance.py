@@ -177,6 +177,25 @@ def test_odometry_follows_the_newer_foot_through_double_support() -> None:
     assert stabilizer._anchor == 1
 
 
+def test_a_large_dcm_error_moves_the_swinging_foot_towards_the_fall() -> None:
+    """Standing on the left foot with the body 6 cm ahead of its plan: the right foot's aim moves forward by
+    step_gain times the DCM error beyond the deadband; within the deadband it lands where planned."""
+    def landing(shift: float, gains: StabilizerGains) -> float:
+        stabilizer, inputs, _ = standing()
+        stabilizer = Stabilizer(stabilizer.robot, 1000.0, gains)
+        com = np.asarray(inputs["position_com_in_world"]).copy()
+        com[0] -= shift  # the plan is behind the body: a DCM error of +shift
+        inputs = {**inputs, "position_com_in_world": com, "support": 1}
+        run(stabilizer, inputs, 1500, loads=(2.0, 0.0))
+        return float(stabilizer._landing[1][0])
+
+    gains = StabilizerGains(step_gain=0.5, step_deadband=0.03)
+    without = dataclasses.replace(gains, step_gain=0.0)
+    moved = landing(0.06, gains) - landing(0.06, without)
+    assert moved > 0.0  # forward, where the body falls
+    assert landing(0.02, gains) == pytest.approx(landing(0.02, without), abs=1e-12)  # inside the deadband
+
+
 @pytest.mark.parametrize("field", ["dcm", "ankle_gain", "com_limit"])
 def test_bad_gains_are_rejected(field: str) -> None:
     with pytest.raises(InvalidParameterError, match=f"gains.{field}"):

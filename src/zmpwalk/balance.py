@@ -27,7 +27,10 @@ separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega 
 4. **Foot force difference control** (Kajita et al. 2010): in double support the feet's heights move apart
    until the measured force difference is the desired one.
 5. **Torso attitude**: the pelvis is turned against the measured roll and pitch (and their rates).
-6. **Floor slope**: in double support both soles lie on the floor, so their attitude (IMU and measured leg
+6. **Landing and stepping**: the swinging foot aims at its planned place in world from the odometry's
+   base, moved by :attr:`StabilizerGains.step_gain` times the DCM error, towards where the body falls (the
+   capture point of Pratt et al. 2006); the correction is released once the foot carries load.
+7. **Floor slope**: in double support both soles lie on the floor, so their attitude (IMU and measured leg
    kinematics) is the floor's; with unit normal ``n`` the CoM must stand ``l (n_x, n_y) / n_z`` uphill of
    its plan for the ZMP to stay where planned, and the CoM admittance is pulled to that offset instead of
    to zero.
@@ -81,6 +84,8 @@ class StabilizerGains:
         landing_limit: Largest landing correction [m].
         slope_time_constant: Low-pass filter of the floor normal measured under both soles in double support
             [s]; 0 turns the slope compensation off.
+        step_gain: The swinging foot's aim moves by this fraction of the DCM error (a step towards where the
+            body is falling) [-]; 0 lands it where planned.
     """
 
     dcm: float = 3.0  # [1/s]
@@ -103,6 +108,8 @@ class StabilizerGains:
     landing_release: float = 0.3  # [s]
     landing_limit: float = 0.1  # [m]
     slope_time_constant: float = 0.5  # [s]
+    step_gain: float = 0.5  # [-]
+    step_deadband: float = 0.03  # [m]
 
     def __post_init__(self) -> None:
         for name, value in vars(self).items():
@@ -392,19 +399,25 @@ class Stabilizer:
         turn_pitch = min(max(-g.attitude_gain * pitch - g.attitude_damping * float(rate[1]), -g.attitude_limit),
                          g.attitude_limit)
         # --- 7. landing: a swinging foot aims at its planned place in world from where the base is (odometry),
-        # not where the plan has it; the correction is released once the foot carries load.
+        # not where the plan has it, moved by step_gain times the DCM error (a step towards where the body is
+        # falling: the capture point of Pratt et al. 2006 lies xi - p ahead of the ZMP); the correction is
+        # released once the foot carries load.
         stance = _rotate3(rot, relative[anchor])
         base_ex, base_ey = foot_anchor[0] - stance[0], foot_anchor[1] - stance[1]
         planned_stance = _rotate2(planned_relative[anchor][0], planned_relative[anchor][1], yaw)
         base_px = float(ankles_in_world[anchor][0]) - planned_stance[0]
         base_py = float(ankles_in_world[anchor][1]) - planned_stance[1]
+        # the step towards the fall: step_gain times the DCM error beyond step_deadband
+        error_norm = math.hypot(ex, ey)
+        step = g.step_gain * max(error_norm - g.step_deadband, 0.0) / error_norm if error_norm > 0.0 else 0.0
+        step_x, step_y = step * ex, step * ey
         landing_rate, release_rate = dt / g.landing_time_constant, dt / g.landing_release
         landing_limit = g.landing_limit
         for foot in range(2):
             land = self._landing[foot]
             if (support == 1 and foot == 1) or (support == 2 and foot == 0):  # swinging
-                land[0] += landing_rate * (base_px + offset[0] - base_ex - land[0])
-                land[1] += landing_rate * (base_py + offset[1] - base_ey - land[1])
+                land[0] += landing_rate * (base_px + offset[0] - base_ex + step_x - land[0])
+                land[1] += landing_rate * (base_py + offset[1] - base_ey + step_y - land[1])
             else:
                 land[0] -= release_rate * land[0]
                 land[1] -= release_rate * land[1]
