@@ -56,6 +56,33 @@ def test_held_peaks_agree_with_inverse_dynamics_of_the_plan(demo: tuple[object, 
             assert abs(row.peak_torque - peak) < 0.15 * largest, column
 
 
+PLANNED_TOL = 1.0  # [N m]: the planned torques are the same inverse dynamics, at the control rate and from the
+# settle phase on; the held peaks of the two samplings of the plan agree to this
+
+
+def test_the_table_carries_the_plans_own_torques_and_flags_what_no_motor_gives(
+        demo: tuple[object, np.ndarray]) -> None:
+    """With the feedforward on, every row also says what the plan needs on an ideal robot (what the feedforward
+    sends); a joint whose plan asks more than its actuator's limit is named whatever the control does."""
+    import dataclasses
+    import math
+
+    from zmpwalk.sim.actuators import planned_over_limit
+
+    result, ideal = demo
+    rows = actuator_table(result)  # type: ignore[arg-type]
+    assert result.planned_torques is not None and result.planned_torques.shape == (len(result.time), 12)  # type: ignore[attr-defined]
+    ideal_peaks = sustained(np.abs(ideal), round(IMPACT_WINDOW * 1000))
+    for row, peak in zip(rows, ideal_peaks, strict=True):
+        assert row.planned_torque == pytest.approx(peak, abs=PLANNED_TOL)
+    assert planned_over_limit(rows) == []  # HUBO's box model has no limits
+    limited = [dataclasses.replace(row, torque_limit=row.planned_torque * 0.9) if row.joint == "left_knee" else row
+               for row in rows]
+    assert [row.joint for row in planned_over_limit(limited)] == ["left_knee"]
+    open_loop = dataclasses.replace(result, planned_torques=None)  # type: ignore[type-var]
+    assert all(math.isnan(row.planned_torque) for row in actuator_table(open_loop))  # type: ignore[arg-type]
+
+
 def test_motor_file_fits_and_exceeds(demo: tuple[object, np.ndarray], tmp_path: Path) -> None:
     result, _ = demo
     fits = motor_fits(result, load_motors(EXAMPLE))  # type: ignore[arg-type]

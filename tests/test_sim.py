@@ -118,7 +118,7 @@ def test_simulate_command_writes_results_and_json(tmp_path, capsys):
         assert key in summary
     assert summary["fell"] is False and len(summary["actuators"]) == 12
     assert set(summary["actuators"][0]) == {"joint", "peak_torque", "impact_torque", "rms_torque", "peak_velocity",
-                                            "peak_power", "mean_power", "torque_limit"}
+                                            "peak_power", "mean_power", "torque_limit", "planned_torque"}
     assert {p.name for p in out.iterdir()} == {"actuators.csv", "actuators.md", "simulation.csv"}
     assert not list(out.glob("*.part"))  # written through temporary files, renamed when complete
 

@@ -368,6 +368,7 @@ def _report(args: argparse.Namespace) -> int:
 def _simulate(args: argparse.Namespace) -> int:
     from zmpwalk.patterns.hyperbolic import paper_walk
     from zmpwalk.sim import actuator_markdown, actuator_table, simulate, write_actuator_csv
+    from zmpwalk.sim.actuators import planned_over_limit
     from zmpwalk.sim.motors import motor_fits
     from zmpwalk.sim.run import write_result_csv
     from zmpwalk.sim.verdict import walk_verdict
@@ -427,6 +428,7 @@ def _simulate(args: argparse.Namespace) -> int:
         "motors": [{"joint": f.joint, "motor": f.motor, "rms_use": f.rms_use, "peak_use": f.peak_use,
                     "fits": f.fits} for f in fits],
         "actuators": [vars(row) for row in rows],
+        "planned_over_limit": [row.joint for row in planned_over_limit(rows)],
     }
     if args.out:
         args.out.mkdir(parents=True, exist_ok=True)
@@ -448,6 +450,10 @@ def _simulate(args: argparse.Namespace) -> int:
         power = max(rows, key=lambda r: r.peak_power)
         print(f"largest torque {top.peak_torque:.3g} N m at {top.joint}; largest power {power.peak_power:.3g} W "
               f"at {power.joint}")
+        over = planned_over_limit(rows)
+        if over:
+            print("the plan itself needs more than the actuators give (ideal robot, inverse dynamics): "
+                  + ", ".join(f"{r.joint} {r.planned_torque:.3g} of {r.torque_limit:.3g} N m" for r in over))
         for fit in fits:
             print(f"motor {fit.motor!r} at {fit.joint}: RMS {fit.rms_use * 100:.0f} % of rated, held peak "
                   f"{fit.peak_use * 100:.0f} % of the envelope: {fit.verdict}")

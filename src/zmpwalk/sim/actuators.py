@@ -29,6 +29,8 @@ class ActuatorRow:
         peak_power: Largest |torque x velocity| held for at least :data:`IMPACT_WINDOW` [W].
         mean_power: Mean |torque x velocity| [W].
         torque_limit: The model's actuator limit [N m] (inf where it has none).
+        planned_torque: Largest |torque| the plan needs on an ideal robot, held for at least
+            :data:`IMPACT_WINDOW` [N m] (the feedforward's inverse dynamics; nan where it did not run).
     """
 
     joint: str
@@ -39,6 +41,7 @@ class ActuatorRow:
     peak_power: float  # [W]
     mean_power: float  # [W]
     torque_limit: float = math.inf  # [N m]
+    planned_torque: float = math.nan  # [N m]
 
 
 def sustained(values: np.ndarray, window: int) -> np.ndarray:
@@ -64,12 +67,20 @@ def actuator_table(result: SimulationResult, skip: float = 0.0) -> list[Actuator
     held_torque = sustained(torque, window)
     held_power = sustained(power, window)
     limits = _torque_limits(result)
+    planned = (np.full(len(result.joint_names), math.nan) if result.planned_torques is None
+               else sustained(np.abs(result.planned_torques[keep]), window))
     return [
         ActuatorRow(name, float(held_torque[i]), float(torque[:, i].max()),
                     float(np.sqrt(np.mean(torque[:, i] ** 2))), float(np.abs(velocity[:, i]).max()),
-                    float(held_power[i]), float(power[:, i].mean()), limits[i])
+                    float(held_power[i]), float(power[:, i].mean()), limits[i], float(planned[i]))
         for i, name in enumerate(result.joint_names)
     ]
+
+
+def planned_over_limit(rows: list[ActuatorRow]) -> list[ActuatorRow]:
+    """The joints whose planned torque (an ideal robot's) exceeds the actuator's limit: the plan itself asks
+    more than the motor gives, whatever the control."""
+    return [r for r in rows if math.isfinite(r.planned_torque) and r.planned_torque > r.torque_limit]
 
 
 def _torque_limits(result: SimulationResult) -> list[float]:
@@ -84,7 +95,7 @@ def write_actuator_csv(rows: list[ActuatorRow], path: Path) -> None:
     with atomic_output(path) as temporary, temporary.open("w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
         writer.writerow(["joint", "peak_torque_Nm", "impact_torque_Nm", "rms_torque_Nm", "peak_velocity_rad_s",
-                         "peak_power_W", "mean_power_W", "torque_limit_Nm"])
+                         "peak_power_W", "mean_power_W", "torque_limit_Nm", "planned_torque_Nm"])
         for row in rows:
             values = asdict(row)
             writer.writerow([values.pop("joint"), *(f"{v:.6g}" for v in values.values())])
@@ -95,13 +106,14 @@ def actuator_markdown(rows: list[ActuatorRow]) -> str:
     window = f"{IMPACT_WINDOW * 1e3:g} ms"
     lines = [f"| joint | peak torque (held {window}) [N m] | impact peak [N m] | RMS torque [N m] | "
              f"peak velocity [rad/s] | peak power (held {window}) [W] | mean power [W] | "
-             "model's limit [N m] (held peak's share) |",
-             "|---|---|---|---|---|---|---|---|"]
+             "model's limit [N m] (held peak's share) | planned, ideal robot [N m] |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         limit = "none"
         if math.isfinite(r.torque_limit):
             share = r.peak_torque / r.torque_limit
             limit = f"{r.torque_limit:.3g} ({share * 100:.0f} %{', EXCEEDED' if share > 1 else ''})"
         lines.append(f"| {r.joint} | {r.peak_torque:.3g} | {r.impact_torque:.3g} | {r.rms_torque:.3g} | "
-                     f"{r.peak_velocity:.3g} | {r.peak_power:.3g} | {r.mean_power:.3g} | {limit} |")
+                     f"{r.peak_velocity:.3g} | {r.peak_power:.3g} | {r.mean_power:.3g} | {limit} | "
+                     f"{'-' if math.isnan(r.planned_torque) else format(r.planned_torque, '.3g')} |")
     return "\n".join(lines)

@@ -193,8 +193,13 @@ def static_feedforward(plant: Plant, qpos: Array, zmp: Array, support: NDArray[n
         rate: Rows per second [Hz].
         dynamic: Include the inertial terms and the horizontal reaction.
     """
+    return servo_offsets(plant, _servo_torques(plant, qpos, zmp, support, ankles, rate, dynamic))
+
+
+def servo_offsets(plant: Plant, torques: Array) -> Array:
+    """Control offsets (n, nu) [rad] that make each position servo deliver ``torques`` (n, nu) [N m]:
+    ``tau / (kp gear^2)`` (0 at the other actuators)."""
     model = plant.model
-    torques = _servo_torques(plant, qpos, zmp, support, ankles, rate, dynamic)
     servos = [a for a in range(model.nu) if is_position_servo(model, a)]
     offsets = np.zeros_like(torques)
     offsets[:, servos] = torques[:, servos] / (model.actuator_gainprm[servos, 0] * model.actuator_gear[servos, 0] ** 2)
@@ -208,8 +213,14 @@ def planned_torques(plant: Plant, qpos: Array, zmp: Array, support: NDArray[np.i
     The torques behind :func:`static_feedforward` (``dynamic=True``): what an ideal robot needs for the plan,
     against which the simulated motor table is checked.
     """
-    torques = _servo_torques(plant, qpos, zmp, support, ankles, rate, dynamic=True)
-    return np.asarray(torques[:, plant.leg_actuators], dtype=np.float64)
+    return servo_torques(plant, qpos, zmp, support, ankles, rate)[:, plant.leg_actuators]
+
+
+def servo_torques(plant: Plant, qpos: Array, zmp: Array, support: NDArray[np.integer],
+                  ankles: tuple[Array, Array], rate: float = 1000.0) -> Array:
+    """Joint torques of the planned motion at every position servo [N m], (n, nu) (0 at the other actuators):
+    :func:`static_feedforward`'s inverse dynamics, for a caller that wants both the torques and the offsets."""
+    return _servo_torques(plant, qpos, zmp, support, ankles, rate, dynamic=True)
 
 
 def _servo_torques(plant: Plant, qpos: Array, zmp: Array, support: NDArray[np.integer],

@@ -52,8 +52,9 @@ from zmpwalk.sim.plant import (
     build_plant,
     damping_feedforward,
     plant_qpos,
+    servo_offsets,
+    servo_torques,
     set_initial_state,
-    static_feedforward,
 )
 from zmpwalk.zmp import batch_hull_margin, edge_margin
 
@@ -90,6 +91,9 @@ class SimulationResult:
         joint_angles, joint_velocities, joint_torques, joint_power: (n, 12) [rad], [rad/s], [N m], [W].
         mass_scale: Multiplier of all masses.
         ankle_positions: Left and right ankle positions in world [m], (n, 2, 3).
+        planned_torques: The leg joint torques the plan needs on an ideal robot (inverse dynamics of the
+            planned motion with the planned ground reaction, what the feedforward sends) [N m], (n, 12); None
+            where the feedforward did not run.
         balance: The stabilizer's log per sample (``zmp_desired``, ``com_offset``, ``ankle_offsets``,
             ``height_difference``, ``pelvis_turn``), or None open loop.
         final_feet_error: Largest horizontal distance of a simulated ankle from its planned final place [m]
@@ -124,6 +128,7 @@ class SimulationResult:
     joint_names: tuple[str, ...] = field(default=JOINT_COLUMNS)
     balance: dict[str, Array] | None = None
     ankle_positions: Array | None = None  # [m] (n, 2, 3)
+    planned_torques: Array | None = None  # [N m] (n, 12)
     final_feet_error: float = math.nan  # [m]
     final_feet_yaw_error: float = math.nan  # [rad]
     end_min_sole_force: float = math.nan  # [N]
@@ -304,6 +309,7 @@ def simulate(
     mujoco.mj_getState(model, data, state, spec)
     control = np.repeat(plant.ctrl_hold[None, :], n, axis=0)
     control[:, plant.leg_actuators] = reference
+    planned_torques: Array | None = None
     if feedforward:
         index = np.clip(np.searchsorted(pattern.time, pattern_time), 0, len(pattern.time) - 1)
         base_path = np.column_stack([np.interp(pattern_time, pattern.time, base_planned[:, i]) for i in range(3)])
@@ -313,8 +319,10 @@ def simulate(
         qpos_path = plant_qpos(plant, base_path, yaw_path, reference)
         rates = np.column_stack([np.interp(pattern_time, joints.time, joints.velocities[:, j]) for j in range(12)])
         control[:, plant.leg_actuators] += damping_feedforward(plant, rates)
-        control += static_feedforward(plant, qpos_path, zmp_ref, pattern.support[index],
-                                      (planned_ankles[0], planned_ankles[1]))
+        needed = servo_torques(plant, qpos_path, zmp_ref, pattern.support[index],
+                               (planned_ankles[0], planned_ankles[1]))
+        control += servo_offsets(plant, needed)
+        planned_torques = needed[:, plant.leg_actuators]
     if disturbances is not None:  # the world changes after the controller's model is made
         disturbances.apply(model)
     balance_log: dict[str, Array] | None = None
@@ -397,6 +405,7 @@ def simulate(
         end_max_speed=end_speed, end_attitude_range=end_attitude,
         balance=None if balance_log is None else {k: v[:end] for k, v in balance_log.items()},
         ankle_positions=np.stack([sensors.take(readings, f"{label}_ankle_pos") for label in ("left", "right")], axis=1),
+        planned_torques=None if planned_torques is None else planned_torques[:end],
     )
 
 
