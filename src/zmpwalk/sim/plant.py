@@ -217,10 +217,11 @@ def planned_torques(plant: Plant, qpos: Array, zmp: Array, support: NDArray[np.i
 
 
 def servo_torques(plant: Plant, qpos: Array, zmp: Array, support: NDArray[np.integer],
-                  ankles: tuple[Array, Array], rate: float = 1000.0) -> Array:
+                  ankles: tuple[Array, Array], rate: float = 1000.0, dynamic: bool = True) -> Array:
     """Joint torques of the planned motion at every position servo [N m], (n, nu) (0 at the other actuators):
-    :func:`static_feedforward`'s inverse dynamics, for a caller that wants both the torques and the offsets."""
-    return _servo_torques(plant, qpos, zmp, support, ankles, rate, dynamic=True)
+    :func:`static_feedforward`'s inverse dynamics, for a caller that wants both the torques and the offsets
+    (``dynamic=False``: gravity and the static reaction only)."""
+    return _servo_torques(plant, qpos, zmp, support, ankles, rate, dynamic)
 
 
 def _servo_torques(plant: Plant, qpos: Array, zmp: Array, support: NDArray[np.integer],

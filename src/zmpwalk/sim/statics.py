@@ -13,7 +13,7 @@ walking posture, for one, needs 24.9 N m at the stance hip roll and 25.5 N m at 
 pitch-roll-yaw hip shares the sideways moment between them), each of a 30 N m limit, before any motion.
 
 The torques come from the same inverse dynamics as the simulation's feedforward
-(:func:`zmpwalk.sim.plant.static_feedforward`, ``dynamic=False``): gravity minus the planned ground
+(:func:`zmpwalk.sim.plant.servo_torques`, ``dynamic=False``): gravity minus the planned ground
 reaction, all weight on the stance sole at the point under the centre of mass.
 """
 
@@ -73,7 +73,7 @@ def static_torques(robot: RobotModel) -> StaticTorques:
     Raises:
         InvalidParameterError: ``robot`` is a box model (no model of its own to hold).
     """
-    from zmpwalk.sim.plant import FEEDFORWARD_PERIOD, _servo_torques, build_plant, plant_qpos
+    from zmpwalk.sim.plant import FEEDFORWARD_PERIOD, build_plant, plant_qpos, servo_torques
 
     if robot.plant is None or robot.legs is None:
         raise InvalidParameterError("robot", robot.name, "a robot imported from its MJCF or URDF model")
@@ -91,9 +91,9 @@ def static_torques(robot: RobotModel) -> StaticTorques:
     if legs.position_base_in_world is None:  # pragma: no cover - imported robots always place the base
         raise InvalidParameterError("robot", robot.name, "a robot imported from its MJCF or URDF model")
     qpos = plant_qpos(plant, legs.position_base_in_world, zero, legs.angles)
-    torques = _servo_torques(plant, qpos, com_xy, np.array([0, 1, 2]), (ankles[0], ankles[1]),
-                             1.0 / FEEDFORWARD_PERIOD,  # every row a key row, none interpolated
-                             dynamic=False)[:, plant.leg_actuators]
+    torques = servo_torques(plant, qpos, com_xy, np.array([0, 1, 2]), (ankles[0], ankles[1]),
+                            1.0 / FEEDFORWARD_PERIOD,  # every row a key row, none interpolated
+                            dynamic=False)[:, plant.leg_actuators]
     limits = np.array([np.inf if joint.actuator is None else joint.actuator.force_limit
                        for joint in robot.plant.joints])
     return StaticTorques(torques[0], torques[1], torques[2], limits, qpos)
