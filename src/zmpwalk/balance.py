@@ -86,6 +86,8 @@ class StabilizerGains:
             [s]; 0 turns the slope compensation off.
         step_gain: The swinging foot's aim moves by this fraction of the DCM error (a step towards where the
             body is falling) [-]; 0 lands it where planned.
+        step_deadband: The part of the DCM error's length that does not move the aim [m] (nominal walking
+            stays within it, so only a push makes the foot step aside).
     """
 
     dcm: float = 3.0  # [1/s]
