@@ -3,6 +3,7 @@ holds up, summed body by body from MuJoCo's own masses and positions."""
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import mujoco
@@ -13,7 +14,7 @@ from zmpwalk.errors import InvalidParameterError
 from zmpwalk.kinematics import JOINT_COLUMNS
 from zmpwalk.robots import load_robot
 from zmpwalk.sim.plant import build_plant
-from zmpwalk.sim.statics import static_torques
+from zmpwalk.sim.statics import StaticTorques, static_torques
 
 ROBOTS = Path(__file__).resolve().parents[2] / "shared" / "robots"
 TALOS = ROBOTS / "pal_talos" / "scene_position.xml"
@@ -81,3 +82,26 @@ def test_t1_one_foot_torques_and_limits() -> None:
 def test_box_models_are_refused() -> None:
     with pytest.raises(InvalidParameterError, match="imported from its MJCF or URDF"):
         static_torques(load_robot("hubo"))
+
+
+@needs_robots
+def test_zmpwalk_robot_prints_the_static_torques_and_flags_what_exceeds(capsys: pytest.CaptureFixture[str]) -> None:
+    import json
+
+    from zmpwalk.cli import main
+
+    assert main(["robot", str(T1)]) == 0
+    out = capsys.readouterr().out
+    assert "2 feet" in out and "1 foot" in out and "over the actuator's limit standing still: none" in out
+    assert main(["robot", str(T1), "--json"]) == 0
+    joints = {j["column"]: j for j in json.loads(capsys.readouterr().out)["joints"]}
+    assert abs(joints["right_hip_roll"]["static_torque"]["on_right"]) == pytest.approx(24.75, abs=0.05)
+
+
+def test_a_limit_below_the_static_torque_is_named() -> None:
+    statics = StaticTorques(both_feet=np.zeros(12), on_left=np.full(12, 5.0), on_right=np.full(12, -7.0),
+                            limits=np.full(12, 10.0), poses=np.zeros((3, 7)))
+    assert statics.over_limit == []
+    limits = statics.limits.copy()
+    limits[3] = 6.0  # left knee: 7 N m on one foot (the other stance's), 6 N m motor
+    assert dataclasses.replace(statics, limits=limits).over_limit == ["left_knee"]
