@@ -39,25 +39,27 @@ class InvalidParameterError(ZmpwalkError, ValueError):
 
 
 class InfeasibleCommandError(InvalidParameterError):
-    """A step command the robot's legs cannot follow (reach or joint range), named by its stride.
+    """A step command the robot's legs cannot follow (reach or joint range), or whose pattern would need the ZMP
+    outside the feet (hyperbolic generator), named by its stride.
 
     Attributes:
         parameter, value, allowed: As :class:`InvalidParameterError`; ``parameter`` is the command's
             largest stride field (``forward``, ``side`` or ``turn``), or ``foot_lift`` for a step in place.
         largest: The largest stride that fits in the same direction, as ``{field: value}`` (SI), or
             empty when no stride in that direction fits (the cause is then another field).
-        cause: The reach or joint-range error behind it.
+        cause: The reach, joint-range or ZMP error behind it.
     """
 
     def __init__(self, parameter: str, value: object, largest: dict[str, float], cause: ZmpwalkError) -> None:
         self.largest = largest
         self.cause = cause
+        fitting = "that keeps the ZMP in the feet" if isinstance(cause, InfeasiblePatternError) else "the legs can follow"
         if largest:
             units = {"turn": "rad"}
             fits = ", ".join(f"{name} = {amount:.3f} {units.get(name, 'm')}" for name, amount in largest.items())
-            allowed = f"a stride the legs can follow from here, at most {fits} ({cause})"
+            allowed = f"a stride {fitting} from here, at most {fits} ({cause})"
         else:
-            allowed = (f"a step the legs can follow from here; no stride in this direction fits, whatever its length "
+            allowed = (f"a step {fitting} from here; no stride in this direction fits, whatever its length "
                        f"({cause})")
         super().__init__(parameter, value, allowed)
 

@@ -51,7 +51,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk.commands import StepCommand
-from zmpwalk.errors import InfeasibleCommandError, InvalidParameterError, UnreachableError, ZmpwalkError
+from zmpwalk.errors import (
+    InfeasibleCommandError,
+    InfeasiblePatternError,
+    InvalidParameterError,
+    UnreachableError,
+    ZmpwalkError,
+)
 from zmpwalk.footsteps import Stance
 from zmpwalk.kinematics import JointLimitError, joint_trajectory
 from zmpwalk.patterns.polynomial import (
@@ -59,12 +65,12 @@ from zmpwalk.patterns.polynomial import (
     Samples,
     Stage,
     StageTable,
+    check_pelvis,
     check_reach,
     closing_command,
     evaluate,
     first_sample_at,
     infeasible_command,
-    pelvis_is_quintic,
     plan_next,
 )
 from zmpwalk.patterns.result import SUPPORT_NAMES, check_rate
@@ -86,6 +92,27 @@ START_DELAY = 0.2  # [s] a walk submitted from standstill starts this much later
 HINT_RATE = 100.0  # [Hz] sampling of the search for the largest stride that fits, in a rejection
 HINT_CONFIRMATIONS = 5  # tries at the control rate, each HINT_SHRINK smaller
 HINT_SHRINK = 0.98
+
+
+ONLINE_GENERATORS = ("polynomial", "hyperbolic")
+
+
+def online_pelvis(pelvis: str, generator: str) -> str:
+    """The pelvis curves of :func:`~zmpwalk.patterns.polynomial.plan_next` for a generator and pelvis option.
+
+    Raises:
+        InvalidParameterError: An unknown name, or a pelvis curve with the hyperbolic generator.
+    """
+    if generator not in ONLINE_GENERATORS:
+        raise InvalidParameterError("generator", generator, f"one of {', '.join(ONLINE_GENERATORS)}")
+    if generator == "hyperbolic":
+        if pelvis != "cubic":
+            raise InvalidParameterError("pelvis", pelvis, "the default: the hyperbolic generator's pelvis is the "
+                                        "pendulum's own motion")
+        return "hyperbolic"
+    if check_pelvis(pelvis) == "hyperbolic":
+        raise InvalidParameterError("pelvis", pelvis, "cubic or quintic (generator=\"hyperbolic\" for the other)")
+    return pelvis
 
 
 @dataclass(frozen=True, slots=True)
@@ -150,6 +177,8 @@ class _Job:
 
 
 _UNFINISHED = object()
+# the rejections that name the largest stride that fits: the legs, or (hyperbolic) the ZMP leaving the feet
+_TOO_LARGE = (UnreachableError, JointLimitError, InfeasiblePatternError)
 
 
 def _step(planning: Generator[None, None, _Plan | None]) -> object:
@@ -183,12 +212,19 @@ class OnlineWalker:
             pattern leaves the legs' reach or joint ranges is rejected).
         pelvis: ``"cubic"`` (the paper's curves) or ``"quintic"`` (jerk-continuous: the cart-table ZMP
             is continuous at every stage boundary).
+        generator: ``"polynomial"`` (the HUBO pattern, default) or ``"hyperbolic"`` (the linear inverted
+            pendulum pattern of Lim et al., stage by stage: :mod:`zmpwalk.patterns.lipm_stage`; same
+            footsteps, swings and continuity; a command whose ZMP would leave the feet is rejected).
+
+    Raises:
+        InvalidParameterError: An unknown ``pelvis`` or ``generator``, or ``pelvis="quintic"`` with the
+            hyperbolic generator (its pelvis is the pendulum's own motion).
     """
 
     def __init__(self, robot: RobotModel, rate: float = 100.0, schedule: Schedule | None = None,
-                 joints: bool = False, pelvis: str = "cubic") -> None:
+                 joints: bool = False, pelvis: str = "cubic", generator: str = "polynomial") -> None:
         check_rate(rate)
-        self._quintic = pelvis_is_quintic(pelvis)
+        self._pelvis = online_pelvis(pelvis, generator)
         self.robot = robot
         self.rate = float(rate)
         self.joints = bool(joints)
@@ -232,7 +268,7 @@ class OnlineWalker:
             boundary = Boundary(max(boundary.time, self.time))
         try:
             plan = _finish(self._checked(command, stance, boundary, self.rate))
-        except (UnreachableError, JointLimitError) as error:
+        except _TOO_LARGE as error:
             raise self._infeasible(command, stance, boundary, error) from None
         self._job = None  # a command given now supersedes one still being checked
         self._pending = plan  # None: a stop while standing
@@ -274,7 +310,7 @@ class OnlineWalker:
         if self._rejection is None:
             return None
         command, error, stance, boundary = self._rejection
-        if isinstance(error, (UnreachableError, JointLimitError)):
+        if isinstance(error, _TOO_LARGE):
             error = self._infeasible(command, stance, boundary, error)
             self._rejection = (command, error, stance, boundary)
         return error
@@ -342,7 +378,7 @@ class OnlineWalker:
         """Plan, sample (and solve the legs of) one command from a stance at ``rate`` [Hz], yielding after the
         plan, after the reach check and after every :data:`SLICE_ROWS` samples; None for a stop while standing."""
         stages, next_stance, next_boundary = plan_next(self.robot, self._schedule, stance, boundary, command,
-                                                       reach=False, quintic=self._quintic)
+                                                       reach=False, pelvis=self._pelvis)
         if not stages:
             return None
         yield

@@ -44,16 +44,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk import curves
 from zmpwalk.commands import StepCommand
-from zmpwalk.errors import InfeasiblePatternError, InvalidParameterError
+from zmpwalk.errors import InfeasiblePatternError
 from zmpwalk.footsteps import LEFT, RIGHT, Pose2D, foot_corners
-from zmpwalk.kinematics import check_leg_reach
 from zmpwalk.patterns.result import (
     SUPPORT_DOUBLE,
     SUPPORT_LEFT,
@@ -64,6 +63,7 @@ from zmpwalk.patterns.result import (
     sample_times,
 )
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.schedule import Schedule
 from zmpwalk.zmp import convex_hull, signed_margin
 
 Array = NDArray[np.float64]
@@ -570,46 +570,22 @@ def paper_walk(robot: RobotModel, gait: HyperbolicGait | None = None, steps: int
 
 
 def generate_hyperbolic(robot: RobotModel, commands: Sequence[StepCommand], rate: float = 100.0,
-                        labels: Sequence[str] | None = None) -> WalkingPattern:
-    """Straight walking of step commands with the hyperbolic pattern, sampled at ``rate`` [Hz].
+                        schedule: Schedule | None = None, labels: Sequence[str] | None = None) -> WalkingPattern:
+    """The hyperbolic pattern of any step commands (forward, side, turn), sampled at ``rate`` [Hz].
 
-    Each command is a steady step of stride ``x_s = 2 * forward`` solved by :func:`solve_step` with
-    the command's step time and double-support time (the robot's ``dsp_time`` unless overridden).
-    The first command's swing is the start transient, which ends in the state of its steady
-    step (the first command's step time split 2:3 into ``t*`` and ``tau*`` as in the paper's
-    example); a stop transient of the last step time ends the walk. Between steps that differ
-    the double support is a cubic between their states: a large change in one step (e.g.
-    from 20 cm steps to stepping on the spot) makes the LIPM's ZMP leave the feet there, which
-    the pattern's ZMP margin shows.
+    Stage by stage as :class:`~zmpwalk.online.OnlineWalker` walks it with ``generator="hyperbolic"``
+    (:mod:`zmpwalk.patterns.lipm_stage`): the footsteps, swings and timing of the polynomial generator,
+    the pelvis of the linear inverted pendulum under a piecewise-constant ZMP, solved per stage from the
+    state it inherits. The paper's own straight walk with its start and stop transients (Eqs. 12-15) is
+    :func:`paper_walk`.
 
     Raises:
-        InvalidParameterError: A side step or turn (the pattern walks straight), or no command.
-        InfeasiblePatternError: A step or transient that the pendulum cannot do.
+        InfeasiblePatternError: A stage would need its ZMP outside the feet (or has no steady step).
         UnreachableError: A leg cannot follow the pattern.
+        ZmpwalkError: Any other infeasible command, as for :func:`zmpwalk.patterns.polynomial.generate`.
     """
-    moving = [c for c in commands if not c.stop]
-    if not moving:
-        raise InvalidParameterError("commands", len(commands), "at least one step that is not a stop")
-    for number, command in enumerate(commands, start=1):
-        for name in ("side", "turn"):
-            if getattr(command, name) != 0:
-                raise InvalidParameterError(name, getattr(command, name),
-                                            "0: the hyperbolic pattern walks straight (use the polynomial generator)",
-                                            context=labels[number - 1] if labels else f"step {number}")
-    a = math.sqrt(robot.gravity / robot.pendulum_length)
-    y_zmp = robot.hip_spacing / 2
-    steps = []
-    for number, command in enumerate(commands, start=1):
-        if command.stop:
-            continue
-        dsp = command.dsp_time if command.dsp_time is not None else robot.dsp_time
-        try:
-            steps.append(solve_step(a, 2 * command.forward, command.duration, dsp, y_zmp))
-        except InfeasiblePatternError as error:
-            raise error.in_context(labels[number - 1] if labels else f"step {number}") from None
-    first, last = moving[0].duration, moving[-1].duration
-    walk = HyperbolicWalk(robot, steps, (0.4 * first, 0.6 * first), (0.4 * last, 0.6 * last))
-    pattern = walk.sample(rate)
-    check_leg_reach(pattern.time, pattern.position_pelvis_in_world, pattern.yaw_pelvis_in_world,
-                    pattern.position_left_ankle_in_world, pattern.position_right_ankle_in_world, robot)
-    return pattern
+    # imported here: the polynomial module's stages are built with this module's steady step
+    from zmpwalk.patterns.polynomial import generate
+
+    pattern = generate(robot, commands, rate=rate, schedule=schedule, labels=labels, pelvis="hyperbolic")
+    return replace(pattern, generator="hyperbolic")

@@ -50,6 +50,7 @@ from zmpwalk.commands import MAX_STRIDE, MAX_TURN, StepCommand
 from zmpwalk.errors import InfeasibleCommandError, InvalidParameterError, UnreachableError, ZmpwalkError
 from zmpwalk.footsteps import GROUNDED_STRETCH, LEFT, Pose2D, StagePlan, Stance, grounded_stage, plan_command
 from zmpwalk.kinematics import check_leg_reach
+from zmpwalk.patterns.lipm_stage import PIECES, LipmPelvis, axis_at, lipm_pelvis
 from zmpwalk.patterns.result import (
     SUPPORT_DOUBLE,
     SUPPORT_LEFT,
@@ -74,7 +75,8 @@ SHIFT_END_RATES = {SHIFT_NONE: (0.0, 0.0), SHIFT_OPEN: (0.0, math.pi), SHIFT_REC
 QUINTIC_SHIFT_RATE = 2.0 * 15.0 / 8.0  # [-] 2 S'(1/2) of the quintic smoothstep S
 QUINTIC_SHIFT_END_RATES = {SHIFT_NONE: (0.0, 0.0), SHIFT_OPEN: (0.0, QUINTIC_SHIFT_RATE),
                            SHIFT_RECOVERY: (QUINTIC_SHIFT_RATE, 0.0)}
-PELVIS_CURVES = ("cubic", "quintic")  # the pelvis option: the paper's cubics, or jerk-continuous quintics
+# the pelvis option: the paper's cubics, jerk-continuous quintics, or the pendulum's own hyperbolic motion
+PELVIS_CURVES = ("cubic", "quintic", "hyperbolic")
 
 
 def side_shift_profile(tau: Array, profile: NDArray[np.integer], quintic: bool = False) -> curves.Curve:
@@ -125,12 +127,16 @@ class Boundary:
         time: Stage boundary time [s].
         pelvis_velocity: Horizontal pelvis velocity in world [m/s], shape (2,).
         sway_velocity: The sway part of it, in world [m/s], shape (2,).
+        at_rest: The robot stands still (the pelvis above the middle of the ankles).
+        pelvis_position: Horizontal pelvis position in world [m] where it is not the middle of the ankles
+            (the hyperbolic pelvis), else None.
     """
 
     time: float  # [s]
     pelvis_velocity: tuple[float, float] = (0.0, 0.0)  # [m/s]
     sway_velocity: tuple[float, float] = (0.0, 0.0)  # [m/s]
     at_rest: bool = True
+    pelvis_position: tuple[float, float] | None = None  # [m] where the pelvis is (hyperbolic pelvis only)
 
 
 @dataclass(frozen=True)
@@ -161,6 +167,7 @@ class Stage:
     grounded: bool = False  # no foot leaves the ground (standing, start)
     end: Boundary = field(default_factory=lambda: Boundary(0.0))
     quintic: bool = False  # jerk-continuous pelvis curves (zero acceleration at every curve's ends)
+    lipm: LipmPelvis | None = None  # the hyperbolic pelvis, in place of the curves above
 
     @property
     def stop_time(self) -> float:
@@ -312,6 +319,15 @@ class StageTable:
         self.out_time = column([s.sway_out_time for s in stages])
         self.back_time = column([s.sway_back_time for s in stages])
         self.quintic = column([s.quintic for s in stages])
+        self.hyperbolic = column([s.lipm is not None for s in stages])
+        if self.hyperbolic.any():  # the pieces of each axis of the hyperbolic pelvis, (stages, PIECES)
+            unused = np.full(PIECES, np.nan)
+            pelvises = [s.lipm for s in stages]
+            self.lipm_yaw = column([p.yaw if p else 0.0 for p in pelvises])
+            self.lipm_axes = [
+                [np.array([getattr(getattr(p, axis), name) if p else unused for p in pelvises], dtype=float)
+                 for name in ("starts", "position", "velocity", "zmp")]
+                for axis in ("along", "across")]
 
     def index_at(self, time: Array) -> NDArray[np.intp]:
         """Index of the stage each time belongs to (a boundary time opens the next stage)."""
@@ -446,6 +462,9 @@ def evaluate(table: StageTable, time: Array, robot: RobotModel, index: NDArray[n
     left_rate = swing_yaw_rate * left_swings
     right_rate = swing_yaw_rate * right_swings
     support = np.where(in_swing, np.where(left_swings, SUPPORT_RIGHT, SUPPORT_LEFT), SUPPORT_DOUBLE)
+    if table.hyperbolic.any():
+        pelvis_x, pelvis_y, pelvis_vx, pelvis_vy, pelvis_ax, pelvis_ay = _hyperbolic_pelvis(
+            table, k, elapsed, robot, (pelvis_x, pelvis_y, pelvis_vx, pelvis_vy, pelvis_ax, pelvis_ay))
     l_over_g = robot.pendulum_length / robot.gravity
     zmp = np.column_stack([pelvis_x - l_over_g * pelvis_ax, pelvis_y - l_over_g * pelvis_ay])  # Eqs. 1-2
     return Samples(
@@ -457,6 +476,19 @@ def evaluate(table: StageTable, time: Array, robot: RobotModel, index: NDArray[n
         right_position=right_position, right_velocity=right_velocity, right_yaw=right_yaw,
         right_yaw_rate=right_rate, zmp_xy=zmp,
     )
+
+
+def _hyperbolic_pelvis(table: StageTable, k: NDArray[np.intp], elapsed: Array, robot: RobotModel,
+                       curves_xy: tuple[Array, ...]) -> tuple[Array, ...]:
+    """Pelvis x, y, their rates and accelerations: the hyperbolic pelvis where a stage has one, else ``curves_xy``."""
+    a = math.sqrt(robot.gravity / robot.pendulum_length)
+    (u, du, ddu), (w, dw, ddw) = (
+        axis_at(a, starts[k], position[k], velocity[k], zmp[k], elapsed)
+        for starts, position, velocity, zmp in table.lipm_axes)
+    c, s = np.cos(table.lipm_yaw[k]), np.sin(table.lipm_yaw[k])  # the supporting foot's frame to world
+    hyperbolic = table.hyperbolic[k]
+    world = (u * c - w * s, u * s + w * c, du * c - dw * s, du * s + dw * c, ddu * c - ddw * s, ddu * s + ddw * c)
+    return tuple(np.where(hyperbolic, value, other) for value, other in zip(world, curves_xy, strict=True))
 
 
 def _cubic_basis(tau: Array) -> tuple[Array, ...]:
@@ -551,7 +583,7 @@ def check_reach(stages: Sequence[Stage], robot: RobotModel) -> None:
 
 def plan_next(
     robot: RobotModel, schedule: Schedule, stance: Stance, boundary: Boundary, command: StepCommand,
-    reach: bool = True, quintic: bool = False,
+    reach: bool = True, pelvis: str = "cubic",
 ) -> tuple[list[Stage], Stance, Boundary]:
     """Stages of one command from a stance and boundary state; nothing is changed on error.
 
@@ -564,11 +596,14 @@ def plan_next(
     Args:
         reach: Check the legs' reach here (a caller that checks many commands at
             once with :func:`check_reach` passes False).
-        quintic: The jerk-continuous pelvis curves instead of the paper's cubics.
+        pelvis: ``"cubic"`` (the paper's curves), ``"quintic"`` (jerk-continuous) or ``"hyperbolic"``
+            (the pendulum's own motion under a piecewise-constant ZMP: :mod:`zmpwalk.patterns.lipm_stage`).
 
     Raises:
-        ZmpwalkError: The command is infeasible for this robot (reach, overlap, timing).
+        ZmpwalkError: The command is infeasible for this robot (reach, overlap, timing, and for the
+            hyperbolic pelvis a ZMP outside the feet).
     """
+    check_pelvis(pelvis)
     if boundary.at_rest and command.stop:
         return [], stance, boundary
     plans, next_stance = plan_command(stance, command, robot, schedule)
@@ -576,8 +611,10 @@ def plan_next(
         first = plans[0]
         plans = [grounded_stage(stance, first.swing, command.duration, first.parameters, "start"), *plans]
     stages: list[Stage] = []
-    for plan in plans:
-        stage = build_stage(plan, boundary, quintic)
+    for number, plan in enumerate(plans):
+        stage = build_stage(plan, boundary, pelvis == "quintic")
+        if pelvis == "hyperbolic":
+            stage = hyperbolic_stage(stage, boundary, robot, plans[number + 1] if plan.kind == "start" else None)
         stages.append(stage)
         boundary = stage.end
     if reach:
@@ -585,6 +622,20 @@ def plan_next(
     if command.stop:
         next_stance = Stance(next_stance.left, next_stance.right, 0)
     return stages, next_stance, boundary
+
+
+def hyperbolic_stage(stage: Stage, boundary: Boundary, robot: RobotModel, next_plan: StagePlan | None) -> Stage:
+    """``stage`` with the hyperbolic pelvis of :func:`~zmpwalk.patterns.lipm_stage.lipm_pelvis` from ``boundary``
+    (``next_plan``: the first swing, for a start stage)."""
+    plan = stage.plan
+    position = boundary.pelvis_position
+    if position is None:  # standing: above the middle of the ankles
+        position = _pair(0.5 * (np.array([plan.support_pose.x, plan.support_pose.y])
+                                + [plan.swing_start.x, plan.swing_start.y]))
+    pelvis, end_position, end_velocity = lipm_pelvis(plan, position, boundary.pelvis_velocity, robot, next_plan)
+    end = Boundary(time=boundary.time + plan.duration, pelvis_velocity=end_velocity, at_rest=plan.stop,
+                   pelvis_position=end_position)
+    return replace(stage, lipm=pelvis, end=end)
 
 
 STRIDE_FIELDS = ("forward", "side", "turn")
@@ -631,15 +682,15 @@ def _scaled(command: StepCommand, scale: float) -> StepCommand:
     return replace(command, **{name: getattr(command, name) * scale for name in STRIDE_FIELDS})
 
 
-def pelvis_is_quintic(pelvis: str) -> bool:
-    """True for ``"quintic"``, False for ``"cubic"``.
+def check_pelvis(pelvis: str) -> str:
+    """``pelvis`` if it is one of :data:`PELVIS_CURVES`.
 
     Raises:
-        InvalidParameterError: Any other value (the message lists both).
+        InvalidParameterError: Any other value (the message lists them).
     """
     if pelvis not in PELVIS_CURVES:
         raise InvalidParameterError("pelvis", pelvis, f"one of {', '.join(PELVIS_CURVES)}")
-    return pelvis == "quintic"
+    return pelvis
 
 
 def closing_command(last: StepCommand) -> StepCommand:
@@ -671,7 +722,7 @@ def plan_walk(
     Raises:
         ZmpwalkError: With the command's label in front, for the first command that fails.
     """
-    quintic = pelvis_is_quintic(pelvis)
+    check_pelvis(pelvis)
     schedule = schedule or Schedule.hubo()
     stance = Stance.ready(robot)
     boundary = Boundary(0.0)
@@ -685,7 +736,7 @@ def plan_walk(
         starts.append((stance, boundary))
         try:
             new, stance, boundary = plan_next(robot, schedule, stance, boundary, command, reach=False,
-                                              quintic=quintic)
+                                              pelvis=pelvis)
         except ZmpwalkError as error:
             raise error.in_context(_label(labels, number)) from None
         stages.extend(new)
@@ -700,9 +751,9 @@ def plan_walk(
 
         def feasible(candidate: StepCommand) -> None:  # the command, and the stop after it
             _, after, after_boundary = plan_next(robot, schedule, start_stance, start_boundary, candidate,
-                                                 quintic=quintic)
+                                                 pelvis=pelvis)
             if not candidate.stop:
-                plan_next(robot, schedule, after, after_boundary, closing_command(candidate), quintic=quintic)
+                plan_next(robot, schedule, after, after_boundary, closing_command(candidate), pelvis=pelvis)
 
         raise infeasible_command(command, error, feasible).in_context(_label(labels, number)) from None
     stages.append(standing_stage(_standing_plan(stance, robot, schedule), boundary.time))
