@@ -17,6 +17,7 @@ from zmpwalk import (
     UnreachableError,
     ZmpwalkError,
     generate,
+    generate_hyperbolic,
     load_robot,
 )
 
@@ -47,11 +48,12 @@ def _drive(walker, commands, ticks):
 
 
 @pytest.mark.parametrize("rate", [100.0, 1000.0])
-def test_walker_reproduces_the_offline_pattern(hubo, rate):
+@pytest.mark.parametrize("generator", ["polynomial", "hyperbolic"])
+def test_walker_reproduces_the_offline_pattern(hubo, rate, generator):
     commands = [StepCommand(0.95, 0.0), StepCommand(0.8, 0.2), StepCommand(0.7, 0.1, turn=0.1),
                 StepCommand(0.8, side=0.05), StepCommand(0.95, -0.1)]
-    pattern = generate(hubo, commands, rate=rate)
-    walker = OnlineWalker(hubo, rate=rate)
+    pattern = (generate if generator == "polynomial" else generate_hyperbolic)(hubo, commands, rate=rate)
+    walker = OnlineWalker(hubo, rate=rate, generator=generator)
     rows = _drive(walker, commands, len(pattern.time))
     np.testing.assert_allclose(rows, _pattern_rows(pattern), atol=TOL, rtol=0)
     assert not walker.walking  # it stopped by itself into the ready posture
@@ -135,12 +137,13 @@ command_strategy = st.one_of(
 )
 
 
-@settings(max_examples=30, deadline=None)
+@pytest.mark.parametrize("generator", ["polynomial", "hyperbolic"])
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(st.lists(st.tuples(st.integers(0, 400), command_strategy), min_size=3, max_size=12))
-def test_commands_at_any_tick_keep_the_motion_continuous(hubo, actions):
+def test_commands_at_any_tick_keep_the_motion_continuous(hubo, generator, actions):
     """Commands queued, replaced or stopped at random ticks: positions never jump between ticks."""
     rate = 200.0
-    walker = OnlineWalker(hubo, rate=rate)
+    walker = OnlineWalker(hubo, rate=rate, generator=generator)
     previous = None
     largest = 0.0
     for wait, action in actions:

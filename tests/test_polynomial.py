@@ -148,6 +148,8 @@ def _breakpoints(stage):
     if not stage.grounded:
         u = stage.plan.parameters.up_ratio
         points.append(t1 + d / 2 + u * (T - d))
+    if stage.lipm is not None:  # the hyperbolic pelvis's pieces
+        points += [t1 + start for axis in (stage.lipm.along, stage.lipm.across) for start in axis.starts]
     return [p for p in points if t1 < p < t1 + T]
 
 
@@ -188,17 +190,20 @@ def assert_continuous(robot, stages):
     np.testing.assert_allclose(exact[1], right[1], atol=VELOCITY_TOL, rtol=0)
 
 
+@pytest.mark.parametrize("pelvis", ["cubic", "hyperbolic"])
 @settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(step_commands(), min_size=10, max_size=16))
-def test_positions_and_velocities_are_continuous_for_random_command_sequences(hubo, schedule, commands):
+def test_positions_and_velocities_are_continuous_for_random_command_sequences(hubo, schedule, pelvis, commands):
+    """Both online generators: the polynomial (cubic pelvis) and the hyperbolic (the pendulum's own motion)."""
     try:
-        stages, _ = plan_walk(hubo, commands, schedule)
+        stages, _ = plan_walk(hubo, commands, schedule, pelvis=pelvis)
     except ZmpwalkError:
         return  # an infeasible sequence is rejected as a whole (tested elsewhere)
     assert_continuous(hubo, stages)
 
 
-def test_random_sequences_are_mostly_feasible(hubo, schedule):
+@pytest.mark.parametrize("pelvis", ["cubic", "hyperbolic"])
+def test_random_sequences_are_mostly_feasible(hubo, schedule, pelvis):
     """Guard for the property test above: the strategy must not be rejected wholesale."""
     rng = np.random.default_rng(3)
     feasible = 0
@@ -217,7 +222,7 @@ def test_random_sequences_are_mostly_feasible(hubo, schedule):
                 forward, turn = float(rng.uniform(0, 0.15)), float(rng.uniform(-0.15, 0.15))
                 commands.append(StepCommand(duration, forward, turn=turn))
         try:
-            plan_walk(hubo, commands, schedule)
+            plan_walk(hubo, commands, schedule, pelvis=pelvis)
             feasible += 1
         except ZmpwalkError:
             pass
@@ -262,13 +267,14 @@ class _Reference:
         self.next = -foot
 
 
-def test_feet_land_where_simple_commands_say(hubo, schedule):
+@pytest.mark.parametrize("pelvis", ["cubic", "hyperbolic"])
+def test_feet_land_where_simple_commands_say(hubo, schedule, pelvis):
     commands = ([StepCommand(0.8, 0.2)] * 3 + [StepCommand(0.95, side=0.05)] * 2 + [StepCommand(0.8, 0.0)]
                 + [StepCommand(0.95, turn=0.2)] * 3 + [StepCommand(0.8, -0.1)] * 2 + [StepCommand(0.7, side=-0.03)])
     reference = _Reference(hubo.hip_spacing)
     for command in commands:
         reference.apply(command)
-    stages, _ = plan_walk(hubo, commands, schedule)
+    stages, _ = plan_walk(hubo, commands, schedule, pelvis=pelvis)
     # The closing stop of plan_walk lands the last swing beside the other foot.
     last = [s for s in stages if s.plan.kind == "stop"][-1]
     reference.apply(StepCommand(last.duration, stop=True))

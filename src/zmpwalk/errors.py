@@ -53,7 +53,8 @@ class InfeasibleCommandError(InvalidParameterError):
     def __init__(self, parameter: str, value: object, largest: dict[str, float], cause: ZmpwalkError) -> None:
         self.largest = largest
         self.cause = cause
-        fitting = "that keeps the ZMP in the feet" if isinstance(cause, InfeasiblePatternError) else "the legs can follow"
+        balance = isinstance(cause, InfeasiblePatternError)
+        fitting = "that keeps the ZMP in the feet" if balance else "the legs can follow"
         if largest:
             units = {"turn": "rad"}
             fits = ", ".join(f"{name} = {amount:.3f} {units.get(name, 'm')}" for name, amount in largest.items())

@@ -71,6 +71,7 @@ from numpy.typing import NDArray
 from zmpwalk.errors import InfeasiblePatternError, InvalidParameterError
 from zmpwalk.footsteps import Pose2D, StagePlan, foot_corners
 from zmpwalk.patterns.hyperbolic import solve_step
+from zmpwalk.patterns.result import PHASE_TIME_TOL
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.zmp import convex_hull, signed_margin
 
@@ -318,7 +319,9 @@ def axis_at(a: float, axis_starts: Array, position: Array, velocity: Array, zmp:
         axis_starts, position, velocity, zmp: Each sample's axis, shape (n, :data:`PIECES`).
         elapsed: Shape (n,).
     """
-    index = np.clip(np.sum(elapsed[:, None] >= axis_starts, axis=1) - 1, 0, PIECES - 1)
+    # a sample at a piece's start (to PHASE_TIME_TOL, whatever the rounding) is in that piece, as the support
+    # phases count it (WalkingPattern.zmp_margin): the ZMP jumps there, and the sample shows the new one
+    index = np.clip(np.sum(elapsed[:, None] >= axis_starts - PHASE_TIME_TOL, axis=1) - 1, 0, PIECES - 1)
     rows = np.arange(len(elapsed))
     tau = elapsed - axis_starts[rows, index]
     x0, v0, c = position[rows, index], velocity[rows, index], zmp[rows, index]

@@ -26,6 +26,7 @@ Array = NDArray[np.float64]
 SUPPORT_DOUBLE, SUPPORT_LEFT, SUPPORT_RIGHT = 0, 1, 2  # codes of WalkingPattern.support
 SUPPORT_NAMES = ("double", "left", "right")  # indexed by the codes
 MARGIN_CHUNK = 2048  # support phases whose ZMP margins are computed in one vectorised pass
+PHASE_TIME_TOL = 1e-9  # [s] a sample this close to a phase change is at it (times are rounded sums)
 
 def check_rate(rate: float) -> None:
     """Raise unless ``rate`` is a sampling rate zmpwalk supports (1 Hz .. 10 kHz)."""
@@ -188,8 +189,9 @@ class WalkingPattern:
         margin = np.full(len(self.time), np.nan)
         phases = self.support_phases
         begins = np.array([phase.begin for phase in phases])
-        # the samples of each phase are one slice of the (sorted) times
-        cuts = np.r_[0, np.searchsorted(self.time, begins[1:], side="left"), len(self.time)]
+        # the samples of each phase are one slice of the (sorted) times; a sample at a phase change (to
+        # PHASE_TIME_TOL, whatever the rounding of the times) belongs to the phase that begins, whose ZMP it shows
+        cuts = np.r_[0, np.searchsorted(self.time, begins[1:] - PHASE_TIME_TOL, side="left"), len(self.time)]
         for first in range(0, len(phases), MARGIN_CHUNK):
             last = min(first + MARGIN_CHUNK, len(phases))
             start, edge, valid = hull_edges(_phase_vertices(phases[first:last], self.robot))
