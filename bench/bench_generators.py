@@ -1,18 +1,21 @@
-"""The three generators on the same walks (HUBO, 1 kHz): ZMP margin, multibody ZMP error, and in MuJoCo with the
-stabilizer the CoP tracking, the verdict and the peak joint torque.
+"""The three generators on the same walks (HUBO, 1 kHz): ZMP margin, multibody ZMP error, and in MuJoCo open loop
+and with the stabilizer the CoP tracking, the verdict and the peak joint torque; then their speed: a 100-step
+walk with its 12 joint trajectories, and the online walkers' control loop (every iteration timed).
 
-Run: python bench/bench_generators.py. Prints a Markdown table (docs/generators.md); asserts nothing. Runs on
-all cores.
+Run: python bench/bench_generators.py. Prints Markdown tables (docs/generators.md); asserts nothing. The
+simulations run on all cores, the timings on one.
 """
 
 from __future__ import annotations
 
 import os
+import statistics
+import time
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from zmpwalk import load_robot
+from zmpwalk import OnlineWalker, StepCommand, load_robot
 from zmpwalk.balance import Stabilizer
 from zmpwalk.dynamics import compare_zmp
 from zmpwalk.errors import ZmpwalkError
@@ -37,13 +40,52 @@ def case(job: tuple[str, str]) -> tuple[str, str, str]:
     margin = float(np.nanmin(pattern.zmp_margin()))
     comparison = compare_zmp(pattern)
     joints = pattern_joint_trajectory(pattern, check_limits=False)
-    result = simulate(robot, joints, pattern, stabilizer=Stabilizer(robot, 1000.0), settle=SETTLE, hold=HOLD)
-    verdict = walk_verdict(result, HOLD)
-    rms, _ = result.cop_error_stats()
-    state = "falls" if result.fell else ("pass" if verdict.passed else "fails " + ", ".join(verdict.failed))
-    top = max(actuator_table(result), key=lambda row: row.peak_torque)
-    return walk, name, (f"{margin * 1e3:+.1f} mm; {comparison.rms * 1e3:.1f} ({comparison.max * 1e3:.0f}) mm; "
-                        f"CoP {rms * 1e3:.1f} mm, {state}; {top.peak_torque:.0f} N m ({top.joint})")
+    cells = [f"{margin * 1e3:+.1f} mm; {comparison.rms * 1e3:.1f} ({comparison.max * 1e3:.0f}) mm"]
+    for stabilizer in (None, Stabilizer(robot, 1000.0)):
+        result = simulate(robot, joints, pattern, stabilizer=stabilizer, settle=SETTLE, hold=HOLD)
+        verdict = walk_verdict(result, HOLD)
+        rms, _ = result.cop_error_stats()
+        state = "falls" if result.fell else ("pass" if verdict.passed else "fails " + ", ".join(verdict.failed))
+        top = max(actuator_table(result), key=lambda row: row.peak_torque)
+        loop = "open" if stabilizer is None else "stab."
+        cells.append(f"{loop}: CoP {rms * 1e3:.1f} mm, {state}, {top.peak_torque:.0f} N m ({top.joint})")
+    return walk, name, "; ".join(cells)
+
+
+SPEED_WALK = [StepCommand(0.8, 0.15)] * 100  # every generator walks it
+
+
+def walk_time(name: str) -> float:
+    """Median time [s] of the 100-step walk at 1 kHz with its 12 joint trajectories."""
+    robot = load_robot("hubo")
+    make = generator(name)
+    runs = []
+    for _ in range(5):
+        start = time.perf_counter()
+        pattern_joint_trajectory(make(robot, SPEED_WALK, rate=1000.0))
+        runs.append(time.perf_counter() - start)
+    return statistics.median(runs)
+
+
+def loop_times(name: str, seconds: float = 30.0) -> np.ndarray:
+    """Every iteration [us] of a 1 kHz loop with joints: steps submitted as the one before starts, walks of five
+    steps from standstill with their automatic stop, 1 s standing between walks."""
+    walker = OnlineWalker(load_robot("hubo"), rate=1000.0, joints=True, generator=name)
+    steps = [StepCommand(0.8, 0.15), StepCommand(0.8, 0.1, turn=0.1), StepCommand(0.8, side=0.05),
+             StepCommand(0.7, 0.1), StepCommand(0.95, 0.1)]
+    iterations, given, standing = [], 0, 0
+    for _ in range(round(seconds * 1000)):
+        start = time.perf_counter()
+        if given < len(steps) and walker.queued is None and walker.checking is None and not standing:
+            walker.submit(steps[given])
+            given += 1
+        walker.tick()
+        iterations.append(time.perf_counter() - start)
+        if given == len(steps) and not walker.walking and walker.checking is None:
+            standing += 1
+            if standing >= 1000:
+                given, standing = 0, 0
+    return np.array(iterations) * 1e6
 
 
 def main() -> None:
@@ -54,8 +96,20 @@ def main() -> None:
     print("|---" * (len(GENERATORS) + 1) + "|")
     for walk in WALKS:
         print(f"| {walk} | " + " | ".join(cells[(walk, name)] for name in GENERATORS) + " |")
-    print("\neach cell: smallest cart-table ZMP margin; multibody - cart-table ZMP, RMS (max); in MuJoCo with the "
-          "stabilizer: CoP - reference ZMP RMS and the verdict; largest joint torque (joint)")
+    print("\neach cell: smallest cart-table ZMP margin; multibody - cart-table ZMP, RMS (max); in MuJoCo open loop "
+          "and with the stabilizer: CoP - reference ZMP RMS, the verdict, largest joint torque (joint)\n")
+    print("| | " + " | ".join(GENERATORS) + " |")
+    print("|---" * (len(GENERATORS) + 1) + "|")
+    print("| 100 steps of 0.15 m at 0.8 s, 1 kHz, 12 joints | "
+          + " | ".join(f"{walk_time(name) * 1e3:.0f} ms" for name in GENERATORS) + " |")
+    cells = []
+    for name in GENERATORS:
+        if name == "preview":
+            cells.append("- (offline)")
+            continue
+        us = loop_times(name)
+        cells.append(f"median {np.median(us):.1f} us, p99.9 {np.percentile(us, 99.9):.0f} us, max {us.max():.0f} us")
+    print("| online loop at 1 kHz with joints, submit(), 30 s | " + " | ".join(cells) + " |")
 
 
 if __name__ == "__main__":

@@ -258,7 +258,8 @@ def _sample_row(sample):
 
 
 @pytest.mark.parametrize("rate", [100.0, 1000.0])
-def test_submitted_commands_give_the_same_walk_as_commands(hubo, rate):
+@pytest.mark.parametrize("generator", ["polynomial", "hyperbolic"])
+def test_submitted_commands_give_the_same_walk_as_commands(hubo, rate, generator):
     """submit() (checked one slice per tick) against command() (checked at once): sample for sample, joint
     angles and rates included; the walk from standstill starts START_DELAY later, as documented."""
     from zmpwalk.online import START_DELAY
@@ -266,7 +267,7 @@ def test_submitted_commands_give_the_same_walk_as_commands(hubo, rate):
     commands = [StepCommand(0.8, 0.2), StepCommand(0.7, 0.1, turn=0.1), StepCommand(0.8, side=0.05),
                 StepCommand(0.95, -0.1)]
     delay = round(START_DELAY * rate)
-    direct, sliced = OnlineWalker(hubo, rate=rate, joints=True), OnlineWalker(hubo, rate=rate, joints=True)
+    direct, sliced = (OnlineWalker(hubo, rate=rate, joints=True, generator=generator) for _ in range(2))
     sliced.submit(commands[0])
     direct_rows, sliced_rows = [], []
     for _ in range(delay):  # both stand still meanwhile
@@ -328,13 +329,14 @@ def test_stop_while_walking_takes_the_stop_planned_with_the_step(hubo):
                                atol=1e-12)  # feet side by side
 
 
+@pytest.mark.parametrize("generator", ["polynomial", "hyperbolic"])
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(actions=st.lists(st.tuples(st.integers(0, 150), _hostile_fields(), st.booleans()), min_size=1, max_size=8))
-def test_hostile_submitted_commands_never_make_a_tick_raise(hubo, actions):
+def test_hostile_submitted_commands_never_make_a_tick_raise(hubo, generator, actions):
     """submit() and command() mixed at random ticks with hostile values: no tick raises, every rejection kept in
     walker.rejection names a parameter, the motion stays continuous, and every walk ends standing."""
     rate = 100.0
-    walker = OnlineWalker(hubo, rate=rate, joints=True)
+    walker = OnlineWalker(hubo, rate=rate, joints=True, generator=generator)
     previous, largest = None, 0.0
     for wait, fields, use_submit in [*actions, (1500, None, False)]:
         for _ in range(wait):
