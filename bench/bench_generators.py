@@ -8,6 +8,7 @@ simulations run on all cores, the timings on one.
 
 from __future__ import annotations
 
+import gc
 import os
 import statistics
 import time
@@ -69,8 +70,11 @@ def walk_time(name: str) -> float:
 
 def loop_times(name: str, seconds: float = 30.0) -> np.ndarray:
     """Every iteration [us] of a 1 kHz loop with joints: steps submitted as the one before starts, walks of five
-    steps from standstill with their automatic stop, 1 s standing between walks."""
+    steps from standstill with their automatic stop, 1 s standing between walks. Set up as docs/speed.md
+    advises: everything loaded before the loop is frozen out of the garbage collector's full passes."""
     walker = OnlineWalker(load_robot("hubo"), rate=1000.0, joints=True, generator=name)
+    gc.collect()
+    gc.freeze()
     steps = [StepCommand(0.8, 0.15), StepCommand(0.8, 0.1, turn=0.1), StepCommand(0.8, side=0.05),
              StepCommand(0.7, 0.1), StepCommand(0.95, 0.1)]
     iterations, given, standing = [], 0, 0
@@ -102,6 +106,7 @@ def main() -> None:
     print("|---" * (len(GENERATORS) + 1) + "|")
     print("| 100 steps of 0.15 m at 0.8 s, 1 kHz, 12 joints | "
           + " | ".join(f"{walk_time(name) * 1e3:.0f} ms" for name in GENERATORS) + " |")
+    walks: list[float] = []
     cells = []
     for name in GENERATORS:
         if name == "preview":

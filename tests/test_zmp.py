@@ -143,3 +143,17 @@ def test_quintic_boundary_map_against_the_sampled_curve(duration):
         predicted = zmp_maps.zmp_from_pelvis_boundary_quintic(duration, length) @ np.array([x0, v0, x1, v1])
         np.testing.assert_allclose(measured[[0, 2]], predicted[[0, 2]], atol=1e-12)  # [m]: z = x at the ends
         np.testing.assert_allclose(measured[[1, 3]], predicted[[1, 3]], rtol=1e-3, atol=1e-4)  # [m/s]
+
+
+def test_point_margin_equals_signed_margin():
+    """The plain-Python margin of one point against the vectorised one: random hulls and points, inside and out."""
+    from zmpwalk.zmp import convex_hull, point_margin, signed_margin
+
+    rng = np.random.default_rng(21)
+    for _ in range(200):
+        polygon = convex_hull(rng.uniform(-0.2, 0.2, (8, 2)))
+        point = rng.uniform(-0.3, 0.3, 2)
+        expected = float(signed_margin(point[None, :], polygon)[0])
+        vertices = [(float(x), float(y)) for x, y in polygon]
+        assert point_margin(float(point[0]), float(point[1]), vertices) == pytest.approx(expected, abs=1e-12)
+

@@ -70,6 +70,7 @@ from zmpwalk.patterns.polynomial import (
     closing_command,
     evaluate,
     first_sample_at,
+    hyperbolic_stages,
     infeasible_command,
     plan_next,
 )
@@ -377,11 +378,18 @@ class OnlineWalker:
               sliced: bool) -> Generator[None, None, _Plan | None]:
         """Plan, sample (and solve the legs of) one command from a stance at ``rate`` [Hz], yielding after the
         plan, after the reach check and after every :data:`SLICE_ROWS` samples; None for a stop while standing."""
+        hyperbolic = self._pelvis == "hyperbolic"
         stages, next_stance, next_boundary = plan_next(self.robot, self._schedule, stance, boundary, command,
-                                                       reach=False, pelvis=self._pelvis)
+                                                       reach=False, pelvis="cubic" if hyperbolic else self._pelvis)
         if not stages:
             return None
         yield
+        if hyperbolic:  # the pendulum's pelvis, one stage per slice
+            pendulum = []
+            for stage in hyperbolic_stages(stages, boundary, self.robot):
+                pendulum.append(stage)
+                yield
+            stages, next_boundary = pendulum, pendulum[-1].end
         check_reach(stages, self.robot)
         yield
         # the samples of these stages, split from the neighbours' exactly as the batch path splits them

@@ -18,6 +18,9 @@ step time), which :func:`half_interval_zmp_map` reproduces.
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -174,6 +177,28 @@ def signed_margin(points: Array, polygon: Array) -> Array:
     nearest = a[None, :, :] + along[:, :, None] * edge[None, :, :]
     outside_distance = np.min(np.linalg.norm(pts[:, None, :] - nearest, axis=2), axis=1)
     return np.asarray(np.where(inside, np.min(inside_distance, axis=1), -outside_distance), dtype=np.float64)
+
+
+def point_margin(x: float, y: float, polygon: Sequence[tuple[float, float]]) -> float:
+    """:func:`signed_margin` of one point [m] in plain Python floats (a few microseconds; for planners that
+    check a handful of points, where numpy's per-call overhead would dominate).
+
+    Args:
+        x, y: The point [m].
+        polygon: Convex polygon's vertices, counter-clockwise [m].
+    """
+    inside, outside = math.inf, math.inf
+    count = len(polygon)
+    for index in range(count):
+        ax, ay = polygon[index]
+        bx, by = polygon[(index + 1) % count]
+        ex, ey = bx - ax, by - ay
+        length2 = ex * ex + ey * ey
+        rx, ry = x - ax, y - ay
+        inside = min(inside, (ex * ry - ey * rx) / math.sqrt(length2))  # left of a CCW edge: inside
+        along = min(max((rx * ex + ry * ey) / length2, 0.0), 1.0)
+        outside = min(outside, math.hypot(rx - along * ex, ry - along * ey))
+    return inside if inside >= 0.0 else -outside
 
 
 def hull_edges(vertices: Array) -> tuple[Array, Array, NDArray[np.bool_]]:

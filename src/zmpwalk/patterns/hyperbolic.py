@@ -42,6 +42,7 @@ paper's steady stride, two steps) advances each foot by ``x_s`` and the body by
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
@@ -172,6 +173,7 @@ def lateral_sway(a: float, t4: float, t5: float, y_zmp: float) -> tuple[float, f
     return y0, v_y
 
 
+@functools.lru_cache(maxsize=1024)  # the online walker solves the same few steps at every stage
 def solve_step(a: float, stride: float, step_time: float, dsp_time: float, y_zmp: float) -> SteadyStep:
     """A steady step that takes ``step_time`` with a double support of ``dsp_time``.
 

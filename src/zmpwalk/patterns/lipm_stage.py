@@ -73,7 +73,7 @@ from zmpwalk.footsteps import Pose2D, StagePlan, foot_corners
 from zmpwalk.patterns.hyperbolic import solve_step
 from zmpwalk.patterns.result import PHASE_TIME_TOL
 from zmpwalk.robots.model import RobotModel
-from zmpwalk.zmp import convex_hull, signed_margin
+from zmpwalk.zmp import convex_hull, point_margin
 
 Array = NDArray[np.float64]
 
@@ -341,39 +341,38 @@ def _zmp_margin(plan: StagePlan, along: LipmAxis, across: LipmAxis, robot: Robot
     T, d = plan.duration, plan.parameters.dsp_time
     grounded = plan.kind in GROUNDED_KINDS
     support = foot_corners(plan.support_pose, -plan.swing, robot)
-    before = convex_hull(np.vstack([support, foot_corners(plan.swing_start, plan.swing, robot)]))
-    after = convex_hull(np.vstack([support, foot_corners(plan.swing_end, plan.swing, robot)]))
+    polygons = [[(float(x), float(y)) for x, y in polygon] for polygon in (
+        support,
+        convex_hull(np.vstack([support, foot_corners(plan.swing_start, plan.swing, robot)])),
+        convex_hull(np.vstack([support, foot_corners(plan.swing_end, plan.swing, robot)])))]
+    single, before, after = polygons
     breaks = sorted(t for t in {*along.starts, *across.starts, T} if t <= T + 1e-12)
-    heading, left = _heading(plan.support_pose.yaw)
-    worst, where = math.inf, (0.0, np.zeros(2))
+    c, s = math.cos(plan.support_pose.yaw), math.sin(plan.support_pose.yaw)
+    worst, where = math.inf, (0.0, 0.0, 0.0)
     for t0, t1 in itertools.pairwise(breaks):
         if t1 - t0 <= 1e-12:
             continue
         middle = 0.5 * (t0 + t1)
-        polygon = before if grounded or middle < d / 2 else after if middle > T - d / 2 else support
+        polygon = before if grounded or middle < d / 2 else after if middle > T - d / 2 else single
         for t in (t0, t1):  # inside a span the ZMP is constant or moves on a straight line: its ends bound it
-            point = _zmp_in_world(along, across, t, middle, heading, left)
-            margin = float(signed_margin(point[None, :], polygon)[0])
+            u, w = _zmp_at(along, t, middle), _zmp_at(across, t, middle)
+            x, y = u * c - w * s, u * s + w * c
+            margin = point_margin(x, y, polygon)
             if margin < worst:
-                worst, where = margin, (t, point)
+                worst, where = margin, (t, x, y)
     if worst < -ZMP_TOLERANCE:
-        t, point = where
+        t, x, y = where
         raise InfeasiblePatternError(
-            f"the hyperbolic pattern needs its ZMP at ({point[0]:.4f}, {point[1]:.4f}) m, {-worst * 1e3:.1f} mm "
+            f"the hyperbolic pattern needs its ZMP at ({x:.4f}, {y:.4f}) m, {-worst * 1e3:.1f} mm "
             f"outside the support polygon, {t:.3f} s into this {plan.kind} stage (a shorter stride or a longer "
             f"step or double-support time fits)")
     return worst
 
 
-def _zmp_in_world(along: LipmAxis, across: LipmAxis, t: float, inside: float, heading: Array,
-                  left: Array) -> Array:
-    """The ZMP [m] at ``t`` [s] of the piece that contains ``inside`` [s] (its value at that end)."""
-    values = []
-    for axis in (along, across):
-        starts = np.array(axis.starts)
-        k = int(np.clip(np.sum(inside >= starts) - 1, 0, PIECES - 1))
-        zmp = axis.zmp[k]
-        if math.isnan(zmp):  # coasting: the ZMP is the body
-            zmp = axis.position[k] + axis.velocity[k] * (t - starts[k])
-        values.append(zmp)
-    return values[0] * heading + values[1] * left
+def _zmp_at(axis: LipmAxis, t: float, inside: float) -> float:
+    """The ZMP [m] on one axis at ``t`` [s] of the piece that contains ``inside`` [s] (its value at that end)."""
+    k = max(sum(1 for start in axis.starts if inside >= start) - 1, 0)
+    zmp = axis.zmp[k]
+    if math.isnan(zmp):  # coasting: the ZMP is the body
+        return axis.position[k] + axis.velocity[k] * (t - axis.starts[k])
+    return zmp

@@ -611,17 +611,29 @@ def plan_next(
         first = plans[0]
         plans = [grounded_stage(stance, first.swing, command.duration, first.parameters, "start"), *plans]
     stages: list[Stage] = []
-    for number, plan in enumerate(plans):
+    start = boundary
+    for plan in plans:
         stage = build_stage(plan, boundary, pelvis == "quintic")
-        if pelvis == "hyperbolic":
-            stage = hyperbolic_stage(stage, boundary, robot, plans[number + 1] if plan.kind == "start" else None)
         stages.append(stage)
         boundary = stage.end
+    if pelvis == "hyperbolic":
+        stages = list(hyperbolic_stages(stages, start, robot))
+        boundary = stages[-1].end
     if reach:
         check_reach(stages, robot)
     if command.stop:
         next_stance = Stance(next_stance.left, next_stance.right, 0)
     return stages, next_stance, boundary
+
+
+def hyperbolic_stages(stages: list[Stage], boundary: Boundary, robot: RobotModel) -> Iterator[Stage]:
+    """``stages`` (one command's, from ``boundary``) with the hyperbolic pelvis, one at a time (a planner that
+    works in slices takes them one per tick)."""
+    for number, stage in enumerate(stages):
+        first_swing = stages[number + 1].plan if stage.plan.kind == "start" else None
+        stage = hyperbolic_stage(stage, boundary, robot, first_swing)
+        boundary = stage.end
+        yield stage
 
 
 def hyperbolic_stage(stage: Stage, boundary: Boundary, robot: RobotModel, next_plan: StagePlan | None) -> Stage:
