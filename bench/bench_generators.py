@@ -2,7 +2,7 @@
 and with the stabilizer the CoP tracking, the verdict and the peak joint torque; then their speed: a 100-step
 walk with its 12 joint trajectories, and the online walkers' control loop (every iteration timed).
 
-Run: python bench/bench_generators.py. Prints Markdown tables (docs/generators.md); asserts nothing. The
+Run: python bench/bench_generators.py [--speed]. Prints Markdown tables (docs/generators.md); asserts nothing. The
 simulations run on all cores, the timings on one.
 """
 
@@ -11,6 +11,7 @@ from __future__ import annotations
 import gc
 import os
 import statistics
+import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
 
@@ -93,6 +94,12 @@ def loop_times(name: str, seconds: float = 30.0) -> np.ndarray:
 
 
 def main() -> None:
+    if "--speed" not in sys.argv:  # --speed: the speed table alone
+        simulations()
+    speed()
+
+
+def simulations() -> None:
     jobs = [(walk, name) for walk in WALKS for name in GENERATORS]
     with ProcessPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
         cells = {(walk, name): text for walk, name, text in pool.map(case, jobs)}
@@ -102,11 +109,13 @@ def main() -> None:
         print(f"| {walk} | " + " | ".join(cells[(walk, name)] for name in GENERATORS) + " |")
     print("\neach cell: smallest cart-table ZMP margin; multibody - cart-table ZMP, RMS (max); in MuJoCo open loop "
           "and with the stabilizer: CoP - reference ZMP RMS, the verdict, largest joint torque (joint)\n")
+
+
+def speed() -> None:
     print("| | " + " | ".join(GENERATORS) + " |")
     print("|---" * (len(GENERATORS) + 1) + "|")
     print("| 100 steps of 0.15 m at 0.8 s, 1 kHz, 12 joints | "
           + " | ".join(f"{walk_time(name) * 1e3:.0f} ms" for name in GENERATORS) + " |")
-    walks: list[float] = []
     cells = []
     for name in GENERATORS:
         if name == "preview":
