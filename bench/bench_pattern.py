@@ -5,6 +5,7 @@ Run: python bench/bench_pattern.py. Prints figures; asserts nothing.
 
 from __future__ import annotations
 
+import gc
 import statistics
 import time
 
@@ -37,6 +38,8 @@ def control_loop(rate: float, seconds: float, joints: bool, use_submit: bool) ->
     steps, each step commanded in the loop as the one before it starts (the first from standstill), then
     the automatic stop and 1 s of standing. Returns the iterations' and the commands' times [us]."""
     walker = OnlineWalker(load_robot("hubo"), rate=rate, joints=joints)
+    gc.collect()
+    gc.freeze()  # as docs/speed.md advises: what was loaded before the loop is out of the GC's full passes
     steps = [StepCommand(0.8, 0.2), StepCommand(0.8, 0.1, turn=0.1), StepCommand(0.8, side=0.05),
              StepCommand(0.7, 0.15), StepCommand(0.95, 0.1)]
     give = walker.submit if use_submit else walker.command
