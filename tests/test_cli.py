@@ -147,8 +147,8 @@ def test_planning_errors_name_the_file_the_table_and_the_walked_step(tmp_path, c
 
 @pytest.mark.parametrize("argv, message", [
     (["plan", "--scenario", "fig10", "--feet", "only_one"], "--feet = 'only_one' must be two body names"),
-    (["plan", "--scenario", "fig10", "--generator", "hyperbolic", "--schedule", "tables.toml"],
-     "--schedule applies to the polynomial generator"),
+    (["plan", "--scenario", "fig10", "--generator", "hyperbolic", "--pelvis", "quintic"],
+     "--pelvis quintic applies to the polynomial generator"),
     (["simulate", "--scenario", "fig10", "--latency", "0.5"], "latency = 0.5"),
     (["simulate", "--scenario", "fig10", "--motors", "no-such-motors.toml"], "no-such-motors.toml"),
     (["robot", "no-such-robot.urdf"], "no such file"),

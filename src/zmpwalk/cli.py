@@ -89,10 +89,7 @@ def _schedule(args: argparse.Namespace) -> Schedule | None:
     path = getattr(args, "schedule", None)
     if path is None:
         return None
-    if getattr(args, "generator", "polynomial") not in ("polynomial", "preview"):
-        raise _UsageError("--schedule applies to the polynomial generator (the HUBO pattern's tables) and to the "
-                          "footsteps of the preview generator")
-    return Schedule.from_file(path)
+    return Schedule.from_file(path)  # the polynomial pattern's tables, and every generator's footstep timing
 
 
 DASK_HELP = ("run on a Dask cluster: its scheduler's address (tcp://host:8786), or local "

@@ -45,7 +45,7 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -589,5 +589,4 @@ def generate_hyperbolic(robot: RobotModel, commands: Sequence[StepCommand], rate
     # imported here: the polynomial module's stages are built with this module's steady step
     from zmpwalk.patterns.polynomial import generate
 
-    pattern = generate(robot, commands, rate=rate, schedule=schedule, labels=labels, pelvis="hyperbolic")
-    return replace(pattern, generator="hyperbolic")
+    return generate(robot, commands, rate=rate, schedule=schedule, labels=labels, pelvis="hyperbolic")

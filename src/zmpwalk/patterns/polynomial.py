@@ -807,7 +807,8 @@ def generate(
     """
     check_rate(rate)
     stages, _ = plan_walk(robot, commands, schedule, labels, pelvis)
-    return _sampled(stages, robot, rate, sample_times(stages[-1].start, rate))
+    pattern = _sampled(stages, robot, rate, sample_times(stages[-1].start, rate))
+    return replace(pattern, generator="hyperbolic") if pelvis == "hyperbolic" else pattern
 
 
 def generate_chunks(
