@@ -70,3 +70,27 @@ def test_overrides_replace_scheduled_values(hubo, schedule):
     assert (first.alpha1, first.d1, first.sway) == pytest.approx((1.1, 0.3, 0.04), abs=TOL)
     assert (second.d1, second.sway, second.alpha1) == pytest.approx((0.1, 0.04, 1.1), abs=TOL)
     assert first.source.endswith("+override")
+
+
+def test_a_turn_table_is_looked_up_like_table_3(hubo):
+    """Exact rows, interpolation towards stepping on the spot below the smallest turn, a curved step's two
+    stages, and the columns checked."""
+    from zmpwalk.errors import FileFormatError
+    from zmpwalk.schedule import TURN_COLUMNS, Schedule
+    from zmpwalk.tune import hubo_schedule_data
+
+    data = hubo_schedule_data()
+    data["turn"] = {"columns": list(TURN_COLUMNS), "rows": [[0.8, 0.2, 0.05, 0.4, 1.1, 0.9, 0.3, 0.1]]}
+    schedule = Schedule(data)
+    first, second = schedule.stage_parameters(StepCommand(0.8, turn=-0.2), hubo)
+    assert (first.sway, first.up_ratio, first.alpha1, first.beta1, first.d1, second.d1) == pytest.approx(
+        (0.05, 0.4, 1.1, 0.9, 0.3, 0.1), abs=1e-12)
+    half, _ = schedule.stage_parameters(StepCommand(0.8, turn=0.1), hubo)
+    spot, _ = Schedule.hubo().stage_parameters(StepCommand(0.8), hubo)
+    assert half.sway == pytest.approx(0.5 * (0.05 + spot.sway), abs=1e-12)  # halfway to the on-spot row
+    curved, _ = schedule.stage_parameters(StepCommand(0.8, 0.1, turn=0.2), hubo)
+    straight, _ = schedule.stage_parameters(StepCommand(0.8, 0.1), hubo)
+    assert curved.alpha == straight.alpha and curved.sway == pytest.approx(0.05, abs=1e-12)
+    data["turn"]["columns"] = ["duration", "turn", "up_ratio", "sway", "alpha1", "beta1", "d1_open", "d1_recovery"]
+    with pytest.raises(FileFormatError, match=r"\[turn\] columns"):
+        Schedule(data)

@@ -86,3 +86,27 @@ def test_without_optuna_tuning_says_how_to_get_it(monkeypatch):
     monkeypatch.setattr(builtins, "__import__", no_optuna)
     with pytest.raises(ZmpwalkError, match=r"pip install 'zmpwalk\[tune\]'"):
         tune("hubo", trials=1)
+
+
+def test_turn_rows_are_added_to_a_grid_without_them_and_tuned_into_the_file(tmp_path):
+    """The paper has no turn table: tune adds TURN_GRID's rows, starting from what a turn takes without one,
+    tunes the 0.7 s row (outside the sole with those values) inside, and writes a [turn] table that is read."""
+    from zmpwalk.tune import TURN_GRID, with_turn_table
+
+    data = with_turn_table(hubo_schedule_data())
+    turns = [c for c in conditions_of(data) if c.mode == "turn"]
+    assert [(c.duration, c.stride) for c in turns] == list(TURN_GRID)
+    hubo = load_robot("hubo")
+    before, _ = Schedule(data).stage_parameters(StepCommand(0.7, turn=0.13), hubo)
+    without, _ = Schedule.hubo().stage_parameters(StepCommand(0.7, turn=0.13), hubo)
+    assert (before.sway, before.up_ratio, before.alpha1, before.d1) == pytest.approx(
+        (without.sway, without.up_ratio, without.alpha1, without.d1), abs=1e-12)  # nothing changes by adding it
+    rows = [Condition("forward", 0.7, 0.0), Condition("turn", 0.7, 0.13)]
+    tuned = tune("hubo", trials=30, seed=2, workers=1, conditions=rows, steps=6)
+    result = tuned.results[1]
+    assert result.table_cart_margin < 0.0 < result.cart_margin and result.walks  # [m]
+    path = tmp_path / "tuned.toml"
+    path.write_text(schedule_toml(tuned, "hubo"), encoding="utf-8")
+    first, second = Schedule.from_file(path).stage_parameters(StepCommand(0.7, turn=0.13), hubo)
+    assert first.sway == pytest.approx(result.values["sway"], rel=1e-5)
+    assert (first.d1, second.d1) == pytest.approx((result.values["d1_open"], result.values["d1_recovery"]), rel=1e-5)

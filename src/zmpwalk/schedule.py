@@ -13,6 +13,12 @@ step up as follows:
 3. Side steps use Table 3. Below the smallest tabulated side step (5 cm) the
    values are interpolated towards stepping on the spot, whose values are
    Table 2's stride-0 row with ``alpha1 = beta1 = 1`` and ``d1`` of Table 2.
+   Turns (without a side step, with or without a stride) use the optional
+   ``[turn]`` table, keyed by the turn of one step [rad] and with Table 3's
+   columns, in the same way (towards stepping on the spot below its smallest
+   turn). The paper has no turn table: without one a turn takes Table 2's row
+   and ``alpha1``, ``beta1``, ``d1`` for both its stages (``zmpwalk tune``
+   writes a ``[turn]`` table).
 4. Outside the tabulated range (a step time below 0.7 s or above 0.95 s, a
    stride beyond the longest row) the nearest edge value is held and the
    lookup is marked ``extrapolated``; the pattern reports it per step.
@@ -141,8 +147,11 @@ def _interpolate_rows(block: np.ndarray, key_index: int, key: float) -> tuple[np
     return out, source
 
 
+TURN_COLUMNS = ["duration", "turn", "sway", "up_ratio", "alpha1", "beta1", "d1_open", "d1_recovery"]  # [turn] [rad]
+
+
 class Schedule:
-    """Shape parameters for any (step time, stride, side step) from tuned tables.
+    """Shape parameters for any (step time, stride, side step, turn) from tuned tables.
 
     Args:
         data: The parsed schedule file (see ``data/schedule_hubo.toml``).
@@ -155,6 +164,12 @@ class Schedule:
             side = data["side"]
             self._forward = _Grid(forward["rows"], forward["columns"], "stride", source)
             self._side = _Grid(side["rows"], side["columns"], "side", source)
+            turn = data.get("turn")
+            self._turn = None
+            if turn is not None:
+                if list(turn["columns"]) != TURN_COLUMNS:
+                    raise FileFormatError(source, f"[turn] columns must be {TURN_COLUMNS}, not {turn['columns']}")
+                self._turn = _Grid(turn["rows"], turn["columns"], "turn", source)
             self._forward_d1 = float(forward["d1"])
             self._forward_alpha1 = float(forward["alpha1"])
             self._forward_beta1 = float(forward["beta1"])
@@ -163,16 +178,20 @@ class Schedule:
         self._cache: dict[tuple[object, ...], tuple[ShapeParameters, ShapeParameters]] = {}
 
     def conditions(self) -> list[tuple[str, float, float]]:
-        """The tabulated conditions: ``("forward", step time [s], stride [m])`` and ``("side", ..., side step [m])``."""
+        """The tabulated conditions: ``("forward", step time [s], stride [m])``, ``("side", ..., side step [m])``
+        and, where the schedule has a turn table, ``("turn", ..., turn [rad])``."""
         result = []
-        for mode, grid in (("forward", self._forward), ("side", self._side)):
+        grids = [("forward", self._forward), ("side", self._side)]
+        if self._turn is not None:
+            grids.append(("turn", self._turn))
+        for mode, grid in grids:
             for duration in sorted(grid.by_duration, reverse=True):
                 for row in grid.by_duration[duration]:
                     result.append((mode, float(duration), float(row[grid.key_index])))
         return result
 
-    def _on_spot_row(self, duration: float) -> np.ndarray:
-        """Stepping on the spot as a Table 3 row (side step 0) at a tabulated step time."""
+    def on_spot_row(self, duration: float) -> np.ndarray:
+        """Stepping on the spot as a Table 3 (or turn table) row, side step (turn) 0, at a tabulated step time."""
         on_spot, _ = self._forward.lookup(duration, 0.0)
         return np.array([
             duration, 0.0, on_spot["sway"], on_spot["up_ratio"], self._forward_alpha1,
@@ -220,8 +239,13 @@ class Schedule:
         open_alpha1 = recovery_alpha1 = self._forward_alpha1
         open_beta1 = recovery_beta1 = self._forward_beta1
         open_d1 = recovery_d1 = self._forward_d1
+        two_stage: tuple[dict[str, float], str] | None = None
         if command.side != 0.0:
-            side_row, side_source = self._side.lookup(duration, abs(command.side) / lateral_scale, self._on_spot_row)
+            two_stage = self._side.lookup(duration, abs(command.side) / lateral_scale, self.on_spot_row)
+        elif command.turn != 0.0 and self._turn is not None:  # a turn is an angle: the same for every robot
+            two_stage = self._turn.lookup(duration, abs(command.turn), self.on_spot_row)
+        if two_stage is not None:
+            side_row, side_source = two_stage
             sway = side_row["sway"] * lateral_scale
             up_ratio = side_row["up_ratio"]
             open_alpha1, open_beta1 = side_row["alpha1"], side_row["beta1"]

@@ -1,9 +1,10 @@
 """Automatic tuning of the HUBO pattern's shape factors per robot: the paper's future work.
 
-For every condition of a grid (step time and stride or side step; the paper's Tables 2-3 by default)
-:func:`tune` searches the shape factors of that table row within :data:`FORWARD_RANGES` and
-:data:`SIDE_RANGES` (table units, those of the HUBO tables; another robot walks them at its
-dynamically similar condition, :mod:`zmpwalk.schedule`) to maximise the stability score:
+For every condition of a grid (step time and stride, side step or turn; the paper's Tables 2-3 by default,
+and a turn table of :data:`TURN_GRID` that the paper does not have) :func:`tune` searches the shape factors
+of that table row within :data:`FORWARD_RANGES` and :data:`SIDE_RANGES` (turns: the side table's columns;
+table units, those of the HUBO tables; another robot walks them at its dynamically similar condition,
+:mod:`zmpwalk.schedule`) to maximise the stability score:
 
 1. **Cheap, every candidate**: the smallest margin, over every 1 kHz sample of a walk of ``steps`` steps
    of the condition from standstill to standstill, of the cart-table ZMP (Eqs. 1-2) and of the
@@ -46,12 +47,14 @@ from zmpwalk.files import read_toml
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots import loaded_robot
 from zmpwalk.robots.model import RobotModel
-from zmpwalk.schedule import Schedule
+from zmpwalk.schedule import TURN_COLUMNS, Schedule
 from zmpwalk.sim.sweep import in_pool
 
 FORWARD_RANGES = {"sway": (0.02, 0.06), "alpha": (1.0, 2.2), "up_ratio": (0.3, 0.6)}  # [m], [-], [-]
 SIDE_RANGES = {"sway": (0.02, 0.06), "up_ratio": (0.3, 0.6), "alpha1": (0.6, 1.2), "beta1": (0.6, 1.2),
                "d1_open": (0.1, 0.4), "d1_recovery": (0.05, 0.35)}  # [m], then [-]
+# turn rows where the schedule has none: step times of Tables 2-3 x turns of one step [rad] (7.5 and 15 degrees)
+TURN_GRID = ((0.95, 0.13), (0.95, 0.26), (0.80, 0.13), (0.80, 0.26), (0.70, 0.13), (0.70, 0.26))
 MARGIN_CAP = 0.03  # [m] margins beyond this score the same
 SIMULATED = 3  # best candidates of each condition that walk in MuJoCo
 RATE = 1000.0  # [Hz]
@@ -59,15 +62,16 @@ RATE = 1000.0  # [Hz]
 
 @dataclass(frozen=True)
 class Condition:
-    """One row of the tables: ``mode`` ``"forward"`` or ``"side"``, step time [s], stride or side step [m]."""
+    """One row of the tables: ``mode`` ``"forward"``, ``"side"`` or ``"turn"``, step time [s], and the row's
+    key: stride or side step [m], or turn [rad]."""
 
     mode: str
     duration: float  # [s]
-    stride: float  # [m]
+    stride: float  # [m] stride or side step, [rad] turn
 
     @property
     def name(self) -> str:
-        return f"{self.mode} {self.duration:.2f} s {self.stride:.2f} m"
+        return f"{self.mode} {self.duration:.2f} s {self.stride:.2f} {'rad' if self.mode == 'turn' else 'm'}"
 
 
 @dataclass
@@ -130,10 +134,30 @@ def hubo_schedule_data() -> dict[str, Any]:
     return read_toml(Path(str(resources.files("zmpwalk") / "data" / "schedule_hubo.toml")))
 
 
+MODE_KEYS = (("forward", "stride"), ("side", "side"), ("turn", "turn"))  # each table and its key column
+
+
+def with_turn_table(data: dict[str, Any]) -> dict[str, Any]:
+    """``data`` with a turn table of :data:`TURN_GRID` where it has none, each row holding what a turn takes
+    without one (Table 2's stride-0 row, and its ``alpha1``, ``beta1``, ``d1`` for both stages)."""
+    if "turn" in data:
+        return data
+    out = copy.deepcopy(data)
+    schedule = Schedule(data, "<schedule>")
+    rows = []
+    for duration, turn in TURN_GRID:
+        on_spot = schedule.on_spot_row(duration)  # [duration, 0, sway, up_ratio, alpha1, beta1, d1, d1]
+        rows.append([duration, turn, *(float(v) for v in on_spot[2:])])
+    out["turn"] = {"columns": list(TURN_COLUMNS), "rows": rows}
+    return out
+
+
 def conditions_of(data: dict[str, Any]) -> list[Condition]:
     """Every row of a schedule's tables as a condition, in the file's order."""
     result = []
-    for mode, key in (("forward", "stride"), ("side", "side")):
+    for mode, key in MODE_KEYS:
+        if mode not in data:
+            continue
         table = data[mode]
         columns = table["columns"]
         for row in table["rows"]:
@@ -142,9 +166,9 @@ def conditions_of(data: dict[str, Any]) -> list[Condition]:
 
 
 def _row_index(data: dict[str, Any], condition: Condition) -> int:
-    table = data[condition.mode]
+    table = data.get(condition.mode, {"columns": [condition.mode], "rows": []})
     columns = table["columns"]
-    key = columns.index("stride" if condition.mode == "forward" else "side")
+    key = columns.index(dict(MODE_KEYS)[condition.mode])
     for index, row in enumerate(table["rows"]):
         if abs(row[columns.index("duration")] - condition.duration) < 1e-9 and abs(row[key] - condition.stride) < 1e-9:
             return index
@@ -153,7 +177,7 @@ def _row_index(data: dict[str, Any], condition: Condition) -> int:
 
 def tuned_columns(condition: Condition) -> dict[str, tuple[float, float]]:
     """The columns searched for a condition and their ranges (``alpha`` is undefined at stride 0)."""
-    if condition.mode == "side":
+    if condition.mode in ("side", "turn"):
         return dict(SIDE_RANGES)
     ranges = dict(FORWARD_RANGES)
     if condition.stride == 0.0:
@@ -184,6 +208,8 @@ def condition_command(robot: RobotModel, condition: Condition) -> StepCommand:
     duration = condition.duration * time_scale
     if condition.mode == "forward":
         return StepCommand(duration, condition.stride * stride_scale)
+    if condition.mode == "turn":
+        return StepCommand(duration, turn=condition.stride)  # an angle: the same for every robot
     return StepCommand(duration, side=condition.stride * lateral_scale)
 
 
@@ -297,7 +323,8 @@ def tune(robot: str, trials: int = 40, seed: int = 0, workers: int | None = None
         workers: Conditions tuned at a time (default: one per core).
         storage: An SQLite file keeping the studies: a run that stops resumes where it was.
         steps: Steps of each condition walked per candidate.
-        data: The schedule to start from (default: Tables 2-3); its rows are the grid.
+        data: The schedule to start from (default: Tables 2-3); its rows are the grid, with the turn rows of
+            :data:`TURN_GRID` added where it has no turn table.
         conditions: Only these rows (default: every row).
         progress: Called with (conditions done, of, best score so far [m]).
         scheduler: Tune the conditions on a Dask cluster (its scheduler's address, or ``"local"``;
@@ -311,7 +338,7 @@ def tune(robot: str, trials: int = 40, seed: int = 0, workers: int | None = None
     for name, value, low in (("trials", trials, 1), ("steps", steps, 2), ("workers", workers or 1, 1)):
         if isinstance(value, bool) or not isinstance(value, int) or value < low:
             raise InvalidParameterError(name, value, f"an integer >= {low}")
-    data = copy.deepcopy(data) if data is not None else hubo_schedule_data()
+    data = with_turn_table(copy.deepcopy(data) if data is not None else hubo_schedule_data())
     grid = list(conditions) if conditions is not None else conditions_of(data)
     for condition in grid:
         _row_index(data, condition)
@@ -345,7 +372,9 @@ def schedule_toml(result: TuneResult, robot: str) -> str:
              "# Each row's comment: smallest cart-table / multibody ZMP margin over its steps at 1 kHz [mm], whether",
              "# it walked them in MuJoCo, and the table's own values' margins before tuning.", ""]
     by_row = {(r.condition.mode, r.condition.duration, r.condition.stride): r for r in result.results}
-    for mode, key in (("forward", "stride"), ("side", "side")):
+    for mode, key in MODE_KEYS:
+        if mode not in result.data:
+            continue
         table = result.data[mode]
         lines.append(f"[{mode}]")
         for name, value in table.items():
