@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 
 from zmpwalk import StepCommand
+from zmpwalk.schedule import Schedule
 
 TOL = 1e-12
 
@@ -76,7 +77,7 @@ def test_a_turn_table_is_looked_up_like_table_3(hubo):
     """Exact rows, interpolation towards stepping on the spot below the smallest turn, a curved step's two
     stages, and the columns checked."""
     from zmpwalk.errors import FileFormatError
-    from zmpwalk.schedule import TURN_COLUMNS, Schedule
+    from zmpwalk.schedule import TURN_COLUMNS
     from zmpwalk.tune import hubo_schedule_data
 
     data = hubo_schedule_data()
@@ -94,3 +95,25 @@ def test_a_turn_table_is_looked_up_like_table_3(hubo):
     data["turn"]["columns"] = ["duration", "turn", "up_ratio", "sway", "alpha1", "beta1", "d1_open", "d1_recovery"]
     with pytest.raises(FileFormatError, match=r"\[turn\] columns"):
         Schedule(data)
+
+
+def test_table_2_may_carry_v_y_and_the_double_support_time(hubo):
+    """Optional columns of the forward table: looked up like the others, for side steps and turns too (their
+    stride's row); without them the robot's values."""
+    from zmpwalk.tune import hubo_schedule_data, with_timing_columns
+
+    data = with_timing_columns(hubo_schedule_data(), hubo)
+    plain, _ = Schedule.hubo().stage_parameters(StepCommand(0.8, 0.1), hubo)
+    same, _ = Schedule(data).stage_parameters(StepCommand(0.8, 0.1), hubo)
+    assert (same.lateral_velocity, same.dsp_time) == (plain.lateral_velocity, plain.dsp_time) == (
+        hubo.lateral_velocity, hubo.dsp_time)
+    columns = data["forward"]["columns"]
+    for row in data["forward"]["rows"]:
+        if row[0] == 0.8:
+            row[columns.index("dsp_time")] = 0.15 if row[1] == 0.0 else 0.12
+            row[columns.index("lateral_velocity")] = 0.14
+    schedule = Schedule(data)
+    forward, _ = schedule.stage_parameters(StepCommand(0.8, 0.1), hubo)
+    side, recovery = schedule.stage_parameters(StepCommand(0.8, side=0.05), hubo)
+    assert (forward.dsp_time, forward.lateral_velocity) == pytest.approx((0.12, 0.14), abs=1e-12)
+    assert (side.dsp_time, recovery.dsp_time) == pytest.approx((0.15, 0.15), abs=1e-12)  # the stride-0 row

@@ -110,3 +110,18 @@ def test_turn_rows_are_added_to_a_grid_without_them_and_tuned_into_the_file(tmp_
     first, second = Schedule.from_file(path).stage_parameters(StepCommand(0.7, turn=0.13), hubo)
     assert first.sway == pytest.approx(result.values["sway"], rel=1e-5)
     assert (first.d1, second.d1) == pytest.approx((result.values["d1_open"], result.values["d1_recovery"]), rel=1e-5)
+
+
+def test_timing_tunes_v_y_and_the_double_support_time_within_their_ranges(tmp_path):
+    from zmpwalk.tune import TIMING_RANGES
+
+    result = tune("hubo", trials=4, seed=1, workers=1, conditions=[Condition("forward", 0.8, 0.0)], steps=4,
+                  timing=True)
+    values = result.results[0].values
+    for name, (low, high) in TIMING_RANGES.items():
+        assert low <= values[name] <= high
+    path = tmp_path / "timed.toml"
+    path.write_text(schedule_toml(result, "hubo"), encoding="utf-8")
+    parameters, _ = Schedule.from_file(path).stage_parameters(StepCommand(0.8), load_robot("hubo"))
+    assert (parameters.dsp_time, parameters.lateral_velocity) == pytest.approx(
+        (values["dsp_time"], values["lateral_velocity"]), rel=1e-5)

@@ -279,6 +279,8 @@ def _parser() -> argparse.ArgumentParser:
     tune_cmd.add_argument("--workers", type=int, help="conditions at a time (default: one per core)")
     tune_cmd.add_argument("--dask", metavar="SCHEDULER", help=DASK_HELP)
     tune_cmd.add_argument("--storage", type=Path, help="SQLite file of the studies: a stopped run resumes")
+    tune_cmd.add_argument("--timing", action="store_true",
+                          help="also tune V_y and the double-support time of Table 2's rows (added as columns)")
     tune_cmd.add_argument("--json", action="store_true", help="print JSON")
     robot_cmd = commands.add_parser(
         "robot", help="import a robot from its MJCF or URDF and show what zmpwalk derived",
@@ -520,7 +522,7 @@ def _tune(args: argparse.Namespace) -> int:
         lambda done, total, best: _progress(f"conditions (best {best * 1e3:+.1f} mm)", done, total))
     started = time.perf_counter()
     result = tune(args.robot, trials=args.trials, seed=args.seed, workers=args.workers, storage=args.storage,
-                  steps=args.steps, data=data, progress=show, scheduler=args.dask)
+                  steps=args.steps, data=data, progress=show, scheduler=args.dask, timing=args.timing)
     wall = time.perf_counter() - started
     write_text(args.out, schedule_toml(result, args.robot) + "\n")
     if args.json:

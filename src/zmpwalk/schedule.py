@@ -19,6 +19,11 @@ step up as follows:
    turn). The paper has no turn table: without one a turn takes Table 2's row
    and ``alpha1``, ``beta1``, ``d1`` for both its stages (``zmpwalk tune``
    writes a ``[turn]`` table).
+   Table 2 may carry two more columns, ``lateral_velocity`` (``V_y`` [m per
+   unit ``2 t_bar``]) and ``dsp_time`` (``d`` [s]), looked up like the others
+   and used by every step of that step time and stride (side steps and turns:
+   their stride's row); without them both are the robot's (``zmpwalk tune
+   --timing`` writes them).
 4. Outside the tabulated range (a step time below 0.7 s or above 0.95 s, a
    stride beyond the longest row) the nearest edge value is held and the
    lookup is marked ``extrapolated``; the pattern reports it per step.
@@ -252,9 +257,13 @@ class Schedule:
             open_d1, recovery_d1 = side_row["d1_open"], side_row["d1_recovery"]
             recovery_alpha1, recovery_beta1 = open_alpha1, open_beta1
             source = _worse(source, side_source)
+        # V_y and d: Table 2's row where the forward table carries them (table units), else the robot's
+        lateral_velocity = row["lateral_velocity"] * lateral_scale if "lateral_velocity" in row \
+            else robot.lateral_velocity
+        dsp_time = row["dsp_time"] * time_scale if "dsp_time" in row else robot.dsp_time
         common = {
             "alpha": alpha, "up_ratio": up_ratio, "sway": sway,
-            "lateral_velocity": robot.lateral_velocity, "dsp_time": robot.dsp_time,
+            "lateral_velocity": lateral_velocity, "dsp_time": dsp_time,
             "foot_lift": robot.foot_lift,
         }
         first = ShapeParameters(alpha1=open_alpha1, beta1=open_beta1, d1=open_d1, source=source, **common)

@@ -53,6 +53,8 @@ from zmpwalk.sim.sweep import in_pool
 FORWARD_RANGES = {"sway": (0.02, 0.06), "alpha": (1.0, 2.2), "up_ratio": (0.3, 0.6)}  # [m], [-], [-]
 SIDE_RANGES = {"sway": (0.02, 0.06), "up_ratio": (0.3, 0.6), "alpha1": (0.6, 1.2), "beta1": (0.6, 1.2),
                "d1_open": (0.1, 0.4), "d1_recovery": (0.05, 0.35)}  # [m], then [-]
+# V_y and d (table units) where the forward table carries them: tune(..., timing=True) adds the columns
+TIMING_RANGES = {"lateral_velocity": (0.05, 0.2), "dsp_time": (0.05, 0.2)}  # [m per unit 2 t_bar], [s]
 # turn rows where the schedule has none: step times of Tables 2-3 x turns of one step [rad] (7.5 and 15 degrees)
 TURN_GRID = ((0.95, 0.13), (0.95, 0.26), (0.80, 0.13), (0.80, 0.26), (0.70, 0.13), (0.70, 0.26))
 MARGIN_CAP = 0.03  # [m] margins beyond this score the same
@@ -175,21 +177,37 @@ def _row_index(data: dict[str, Any], condition: Condition) -> int:
     raise InvalidParameterError("condition", condition.name, "a row of the schedule's tables")
 
 
-def tuned_columns(condition: Condition) -> dict[str, tuple[float, float]]:
-    """The columns searched for a condition and their ranges (``alpha`` is undefined at stride 0)."""
+def tuned_columns(condition: Condition, data: dict[str, Any] | None = None) -> dict[str, tuple[float, float]]:
+    """The columns searched for a condition and their ranges (``alpha`` is undefined at stride 0; ``V_y`` and
+    ``d`` where ``data``'s forward table carries them)."""
     if condition.mode in ("side", "turn"):
         return dict(SIDE_RANGES)
     ranges = dict(FORWARD_RANGES)
     if condition.stride == 0.0:
         del ranges["alpha"]
+    if data is not None:
+        ranges.update({name: span for name, span in TIMING_RANGES.items() if name in data["forward"]["columns"]})
     return ranges
+
+
+def with_timing_columns(data: dict[str, Any], robot: RobotModel) -> dict[str, Any]:
+    """``data`` with Table 2 carrying ``V_y`` and ``d`` (the robot's, in table units) where it does not."""
+    out = copy.deepcopy(data)
+    table = out["forward"]
+    time_scale, _, lateral_scale = robot.schedule_scale
+    for name, value in (("lateral_velocity", robot.lateral_velocity / lateral_scale),
+                        ("dsp_time", robot.dsp_time / time_scale)):
+        if name not in table["columns"]:
+            table["columns"] = [*table["columns"], name]
+            table["rows"] = [[*row, value] for row in table["rows"]]
+    return out
 
 
 def row_values(data: dict[str, Any], condition: Condition) -> dict[str, float]:
     """The tuned columns of a condition's row as the schedule has them."""
     table = data[condition.mode]
     row = table["rows"][_row_index(data, condition)]
-    return {name: float(row[table["columns"].index(name)]) for name in tuned_columns(condition)}
+    return {name: float(row[table["columns"].index(name)]) for name in tuned_columns(condition, data)}
 
 
 def with_row(data: dict[str, Any], condition: Condition, values: dict[str, float]) -> dict[str, Any]:
@@ -275,7 +293,7 @@ def tune_condition(robot_spec: str, data: dict[str, Any], condition: Condition, 
     optuna = _optuna()
     start = time.perf_counter()
     robot = loaded_robot(robot_spec)
-    ranges = tuned_columns(condition)
+    ranges = tuned_columns(condition, data)
     table = row_values(data, condition)
     sampler = optuna.samplers.TPESampler(seed=seed * 1009 + index)
     study = optuna.create_study(direction="maximize", sampler=sampler, storage=storage, load_if_exists=True,
@@ -313,7 +331,8 @@ def tune_condition(robot_spec: str, data: dict[str, Any], condition: Condition, 
 
 def tune(robot: str, trials: int = 40, seed: int = 0, workers: int | None = None, storage: Path | None = None,
          steps: int = 10, data: dict[str, Any] | None = None, conditions: Sequence[Condition] | None = None,
-         progress: Callable[[int, int, float], None] | None = None, scheduler: str | None = None) -> TuneResult:
+         progress: Callable[[int, int, float], None] | None = None, scheduler: str | None = None,
+         timing: bool = False) -> TuneResult:
     """Tune the shape factors of every condition of a schedule for a robot.
 
     Args:
@@ -329,6 +348,8 @@ def tune(robot: str, trials: int = 40, seed: int = 0, workers: int | None = None
         progress: Called with (conditions done, of, best score so far [m]).
         scheduler: Tune the conditions on a Dask cluster (its scheduler's address, or ``"local"``;
             :func:`zmpwalk.sim.sweep.in_pool`). With ``storage``, every worker must reach the same file.
+        timing: Also tune ``V_y`` and the double-support time ``d`` of Table 2's rows (within
+            :data:`TIMING_RANGES`; the columns are added, starting from the robot's values).
 
     Raises:
         InvalidParameterError: A bad count or a condition that is not a row.
@@ -342,7 +363,9 @@ def tune(robot: str, trials: int = 40, seed: int = 0, workers: int | None = None
     grid = list(conditions) if conditions is not None else conditions_of(data)
     for condition in grid:
         _row_index(data, condition)
-    loaded_robot(robot)
+    model = loaded_robot(robot)
+    if timing:
+        data = with_timing_columns(data, model)
     url = f"sqlite:///{Path(storage).resolve()}" if storage is not None else None
     workers = workers or os.cpu_count() or 1
     results: dict[int, ConditionResult] = {}
