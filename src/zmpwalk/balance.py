@@ -406,9 +406,6 @@ class Stabilizer:
         # released once the foot carries load.
         stance = _rotate3(rot, relative[anchor])
         base_ex, base_ey = foot_anchor[0] - stance[0], foot_anchor[1] - stance[1]
-        planned_stance = _rotate2(planned_relative[anchor][0], planned_relative[anchor][1], yaw)
-        base_px = float(ankles_in_world[anchor][0]) - planned_stance[0]
-        base_py = float(ankles_in_world[anchor][1]) - planned_stance[1]
         # the step towards the fall: step_gain times the DCM error beyond step_deadband
         error_norm = math.hypot(ex, ey)
         step = g.step_gain * max(error_norm - g.step_deadband, 0.0) / error_norm if error_norm > 0.0 else 0.0
@@ -418,8 +415,14 @@ class Stabilizer:
         for foot in range(2):
             land = self._landing[foot]
             if (support == 1 and foot == 1) or (support == 2 and foot == 0):  # swinging
-                land[0] += landing_rate * (base_px + offset[0] - base_ex + step_x - land[0])
-                land[1] += landing_rate * (base_py + offset[1] - base_ey + step_y - land[1])
+                # the foot's planned place seen from the estimated base through the measured attitude, less the
+                # pelvis turn and shift applied to every foot below: what puts it there in world
+                px, py, pz = planned_relative[foot]
+                seen = _rotate3_back(rot, (float(ankles_in_world[foot][0]) - base_ex,
+                                           float(ankles_in_world[foot][1]) - base_ey, pz))
+                aim = _rotate2(seen[0] - px + turn_pitch * pz, seen[1] - py - turn_roll * pz, yaw)
+                land[0] += landing_rate * (aim[0] + offset[0] + step_x - land[0])
+                land[1] += landing_rate * (aim[1] + offset[1] + step_y - land[1])
             else:
                 land[0] -= release_rate * land[0]
                 land[1] -= release_rate * land[1]
@@ -522,6 +525,12 @@ def _rotate3(r: tuple[float, ...], v: tuple[float, ...] | list[float]) -> tuple[
     """The row-major rotation ``r`` applied to ``v``."""
     x, y, z = v[0], v[1], v[2]
     return (r[0] * x + r[1] * y + r[2] * z, r[3] * x + r[4] * y + r[5] * z, r[6] * x + r[7] * y + r[8] * z)
+
+
+def _rotate3_back(r: tuple[float, ...], v: tuple[float, ...] | list[float]) -> tuple[float, float, float]:
+    """The transpose of the row-major rotation ``r`` applied to ``v``."""
+    x, y, z = v[0], v[1], v[2]
+    return (r[0] * x + r[3] * y + r[6] * z, r[1] * x + r[4] * y + r[7] * z, r[2] * x + r[5] * y + r[8] * z)
 
 
 def _sub3(a: tuple[float, ...] | list[float], b: tuple[float, ...] | list[float]) -> tuple[float, float, float]:
