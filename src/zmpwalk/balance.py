@@ -230,6 +230,8 @@ class Stabilizer:
         self._landing = [[0.0, 0.0], [0.0, 0.0]]  # landing corrections of the feet in world [m]
         self._anchor = 0
         self._floor_normal = [0.0, 0.0, 1.0]  # filtered, in world (gravity up)
+        self._sole_normals = [[0.0, 0.0], [0.0, 0.0]]  # horizontal parts of each sole's normal in world, last tick
+        self._started_odometry = False
         self.state = BalanceState(np.zeros(2), np.full(2, np.nan), np.zeros(2), np.zeros(2), np.zeros((2, 2)),
                                   0.0, np.zeros(2))
 
@@ -304,6 +306,17 @@ class Stabilizer:
         # load too, it is placed from the reference by the measured kinematics at every tick, so a foot that
         # lands heel first and rolls flat is followed; when the reference unloads, the other one takes over.
         anchor = self._anchor
+        # A loaded sole that tilts rolls on an edge below its ankle (a heel-first landing rolling flat): the
+        # ankle moves by the ankle height times the change of the sole normal's horizontal part.
+        h = self.robot.ankle_height
+        for foot in range(2):
+            normal_in_world = _rotate3(rot, rotations[2 * foot, 6, :, 2].tolist())
+            last = self._sole_normals[foot]
+            if foot == anchor and self._started_odometry and (loaded0 if foot == 0 else loaded1):
+                self._feet[foot][0] += h * (normal_in_world[0] - last[0])
+                self._feet[foot][1] += h * (normal_in_world[1] - last[1])
+            last[0], last[1] = normal_in_world[0], normal_in_world[1]
+        self._started_odometry = True
         if loaded0 and loaded1:
             d = _rotate3(rot, _sub3(relative[1 - anchor], relative[anchor]))
             self._feet[1 - anchor] = [self._feet[anchor][0] + d[0], self._feet[anchor][1] + d[1]]
