@@ -238,3 +238,20 @@ def test_talos_walks_with_its_own_servos_and_the_stabilizer() -> None:
     assert result.final_feet_yaw_error < np.radians(2)
     assert result.end_max_speed < 0.05  # [m/s] standing still over the last 2 s
     assert result.end_min_sole_force > 100.0  # [N] both soles loaded
+
+
+def test_odometry_follows_a_loaded_sole_rolling_on_its_edge() -> None:
+    """The reference sole (left, loaded) pitches by 0.02 rad (a heel-first landing rolling flat): its ankle
+    moves by the ankle height times the change of the sole normal's horizontal part, h dphi forward."""
+    stabilizer, inputs, _ = standing()
+    run(stabilizer, inputs, 5, loads=(1.5, 0.5))
+    assert stabilizer._anchor == 0
+    before = np.asarray(stabilizer._feet[0]).copy()
+    angles = np.asarray(inputs["joint_angles"]).copy()
+    angles[4] += 0.02  # the left ankle pitch
+    run(stabilizer, inputs, 1, joint_angles=angles, loads=(2.0, 0.0))
+    chains = leg_chains(stabilizer.robot)
+    normals = [chains[0].fk(a[None])[1][0][:, 2] for a in (np.asarray(inputs["joint_angles"])[:6], angles[:6])]
+    expected = before + stabilizer.robot.ankle_height * (normals[1] - normals[0])[:2]  # upright torso, heading 0
+    assert np.asarray(stabilizer._feet[0]) == pytest.approx(expected, abs=1e-12)
+    assert abs(stabilizer._feet[0][0] - before[0]) > 0.5 * stabilizer.robot.ankle_height * 0.02
