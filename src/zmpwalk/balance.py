@@ -11,8 +11,10 @@ separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega 
 
 1. **DCM tracking.** The CoM ``c`` is estimated from the encoders and the IMU, anchored at the sole that
    has carried load the longest, whose place in world comes from leg odometry (while both soles carry load
-   the newer one is placed from it by the measured kinematics, tick by tick), so a step landed short shows
-   as a DCM error; the divergent component of motion ``xi = c + c' / omega`` must follow the pattern's.
+   the newer one is placed from it by the measured kinematics, tick by tick; while the reference sole rolls
+   on an edge, its ankle moves by the ankle height times the change of the sole normal's horizontal part),
+   so a step landed short shows as a DCM error; the divergent component of motion ``xi = c + c' / omega``
+   must follow the pattern's.
    Its error ``e = xi - xi_ref`` decays at rate ``k_xi`` when the ZMP is
 
    .. math:: p_d = p_{ref} + (1 + k_\xi / \omega)\, e, \qquad \dot e = -k_\xi e
@@ -28,8 +30,9 @@ separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega 
    until the measured force difference is the desired one.
 5. **Torso attitude**: the pelvis is turned against the measured roll and pitch (and their rates).
 6. **Landing and stepping**: the swinging foot aims at its planned place in world from the odometry's
-   base, moved by :attr:`StabilizerGains.step_gain` times the DCM error, towards where the body falls (the
-   capture point of Pratt et al. 2006); the correction is released once the foot carries load.
+   base, seen through the measured pelvis attitude, moved by :attr:`StabilizerGains.step_gain` times the
+   DCM error, towards where the body falls (the capture point of Pratt et al. 2006); the correction is
+   released once the foot carries load.
 7. **Floor slope**: in double support both soles lie on the floor, so their attitude (IMU and measured leg
    kinematics) is the floor's; with unit normal ``n`` the CoM must stand ``l (n_x, n_y) / n_z`` uphill of
    its plan for the ZMP to stay where planned, and the CoM admittance is pulled to that offset instead of
