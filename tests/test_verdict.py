@@ -65,3 +65,33 @@ def test_the_cop_criterion_skips_each_touchdown_the_first_sample_included() -> N
     assert cop_margin_outside_touchdowns(result) == pytest.approx(-0.007, abs=1e-12)  # type: ignore[arg-type]
     margin[600 + 3] = -0.030  # inside it: not judged
     assert cop_margin_outside_touchdowns(result) == pytest.approx(-0.007, abs=1e-12)  # type: ignore[arg-type]
+
+
+def test_a_touchdown_starts_at_first_contact_not_when_the_sole_becomes_loaded() -> None:
+    """The landing sole first touches with a small force (here 101 N, under the loaded share) while the carrying
+    sole's sensor reads a CoP beyond its edge from the impact: that first contact millisecond is a touchdown."""
+    import types
+
+    import numpy as np
+
+    from zmpwalk.robots import load_robot
+    from zmpwalk.sim.run import LOADED_FRACTION
+    from zmpwalk.sim.verdict import CONTACT_FRACTION, cop_margin_outside_touchdowns
+
+    robot = load_robot("hubo")
+    time = np.arange(0.0, 1.0, 0.001)
+    weight = robot.mass * robot.gravity
+    left = np.full(len(time), weight)
+    right = np.zeros(len(time))
+    right[:100] = weight / 2
+    left[:100] = weight / 2
+    touch = 500
+    right[touch] = 0.5 * (CONTACT_FRACTION + LOADED_FRACTION) * weight  # touching, not yet loaded
+    right[touch + 1:] = weight / 2
+    left[touch + 1:] = weight / 2
+    margin = np.full(len(time), 0.02)
+    margin[touch] = -0.030
+    result = types.SimpleNamespace(robot=robot, time=time, force_left=left, force_right=right, cop_margin=margin)
+    assert cop_margin_outside_touchdowns(result) == pytest.approx(0.02, abs=1e-12)  # type: ignore[arg-type]
+    margin[touch - 1] = -0.030  # before the contact: judged
+    assert cop_margin_outside_touchdowns(result) == pytest.approx(-0.030, abs=1e-12)  # type: ignore[arg-type]

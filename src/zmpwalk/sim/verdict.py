@@ -10,7 +10,10 @@ A walk passes when all of these hold (the limits are module constants, stated in
 3. **The feet end where the plan puts them**: each ankle within :data:`FEET_DISTANCE` and
    :data:`FEET_YAW` of its planned final pose.
 4. **The CoP stays inside the loaded soles** (margin at least :data:`COP_MARGIN`) except at touchdown
-   transients: the :data:`TOUCHDOWN_WINDOW` after a sole becomes loaded is not judged.
+   transients: the :data:`TOUCHDOWN_WINDOW` after a sole touches the floor (carries more than
+   :data:`CONTACT_FRACTION` of the weight) or becomes loaded is not judged. (The other sole's force-torque
+   reading swings with the impact before the landing sole counts as loaded: TALOS's carrying sole read a CoP
+   30 mm outside itself at the first millisecond of the other's touchdown, at 101 N on the landing sole.)
 """
 
 from __future__ import annotations
@@ -32,6 +35,7 @@ FEET_DISTANCE = 0.02  # [m]
 FEET_YAW = math.radians(2.0)  # [rad]
 COP_MARGIN = -0.005  # [m]: 5 mm of the sensors' CoP beyond an edge is the foot's own inertia at its limit
 TOUCHDOWN_WINDOW = 0.05  # [s]
+CONTACT_FRACTION = 0.01  # [-] of the weight: a sole carrying more touches the floor
 
 
 @dataclass(frozen=True)
@@ -127,19 +131,21 @@ def walk_verdict(result: SimulationResult, hold: float) -> Verdict:
 
 
 def cop_margin_outside_touchdowns(result: SimulationResult) -> float:
-    """Least CoP margin [m] over the samples not within :data:`TOUCHDOWN_WINDOW` after a sole became loaded.
+    """Least CoP margin [m] over the samples not within :data:`TOUCHDOWN_WINDOW` after a sole touched the floor
+    or became loaded.
 
     The robot is set on the floor at the first sample: a sole loaded there has just touched down too.
     """
     weight = result.robot.mass * result.robot.gravity
-    loaded = np.column_stack([result.force_left, result.force_right]) > LOADED_FRACTION * weight
+    forces = np.column_stack([result.force_left, result.force_right])
     touchdown = np.zeros(len(result.time), dtype=bool)
     window = max(1, round(TOUCHDOWN_WINDOW / max(float(np.median(np.diff(result.time))), 1e-6)))
-    for foot in range(2):
-        became = np.concatenate([[True], ~loaded[:-1, foot]])  # nothing is loaded before the first sample
-        starts = np.flatnonzero(loaded[:, foot] & became)
-        for start in starts:
-            touchdown[start:start + window] = True
+    for fraction in (CONTACT_FRACTION, LOADED_FRACTION):
+        over = forces > fraction * weight
+        for foot in range(2):
+            became = np.concatenate([[True], ~over[:-1, foot]])  # nothing touches before the first sample
+            for start in np.flatnonzero(over[:, foot] & became):
+                touchdown[start:start + window] = True
     judged = result.cop_margin[~touchdown]
     judged = judged[np.isfinite(judged)]
     return float(judged.min()) if len(judged) else math.nan
