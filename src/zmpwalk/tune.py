@@ -245,11 +245,16 @@ def condition_walk(robot: RobotModel, data: dict[str, Any], condition: Condition
 
 def margins(robot: RobotModel, data: dict[str, Any], condition: Condition, steps: int) -> tuple[float, float]:
     """Smallest cart-table and multibody ZMP margins [m] of ``steps`` steps of a condition at 1 kHz (multibody:
-    nan without link masses; -inf where the walk cannot be planned)."""
+    nan without link masses; -inf where the walk cannot be planned, or, for a robot's own model, its legs
+    cannot be solved along it: its base goes under the whole-body centre of mass, which the pattern's reach
+    check does not see)."""
     from zmpwalk.dynamics import compare_zmp
+    from zmpwalk.kinematics import pattern_joint_trajectory
 
     try:
         pattern = condition_walk(robot, data, condition, steps)
+        if robot.plant is not None:
+            pattern_joint_trajectory(pattern, check_limits=False)
     except ZmpwalkError:
         return -math.inf, -math.inf
     cart = float(np.nanmin(pattern.zmp_margin()))
