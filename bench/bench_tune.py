@@ -1,5 +1,5 @@
-"""Time of a full tuning run: the paper's grid (18 rows) and the turn rows (6) for HUBO on every core, as ``zmpwalk tune``
-runs it.
+"""Time of a full tuning run: the paper's grid (18 rows) and the turn rows (6) for HUBO on every core, as
+``zmpwalk tune`` runs it.
 
 Run: python bench/bench_tune.py [--robot hubo] [--trials 40] [--workers N]. Prints figures; asserts nothing.
 """
