@@ -88,7 +88,8 @@ class StabilizerGains:
         slope_time_constant: Low-pass filter of the floor normal measured under both soles in double support
             [s]; 0 turns the slope compensation off.
         step_gain: The swinging foot's aim moves by this fraction of the DCM error (a step towards where the
-            body is falling) [-]; 0 lands it where planned.
+            body is falling) [-]; 1 puts it on the capture point (Pratt et al. 2006: the DCM error is how far
+            ahead of its plan the body will come to rest over the ZMP), 0 lands it where planned.
         step_deadband: The part of the DCM error's length that does not move the aim [m] (nominal walking
             stays within it, so only a push makes the foot step aside).
     """
@@ -113,7 +114,7 @@ class StabilizerGains:
     landing_release: float = 0.3  # [s]
     landing_limit: float = 0.1  # [m]
     slope_time_constant: float = 0.5  # [s]
-    step_gain: float = 0.5  # [-]
+    step_gain: float = 1.0  # [-]
     step_deadband: float = 0.03  # [m]
 
     def __post_init__(self) -> None:
