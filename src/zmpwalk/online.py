@@ -31,8 +31,8 @@ Behaviour:
 **Inside a hard real-time loop** use :meth:`OnlineWalker.submit` instead of
 :meth:`~OnlineWalker.command`: it only stores the command (microseconds), and
 the same whole check (the step and its stop, every sample at the control rate)
-runs in slices (the plan, the reach check, then :data:`SLICE_ROWS` samples of the
-pattern and, in the next tick, of the legs), one slice per tick, while the step
+runs in slices (the plan, with the hyperbolic generator each stage's pendulum, the reach check, then
+:data:`SLICE_ROWS` samples of the pattern and, in the next tick, of the legs), one slice per tick, while the step
 under way goes on. The command is queued when its check completes, or its
 rejection is kept in :attr:`OnlineWalker.rejection` (no tick ever raises). A
 walk submitted from standstill starts :data:`START_DELAY` later, by which time
