@@ -270,13 +270,13 @@ def _leg_ik_yaw_rates(leg: Leg, px: Array, py: Array, pz: Array, yaw: Array,
     dry = -(c * vy - s * vx) - w * rx
     drz = -vz
     d_distance = (rx * drx + ry * dry + rz * drz) / distance
-    with np.errstate(divide="ignore", invalid="ignore"):  # a stretched leg has no joint rates (J singular)
-        dq4 = -distance * d_distance / (a * b * sin4)
-    du = (ry * dry + rz * drz) / u_z
-    dq6 = (rz * dry - ry * drz) / u_squared
-    d_big_y, d_big_x = -a * cos4 * dq4, -a * sin4 * dq4
-    dq5 = ((big_x * d_big_y - big_y * d_big_x) / (big_x * big_x + big_y * big_y)
-           - (u_z * drx - rx * du) / (rx * rx + u_squared))
+    with np.errstate(divide="ignore", invalid="ignore"):  # a stretched leg has no joint rates (J singular;
+        dq4 = -distance * d_distance / (a * b * sin4)  # such a sample is beyond reach, which the caller rejects)
+        du = (ry * dry + rz * drz) / u_z
+        dq6 = (rz * dry - ry * drz) / u_squared
+        d_big_y, d_big_x = -a * cos4 * dq4, -a * sin4 * dq4
+        dq5 = ((big_x * d_big_y - big_y * d_big_x) / (big_x * big_x + big_y * big_y)
+               - (u_z * drx - rx * du) / (rx * rx + u_squared))
     dq1 = w
     dq2 = np.where(flipped, dq6, -dq6)
     dq3 = -(dq4 + dq5)
