@@ -142,3 +142,14 @@ def test_the_hyperbolic_generator_takes_no_pelvis_curve(hubo):
         OnlineWalker(hubo, generator="preview")
     with pytest.raises(InvalidParameterError, match="pelvis"):
         OnlineWalker(hubo, pelvis="hyperbolic")
+
+
+def test_a_long_hyperbolic_walk_in_pieces_is_the_whole_walk(hubo):
+    from zmpwalk.patterns.polynomial import generate_chunks
+
+    commands = [StepCommand(0.8, 0.1, turn=0.05)] * 12
+    whole = generate_hyperbolic(hubo, commands, rate=200.0)
+    pieces = list(generate_chunks(hubo, commands, rate=200.0, chunk_stages=5, pelvis="hyperbolic"))
+    assert whole.generator == "hyperbolic" and all(piece.generator == "hyperbolic" for piece in pieces)
+    joined = np.concatenate([piece.position_pelvis_in_world for piece in pieces])
+    np.testing.assert_array_equal(joined, whole.position_pelvis_in_world)

@@ -807,8 +807,7 @@ def generate(
     """
     check_rate(rate)
     stages, _ = plan_walk(robot, commands, schedule, labels, pelvis)
-    pattern = _sampled(stages, robot, rate, sample_times(stages[-1].start, rate))
-    return replace(pattern, generator="hyperbolic") if pelvis == "hyperbolic" else pattern
+    return _sampled(stages, robot, rate, sample_times(stages[-1].start, rate), generator_name(pelvis))
 
 
 def generate_chunks(
@@ -834,10 +833,16 @@ def generate_chunks(
     if isinstance(chunk_stages, bool) or not isinstance(chunk_stages, int) or chunk_stages < 1:
         raise InvalidParameterError("chunk_stages", chunk_stages, "an integer >= 1")
     stages, _ = plan_walk(robot, commands, schedule, labels, pelvis)
-    return _chunks(stages, robot, rate, chunk_stages)
+    return _chunks(stages, robot, rate, chunk_stages, generator_name(pelvis))
 
 
-def _chunks(stages: list[Stage], robot: RobotModel, rate: float, chunk_stages: int) -> Iterator[WalkingPattern]:
+def generator_name(pelvis: str) -> str:
+    """The name a pattern of these pelvis curves carries: ``"hyperbolic"`` for the pendulum's, else ``"polynomial"``."""
+    return "hyperbolic" if pelvis == "hyperbolic" else "polynomial"
+
+
+def _chunks(stages: list[Stage], robot: RobotModel, rate: float, chunk_stages: int, generator: str
+            ) -> Iterator[WalkingPattern]:
     end = stages[-1].start  # the first sample of standing still closes the walk
     for first in range(0, len(stages), chunk_stages):
         chunk = stages[first:first + chunk_stages]
@@ -847,7 +852,7 @@ def _chunks(stages: list[Stage], robot: RobotModel, rate: float, chunk_stages: i
         # the last piece ends where sample_times ends the whole walk
         stop_index = math.ceil(end * rate - 1e-9) + 1 if last else first_sample_at(stop_time, rate)
         if stop_index > begin_index:
-            yield _sampled(chunk, robot, rate, np.arange(begin_index, stop_index) / rate)
+            yield _sampled(chunk, robot, rate, np.arange(begin_index, stop_index) / rate, generator)
 
 
 def first_sample_at(time: float, rate: float) -> int:
@@ -861,8 +866,9 @@ def first_sample_at(time: float, rate: float) -> int:
     return index
 
 
-def _sampled(stages: list[Stage], robot: RobotModel, rate: float, times: Array) -> WalkingPattern:
-    return pattern_from_samples(evaluate(StageTable(stages), times, robot), stages, robot, rate, "polynomial")
+def _sampled(stages: list[Stage], robot: RobotModel, rate: float, times: Array,
+             generator: str = "polynomial") -> WalkingPattern:
+    return pattern_from_samples(evaluate(StageTable(stages), times, robot), stages, robot, rate, generator)
 
 
 def pattern_from_samples(
