@@ -234,8 +234,7 @@ class Stabilizer:
         self._landing = [[0.0, 0.0], [0.0, 0.0]]  # landing corrections of the feet in world [m]
         self._anchor = 0
         self._floor_normal = [0.0, 0.0, 1.0]  # filtered, in world (gravity up)
-        self._sole_normals = [[0.0, 0.0], [0.0, 0.0]]  # horizontal parts of each sole's normal in world, last tick
-        self._started_odometry = False
+        self._sole_normals = [(0.0, 0.0), (0.0, 0.0)]  # horizontal parts of each sole's normal in world, last tick
         self.state = BalanceState(np.zeros(2), np.full(2, np.nan), np.zeros(2), np.zeros(2), np.zeros((2, 2)),
                                   0.0, np.zeros(2))
 
@@ -300,7 +299,9 @@ class Stabilizer:
         com_in_base = [(self._rest_moment[i] + float(moment[i])) / self._mass for i in range(3)]
         relative = (tuple(ankles[0].tolist()), tuple(ankles[2].tolist()))
         planned_relative = (ankles[1].tolist(), ankles[3].tolist())
+        sole_normals = [_rotate3(rot, rotations[2 * foot, 6, :, 2].tolist())[:2] for foot in range(2)]  # in world
         if not self._started:
+            self._sole_normals = sole_normals
             self._previous_relative = relative
             self._feet = [[float(ankles_in_world[0][0]), float(ankles_in_world[0][1])],
                           [float(ankles_in_world[1][0]), float(ankles_in_world[1][1])]]
@@ -312,15 +313,12 @@ class Stabilizer:
         anchor = self._anchor
         # A loaded sole that tilts rolls on an edge below its ankle (a heel-first landing rolling flat): the
         # ankle moves by the ankle height times the change of the sole normal's horizontal part.
-        h = self.robot.ankle_height
-        for foot in range(2):
-            normal_in_world = _rotate3(rot, rotations[2 * foot, 6, :, 2].tolist())
-            last = self._sole_normals[foot]
-            if foot == anchor and self._started_odometry and (loaded0 if foot == 0 else loaded1):
-                self._feet[foot][0] += h * (normal_in_world[0] - last[0])
-                self._feet[foot][1] += h * (normal_in_world[1] - last[1])
-            last[0], last[1] = normal_in_world[0], normal_in_world[1]
-        self._started_odometry = True
+        if loaded0 if anchor == 0 else loaded1:
+            now, last = sole_normals[anchor], self._sole_normals[anchor]
+            h = self.robot.ankle_height
+            self._feet[anchor][0] += h * (now[0] - last[0])
+            self._feet[anchor][1] += h * (now[1] - last[1])
+        self._sole_normals = sole_normals
         if loaded0 and loaded1:
             d = _rotate3(rot, _sub3(relative[1 - anchor], relative[anchor]))
             self._feet[1 - anchor] = [self._feet[anchor][0] + d[0], self._feet[anchor][1] + d[1]]
