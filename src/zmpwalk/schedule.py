@@ -152,7 +152,8 @@ def _interpolate_rows(block: np.ndarray, key_index: int, key: float) -> tuple[np
     return out, source
 
 
-TURN_COLUMNS = ["duration", "turn", "sway", "up_ratio", "alpha1", "beta1", "d1_open", "d1_recovery"]  # [turn] [rad]
+# the [turn] table's columns: Table 3's, keyed by the turn of one step [rad]
+TURN_COLUMNS = ["duration", "turn", "sway", "up_ratio", "alpha1", "beta1", "d1_open", "d1_recovery"]
 
 
 class Schedule:
@@ -170,16 +171,16 @@ class Schedule:
             self._forward = _Grid(forward["rows"], forward["columns"], "stride", source)
             self._side = _Grid(side["rows"], side["columns"], "side", source)
             turn = data.get("turn")
-            self._turn = None
-            if turn is not None:
-                if list(turn["columns"]) != TURN_COLUMNS:
-                    raise FileFormatError(source, f"[turn] columns must be {TURN_COLUMNS}, not {turn['columns']}")
-                self._turn = _Grid(turn["rows"], turn["columns"], "turn", source)
+            turn_columns = None if turn is None else list(turn["columns"])
+            self._turn = None if turn is None or turn_columns != TURN_COLUMNS else \
+                _Grid(turn["rows"], turn["columns"], "turn", source)
             self._forward_d1 = float(forward["d1"])
             self._forward_alpha1 = float(forward["alpha1"])
             self._forward_beta1 = float(forward["beta1"])
         except (KeyError, TypeError, ValueError) as error:
             raise FileFormatError(source, f"malformed schedule: {error}") from None
+        if turn_columns is not None and turn_columns != TURN_COLUMNS:
+            raise FileFormatError(source, f"[turn] columns must be {TURN_COLUMNS}, not {turn_columns}")
         self._cache: dict[tuple[object, ...], tuple[ShapeParameters, ShapeParameters]] = {}
 
     def conditions(self) -> list[tuple[str, float, float]]:
