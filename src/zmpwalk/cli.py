@@ -168,7 +168,8 @@ def _parser() -> argparse.ArgumentParser:
     plan.add_argument("--allow-outside", action="store_true",
                       help="exit 0 even when the ZMP leaves the support polygon (default: exit 3)")
     plan.add_argument("--generator", choices=GENERATORS, default="polynomial",
-                      help="polynomial (HUBO, Park et al. 2008; default) or hyperbolic (LIPM, Lim et al.)")
+                      help="polynomial (HUBO, Park et al. 2008; default), hyperbolic (LIPM, Lim et al., stage by "
+                           "stage) or preview (preview control, Kajita et al. 2003: the baseline)")
     plan.add_argument("--out", type=Path, help="CSV file to write")
     plan.add_argument("--joints", action="store_true", help="append the 12 leg joint angles [rad] to the CSV")
     plan.add_argument("--json", action="store_true", help="print a JSON summary")
