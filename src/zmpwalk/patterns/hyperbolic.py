@@ -219,25 +219,53 @@ def solve_step(a: float, stride: float, step_time: float, dsp_time: float, y_zmp
                       step.t2, step.t3, step.t4, step.t5, step.y_zmp, step.y0, step.v_y)
 
 
+# A piece of an axis: (duration [s], slot): slot 0 or 1 is the unknown ZMP it holds, COAST none.
+COAST = -1
+Piece = tuple[float, int]
+
+
+def propagate(a: float, position: float, velocity: float, duration: float, zmp: float | None
+              ) -> tuple[float, float]:
+    """State after ``duration`` [s] of one piece: constant ``zmp`` (Eq. 5) or coasting (None)."""
+    if zmp is None:
+        return position + velocity * duration, velocity
+    c, s = math.cosh(a * duration), math.sinh(a * duration)
+    return (position - zmp) * c + velocity / a * s + zmp, (position - zmp) * a * s + velocity * c  # Eq. 5
+
+
+def run_pieces(a: float, position: float, velocity: float, pieces: list[Piece], zmps: tuple[float, float]
+               ) -> tuple[float, float]:
+    """The state after ``pieces``, each holding ZMP ``zmps[slot]`` or coasting."""
+    for duration, slot in pieces:
+        position, velocity = propagate(a, position, velocity, duration, None if slot == COAST else zmps[slot])
+    return position, velocity
+
+
+def solve_zmps(a: float, position: float, velocity: float, pieces: list[Piece], target: tuple[float, float]
+               ) -> tuple[float, float]:
+    """The two ZMPs (slots 0 and 1) that take ``(position, velocity)`` to ``target`` through ``pieces``.
+
+    The end state is affine in the ZMPs (Eq. 5 is affine in ``c``), so three runs give the map and
+    one 2x2 solve the ZMPs.
+
+    Raises:
+        InfeasiblePatternError: The pieces cannot reach every end state (a slot acts too briefly).
+    """
+    base = np.array(run_pieces(a, position, velocity, pieces, (0.0, 0.0)))
+    matrix = np.column_stack([np.array(run_pieces(a, position, velocity, pieces, (1.0, 0.0))) - base,
+                              np.array(run_pieces(a, position, velocity, pieces, (0.0, 1.0))) - base])
+    if abs(np.linalg.det(matrix)) < 1e-12:
+        raise InfeasiblePatternError(
+            "the hyperbolic pattern cannot reach its end state: the single support is too short for two ZMPs")
+    first, second = np.linalg.solve(matrix, np.array(target) - base)
+    return float(first), float(second)
+
+
 def single_support_zmps(a: float, x: float, v: float, step: SteadyStep, x_end: float, v_end: float
                         ) -> tuple[float, float]:
-    """ZMPs of intervals I and III that take the body from ``(x, v)`` to ``(x_end, v_end)`` in ``t5``.
-
-    The end state is affine in the two ZMPs (Eq. 5 twice with the coasting interval II in
-    between), so three evaluations give the map and one 2x2 solve the ZMPs.
-    """
-
-    def end_state(zmp1: float, zmp2: float) -> np.ndarray:
-        c1, s1 = math.cosh(a * step.t1), math.sinh(a * step.t1)
-        x1, v1 = (x - zmp1) * c1 + v / a * s1 + zmp1, (x - zmp1) * a * s1 + v * c1
-        x2 = x1 + v1 * step.t2
-        c3, s3 = math.cosh(a * step.t3), math.sinh(a * step.t3)
-        return np.array([(x2 - zmp2) * c3 + v1 / a * s3 + zmp2, (x2 - zmp2) * a * s3 + v1 * c3])
-
-    base = end_state(0.0, 0.0)
-    matrix = np.column_stack([end_state(1.0, 0.0) - base, end_state(0.0, 1.0) - base])
-    zmp1, zmp2 = np.linalg.solve(matrix, np.array([x_end, v_end]) - base)
-    return float(zmp1), float(zmp2)
+    """ZMPs of intervals I and III that take the body from ``(x, v)`` to ``(x_end, v_end)`` in ``t5``
+    (interval II coasts: the ZMP under the body)."""
+    return solve_zmps(a, x, v, [(step.t1, 0), (step.t2, COAST), (step.t3, 1)], (x_end, v_end))
 
 
 # ---------------------------------------------------------------------------------------- transient
@@ -329,8 +357,7 @@ class _Axis:
     def hold_zmp(self, duration: float, zmp: float) -> None:
         """Constant ZMP for ``duration`` (Eqs. 5, 8-10, 12-13)."""
         self.pieces.append(_Piece(self.t, duration, True, self.x, self.v, zmp))
-        c, s = math.cosh(self.a * duration), math.sinh(self.a * duration)
-        self.x, self.v = (self.x - zmp) * c + self.v / self.a * s + zmp, (self.x - zmp) * self.a * s + self.v * c
+        self.x, self.v = propagate(self.a, self.x, self.v, duration, zmp)
         self.t += duration
 
     def cubic_to(self, duration: float, x1: float, v1: float) -> None:

@@ -50,7 +50,7 @@ swing's steady state has (Eq. 15 solves the paper's version of this with two ZMP
 state). The closing swing holds one ZMP per axis over its single support that ends with ``xi`` on
 the middle of the ankles: the state from which the pendulum can come to rest there; the *settle*
 stage (both feet down) holds two ZMPs, one per half, that bring it to rest exactly (the full state,
-solved as a 2x2 system: :func:`solve_zmps`).
+solved as a 2x2 system: :func:`~zmpwalk.patterns.hyperbolic.solve_zmps`).
 
 **Feasibility.** The ZMP is the pattern's own input here, so it is checked, not assumed: at every
 piece boundary (the ZMP is constant or moves with the body on a straight line between them, so the
@@ -70,7 +70,7 @@ from numpy.typing import NDArray
 
 from zmpwalk.errors import InfeasiblePatternError, InvalidParameterError
 from zmpwalk.footsteps import Pose2D, StagePlan, foot_corners
-from zmpwalk.patterns.hyperbolic import solve_step
+from zmpwalk.patterns.hyperbolic import COAST, Piece, propagate, run_pieces, solve_step, solve_zmps
 from zmpwalk.patterns.result import PHASE_TIME_TOL
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.zmp import convex_hull, point_margin
@@ -80,11 +80,6 @@ Array = NDArray[np.float64]
 PIECES = 5  # pieces per axis of a stage (unused trailing pieces last 0 s)
 GROUNDED_KINDS = ("start", "settle")  # stages with both feet down
 ZMP_TOLERANCE = 1e-9  # [m] how far outside its polygon a ZMP may be from rounding alone
-
-# A piece of an axis: (duration [s], slot): slot 0 or 1 is the unknown ZMP it holds, COAST none.
-COAST = -1
-Piece = tuple[float, int]
-
 
 @dataclass(frozen=True)
 class LipmAxis:
@@ -120,42 +115,6 @@ class LipmPelvis:
     zmp_margin: float  # [m]
 
 
-def propagate(a: float, position: float, velocity: float, duration: float, zmp: float | None
-              ) -> tuple[float, float]:
-    """State after ``duration`` [s] of one piece: constant ``zmp`` (Eq. 5) or coasting (None)."""
-    if zmp is None:
-        return position + velocity * duration, velocity
-    c, s = math.cosh(a * duration), math.sinh(a * duration)
-    return (position - zmp) * c + velocity / a * s + zmp, (position - zmp) * a * s + velocity * c  # Eq. 5
-
-
-def _run(a: float, position: float, velocity: float, pieces: list[Piece], zmps: tuple[float, float]
-         ) -> tuple[float, float]:
-    for duration, slot in pieces:
-        position, velocity = propagate(a, position, velocity, duration, None if slot == COAST else zmps[slot])
-    return position, velocity
-
-
-def solve_zmps(a: float, position: float, velocity: float, pieces: list[Piece], target: tuple[float, float]
-               ) -> tuple[float, float]:
-    """The two ZMPs (slots 0 and 1) that take ``(position, velocity)`` to ``target`` through ``pieces``.
-
-    The end state is affine in the ZMPs (Eq. 5 is affine in ``c``), so three runs give the map and
-    one 2x2 solve the ZMPs.
-
-    Raises:
-        InfeasiblePatternError: The pieces cannot reach every end state (a slot acts too briefly).
-    """
-    base = np.array(_run(a, position, velocity, pieces, (0.0, 0.0)))
-    matrix = np.column_stack([np.array(_run(a, position, velocity, pieces, (1.0, 0.0))) - base,
-                              np.array(_run(a, position, velocity, pieces, (0.0, 1.0))) - base])
-    if abs(np.linalg.det(matrix)) < 1e-12:
-        raise InfeasiblePatternError(
-            "the hyperbolic pattern cannot reach its end state: the single support is too short for two ZMPs")
-    first, second = np.linalg.solve(matrix, np.array(target) - base)
-    return float(first), float(second)
-
-
 def dcm_zmps(a: float, position: float, velocity: float, pieces: list[Piece], nominal: tuple[float, float],
              dcm: float) -> tuple[float, float]:
     """The ``nominal`` ZMPs (slots 0 and 1), both moved by one amount, that end the pieces with the
@@ -168,7 +127,7 @@ def dcm_zmps(a: float, position: float, velocity: float, pieces: list[Piece], no
     """
 
     def end_dcm(shift: float) -> float:
-        end = _run(a, position, velocity, pieces, (nominal[0] + shift, nominal[1] + shift))
+        end = run_pieces(a, position, velocity, pieces, (nominal[0] + shift, nominal[1] + shift))
         return end[0] + end[1] / a
 
     base = end_dcm(0.0)
