@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import math
+from dataclasses import replace
+
 import pytest
 
-from zmpwalk import StepCommand
+from zmpwalk import StepCommand, generate
+from zmpwalk.robots.model import schedule_scale
 from zmpwalk.schedule import Schedule
 
 TOL = 1e-12
@@ -117,3 +121,34 @@ def test_table_2_may_carry_v_y_and_the_double_support_time(hubo):
     side, recovery = schedule.stage_parameters(StepCommand(0.8, side=0.05), hubo)
     assert (forward.dsp_time, forward.lateral_velocity) == pytest.approx((0.12, 0.14), abs=1e-12)
     assert (side.dsp_time, recovery.dsp_time) == pytest.approx((0.15, 0.15), abs=1e-12)  # the stride-0 row
+
+
+@pytest.mark.parametrize("pendulum_factor, leg_factor", [(1.47, 1.175), (0.9, 0.85), (2.0, 1.0)])
+def test_a_scaled_robot_walks_hubos_pattern_scaled_in_time_by_the_pendulum_and_in_length_by_the_legs(
+        hubo, pendulum_factor, leg_factor):
+    """The derivation of robots.model.schedule_scale: the cart-table model is linear in length, so a robot of
+    pendulum l and leg L walks HUBO's forward pelvis, feet and ZMP times L / L_HUBO at the times sqrt(l / l_HUBO)
+    (any length factor works; only the time is fixed by the pendulum)."""
+    s_t = math.sqrt(pendulum_factor)
+    robot = replace(hubo, pendulum_length=hubo.pendulum_length * pendulum_factor,
+                    thigh_length=hubo.thigh_length * leg_factor, shank_length=hubo.shank_length * leg_factor,
+                    pelvis_height=hubo.pelvis_height * leg_factor, hip_drop=hubo.hip_drop * leg_factor,
+                    ankle_height=hubo.ankle_height * leg_factor, dsp_time=hubo.dsp_time * s_t,
+                    foot_lift=hubo.foot_lift * leg_factor,
+                    schedule_scale=schedule_scale(hubo.pendulum_length * pendulum_factor,
+                                                  (hubo.thigh_length + hubo.shank_length) * leg_factor,
+                                                  hubo.hip_spacing))
+    assert robot.schedule_scale == pytest.approx((s_t, leg_factor, 1.0), abs=1e-12)
+    commands = [StepCommand(0.8, 0.15), StepCommand(0.7, 0.25), StepCommand(0.95, 0.1)]
+    # quintic pelvis curves: the ZMP is continuous, so a sample on a stage boundary (where rounding may put it
+    # in either stage) compares too
+    reference = generate(hubo, commands, rate=100.0, pelvis="quintic")
+    scaled = generate(robot, [StepCommand(c.duration * s_t, c.forward * leg_factor) for c in commands],
+                      rate=100.0 / s_t, pelvis="quintic")  # the same samples in the dimensionless time
+    assert len(scaled.time) == len(reference.time)
+    assert scaled.time == pytest.approx(reference.time * s_t, abs=1e-9)
+    for name in ("position_pelvis_in_world", "position_left_ankle_in_world", "position_right_ankle_in_world"):
+        assert getattr(scaled, name)[:, 0] == pytest.approx(getattr(reference, name)[:, 0] * leg_factor, abs=1e-9)
+    assert scaled.zmp_in_world[:, 0] == pytest.approx(reference.zmp_in_world[:, 0] * leg_factor, abs=1e-9)
+    # sideways: the hip spacing is HUBO's, so the sway and its ZMP are HUBO's at the scaled times
+    assert scaled.zmp_in_world[:, 1] == pytest.approx(reference.zmp_in_world[:, 1], abs=1e-9)

@@ -30,12 +30,13 @@ step up as follows:
 5. Any value given in the :class:`~zmpwalk.commands.StepCommand` replaces the
    scheduled one.
 6. Another robot walks the tables at the dynamically similar condition
-   (:attr:`~zmpwalk.robots.model.RobotModel.schedule_scale`): the cart-table
+   (:func:`~zmpwalk.robots.model.schedule_scale`): the cart-table
    model ``x'' = (g / l)(x - p)`` is the same equation for every ``l`` in the
-   dimensionless time ``t / sqrt(l / g)``, so a step time ``T`` is looked up at
-   ``T / sqrt(l / l_HUBO)``, a stride at ``f / (l / l_HUBO)``, and a side step and
-   the sway ``S_y`` scale with the hip spacing (the lateral distance the sway
-   must cover). HUBO's own factors are 1.
+   dimensionless time ``t / sqrt(l / g)`` and is linear in length, so a step
+   time ``T`` is looked up at ``T / sqrt(l / l_HUBO)``, a stride at
+   ``f / (L / L_HUBO)`` with ``L`` the leg length (the legs sweep HUBO's
+   angles), and a side step and the sway ``S_y`` scale with the hip spacing
+   (the lateral distance the sway must cover). HUBO's own factors are 1.
 """
 
 from __future__ import annotations
@@ -234,7 +235,8 @@ class Schedule:
         self, command: StepCommand, robot: RobotModel
     ) -> tuple[ShapeParameters, ShapeParameters]:
         # The tables' robot (HUBO) walks this robot's step at the dynamically similar condition:
-        # step time / sqrt(l / l_HUBO), stride / (l / l_HUBO), side step and sway with the hip spacing.
+        # step time / sqrt(l / l_HUBO), stride / (L / L_HUBO), side step and sway with the hip spacing
+        # (robots.model.schedule_scale).
         time_scale, stride_scale, lateral_scale = robot.schedule_scale
         duration = command.duration / time_scale
         stride = abs(command.forward) / stride_scale

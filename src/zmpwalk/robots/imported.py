@@ -46,7 +46,7 @@ from numpy.typing import NDArray
 
 from zmpwalk.errors import FileFormatError
 from zmpwalk.leg_chain import LegChain
-from zmpwalk.robots.model import HUBO_HIP_SPACING, HUBO_PENDULUM, RobotModel
+from zmpwalk.robots.model import RobotModel, schedule_scale
 from zmpwalk.zmp import convex_hull
 
 Array = NDArray[np.float64]
@@ -396,11 +396,9 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
             com_offset = new_offset
             break
         com_offset = new_offset
-    # The HUBO tables scaled to this robot (docs/robot-import.md): times with sqrt(l/g), lengths with l
-    # (strides, foot lift) and the hip spacing (sway, V_y).
-    length_scale = pendulum / HUBO_PENDULUM
-    lateral_scale = hip_spacing / HUBO_HIP_SPACING
-    time_scale = math.sqrt(length_scale)
+    # The HUBO tables scaled to this robot (docs/robot-import.md): times with sqrt(l/g), strides and foot lift
+    # with the leg length, sway and V_y with the hip spacing.
+    time_scale, length_scale, lateral_scale = schedule_scale(pendulum, thigh + shank, hip_spacing)
     limits = {f"{'left' if i < 6 else 'right'}_{joint.role}": joint.limits for i, joint in enumerate(leg_joints)}
     fields_: dict[str, Any] = {
         "name": robot_name,

@@ -28,6 +28,7 @@ if TYPE_CHECKING:
 JOINT_NAMES = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll")
 HUBO_PENDULUM = 0.62  # [m] pendulum length the HUBO tables were tuned for (robots/data/hubo.toml)
 HUBO_HIP_SPACING = 0.17  # [m] HUBO's hip spacing (robots/data/hubo.toml)
+HUBO_LEG_LENGTH = 0.60  # [m] HUBO's thigh plus shank (robots/data/hubo.toml)
 LINK_NAMES = ("torso", "thigh", "shank", "foot")
 FOOT_SPEED_FROUDE = 1.6  # [-] default swing-foot speed limit over sqrt(g l)
 FOOT_ACCELERATION_G = 5.0  # [-] default swing-foot acceleration limit over g
@@ -125,8 +126,8 @@ class RobotModel:
             angles; None for the built-in yaw-roll-pitch-pitch-pitch-roll leg of the robot file.
         plant: The model file and what the simulation needs to run it (imported robots), or None.
         schedule_scale: Factors (time, stride, lateral) [-] mapping this robot's steps onto the HUBO
-            tables: times with ``sqrt(l / l_HUBO)``, strides and foot lift with ``l / l_HUBO``, sway with
-            the hip spacing (``zmpwalk.schedule``).
+            tables: times with ``sqrt(l / l_HUBO)``, strides and foot lift with the leg length
+            ``L / L_HUBO`` (thigh plus shank), sway with the hip spacing (``zmpwalk.schedule``).
         foot_speed_limit: Fastest the swinging ankle may move [m/s]; None: :attr:`max_foot_speed`'s
             size-scaled default.
         foot_acceleration_limit: Largest acceleration of the swinging ankle [m/s^2]; None: 5 g.
@@ -236,6 +237,30 @@ _POSITIVE = {"mass", "height", "hip_spacing", "thigh_length", "shank_length", "a
              "dsp_time", "lateral_velocity", "foot_speed_limit", "foot_acceleration_limit"}
 # Sections a later part of zmpwalk reads (bodies, servos); kept as raw tables.
 _EXTRA_SECTIONS = {"limits", "bodies", "servos", "contact"}  # read by their own parsers
+
+
+def schedule_scale(pendulum_length: float, leg_length: float, hip_spacing: float) -> tuple[float, float, float]:
+    r"""Factors (time, stride, lateral) [-] that map a robot's steps onto the HUBO tables.
+
+    The cart-table model ``p = x - (l / g) x''`` (Eqs. 1-2) is linear in length: if HUBO's pelvis
+    ``x_H(t)`` has the ZMP ``p_H(t)``, then ``lambda x_H(t / s_t)`` has the ZMP ``lambda p_H(t / s_t)`` on a
+    robot of pendulum length ``l`` for **any** length factor ``lambda``, provided the time factor is
+
+    .. math:: s_t = \sqrt{l / l_{HUBO}}
+
+    (``x'' / s_t^2`` times ``l / g`` is HUBO's ``l_HUBO / g``). Time is fixed by the pendulum; length is
+    free. zmpwalk takes the leg length ``L`` (thigh plus shank) for strides and foot lift,
+    ``lambda = L / L_HUBO``: the legs then sweep HUBO's angles, so a table row asks of every robot what it
+    asks of HUBO's legs (a top-heavy robot has a long pendulum on short legs: TALOS, ``l / l_HUBO`` = 1.47
+    but ``L / L_HUBO`` = 1.17, would otherwise be asked for 44 cm strides that its legs cannot reach). The
+    sideways sway scales with the hip spacing, the distance it must cover.
+
+    Args:
+        pendulum_length: ``l`` [m].
+        leg_length: ``L`` [m].
+        hip_spacing: [m].
+    """
+    return (math.sqrt(pendulum_length / HUBO_PENDULUM), leg_length / HUBO_LEG_LENGTH, hip_spacing / HUBO_HIP_SPACING)
 
 
 def robot_from_toml(path: Path) -> RobotModel:
@@ -384,8 +409,8 @@ def robot_from_dict(data: dict[str, Any], source: str = "<robot>") -> RobotModel
     values["servos"] = _table(Servos, data.get("servos"), "servos", source)
     values["contact"] = _table(Contact, data.get("contact"), "contact", source)
     if values.pop("scale_schedule", True):
-        length = values["pendulum_length"] / HUBO_PENDULUM
-        values["schedule_scale"] = (math.sqrt(length), length, values["hip_spacing"] / HUBO_HIP_SPACING)
+        values["schedule_scale"] = schedule_scale(values["pendulum_length"], values["thigh_length"]
+                                                  + values["shank_length"], values["hip_spacing"])
     robot = RobotModel(**values)
     if robot.hip_height - robot.ankle_height >= robot.max_leg_reach:
         raise FileFormatError(source, "[posture] pelvis_height leaves the legs straighter than min_knee allows")
