@@ -64,6 +64,15 @@ def test_a_stored_study_resumes_where_it_stopped(tmp_path):
     assert resumed.results[0].trials == 7  # 4 kept, 3 more
 
 
+def test_a_new_study_file_is_shared_by_parallel_workers(tmp_path):
+    """Two worker processes starting on a new SQLite file (each used to make its tables: "table studies already
+    exists"); the rows are those of one process."""
+    rows = [Condition("forward", 0.7, 0.0), Condition("forward", 0.8, 0.0)]  # one pass: both at once
+    stored = tune("hubo", trials=3, seed=5, workers=2, conditions=rows, steps=4, storage=tmp_path / "new.db")
+    inline = tune("hubo", trials=3, seed=5, workers=1, conditions=rows, steps=4)
+    assert [r.values for r in stored.results] == [r.values for r in inline.results]
+
+
 def test_bad_tuning_input_is_one_clear_error(tmp_path, capsys):
     with pytest.raises(ZmpwalkError, match="trials = 0"):
         tune("hubo", trials=0)

@@ -149,6 +149,8 @@ class BalanceMeasurement:
 class BalanceState:
     """What the stabilizer did at the last tick (for plots and logs), in world unless said otherwise.
 
+    :attr:`Stabilizer.state` is one object whose arrays every update overwrites: copy what you keep.
+
     Attributes:
         zmp_desired: ``p_d`` [m], (2,).
         zmp_measured: From both soles' sensors [m], (2,) (nan when no sole is loaded).
@@ -458,9 +460,15 @@ class Stabilizer:
         result = reference_angles.copy()
         result[0:6] += deltas[0, self._scatter[0]]
         result[6:12] += deltas[1, self._scatter[1]]
-        self.state = BalanceState(np.array([pdx, pdy]), np.array([zmx, zmy]), np.array([ex, ey]),
-                                  np.array(offset), np.array(self._ankle), self._height,
-                                  np.array([turn_roll, turn_pitch]), np.array([-slope_x, -slope_y]))
+        state = self.state  # written in place: the control path allocates no state
+        state.zmp_desired[:] = pdx, pdy
+        state.zmp_measured[:] = zmx, zmy
+        state.dcm_error[:] = ex, ey
+        state.com_offset[:] = offset
+        state.ankle_offsets[:] = self._ankle
+        state.height_difference = self._height
+        state.pelvis_turn[:] = turn_roll, turn_pitch
+        state.slope_offset[:] = -slope_x, -slope_y
         return result
 
     def _jacobians(self, rotations: Array, translations: Array, ankles: Array) -> Array:

@@ -372,6 +372,8 @@ def tune(robot: str, trials: int = 40, seed: int = 0, workers: int | None = None
     if timing:
         data = with_timing_columns(data, model)
     url = f"sqlite:///{Path(storage).resolve()}" if storage is not None else None
+    if url is not None:  # the tables made once here: workers starting together on a new file would race to
+        _optuna().storages.RDBStorage(url)  # make them ("table studies already exists")
     workers = workers or os.cpu_count() or 1
     results: dict[int, ConditionResult] = {}
     best = -math.inf

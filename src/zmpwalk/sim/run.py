@@ -490,25 +490,39 @@ class SensorNoise:
                 raise InvalidParameterError(f"noise.{name}", value, "a standard deviation >= 0")
 
 
-def _measurement(row: Array, sensors: _Sensors, floor: Array | None = None) -> BalanceMeasurement:
-    """The stabilizer's inputs from one row of sensor data: the ground's wrench on each foot is the opposite
-    of what the ankle sensor between foot and leg reads (both in the foot frame); the IMU's attitude is
-    relative to gravity (on a tilted floor, ``floor`` is the floor's rotation from level)."""
-    def take(name: str) -> Array:
-        return row[sensors.slices[name]]
+class _MeasurementReader:
+    """The stabilizer's inputs from one row of sensor data (:meth:`read`), with the sensors' columns found once.
 
-    quaternion = take("pelvis_quat")
-    if floor is None or np.allclose(floor, np.eye(3)):
-        rpy = _rpy(quaternion[None])[0]
-    else:
-        level = floor @ _rotation(quaternion[None])[0]
-        rpy = np.array([math.atan2(level[2, 1], level[2, 2]), math.asin(max(-1.0, min(1.0, -level[2, 0]))),
-                        math.atan2(level[1, 0], level[0, 0])])
-    return BalanceMeasurement(
-        wrench_left=-np.concatenate([take("left_force"), take("left_torque")]),
-        wrench_right=-np.concatenate([take("right_force"), take("right_torque")]),
-        attitude=rpy[:2], rate=take("pelvis_gyro").copy(), yaw=float(rpy[2]),
-        joint_angles=np.array([row[sensors.slices[f"{c}_q"]][0] for c in JOINT_COLUMNS]))
+    The ground's wrench on each foot is the opposite of what the ankle sensor between foot and leg reads
+    (both in the foot frame); the IMU's attitude is relative to gravity (on a tilted floor, ``floor`` is the
+    floor's rotation from level).
+    """
+
+    def __init__(self, sensors: _Sensors, floor: Array | None = None) -> None:
+        def columns(*names: str) -> NDArray[np.intp]:
+            return np.concatenate([np.arange(sensors.slices[n].start, sensors.slices[n].stop) for n in names])
+
+        self._left = columns("left_force", "left_torque")
+        self._right = columns("right_force", "right_torque")
+        self._quaternion = sensors.slices["pelvis_quat"]
+        self._gyro = sensors.slices["pelvis_gyro"]
+        self._joints = columns(*(f"{c}_q" for c in JOINT_COLUMNS))
+        self._floor = None if floor is None or np.allclose(floor, np.eye(3)) else floor
+
+    def read(self, row: Array) -> BalanceMeasurement:
+        """The measurement of one row of ``sensordata``."""
+        w, x, y, z = row[self._quaternion].tolist()
+        if self._floor is None:
+            roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+            pitch = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
+            yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+        else:
+            level = self._floor @ _rotation(row[None, self._quaternion])[0]
+            roll, pitch = math.atan2(level[2, 1], level[2, 2]), math.asin(max(-1.0, min(1.0, -level[2, 0])))
+            yaw = math.atan2(level[1, 0], level[0, 0])
+        return BalanceMeasurement(wrench_left=-row[self._left], wrench_right=-row[self._right],
+                                  attitude=np.array([roll, pitch]), rate=row[self._gyro].copy(), yaw=yaw,
+                                  joint_angles=row[self._joints])
 
 
 def _closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabilizer: Stabilizer | None,
@@ -538,7 +552,7 @@ def _closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabi
            "height_difference": np.empty(n), "pelvis_turn": np.empty((n, 2))}
     mujoco.mj_forward(model, data)
     current = data.sensordata.copy()
-    tilt = np.eye(3) if disturbances is None else disturbances.floor_rotation
+    reader = _MeasurementReader(sensors, None if disturbances is None else disturbances.floor_rotation)
     push_body = int(model.site_bodyid[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "pelvis")])
     if stabilizer is not None:
         stabilizer.reset()
@@ -557,7 +571,7 @@ def _closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabi
                 break
             continue
         row = current if k - 1 - delay < 0 else readings[k - 1 - delay]
-        measurement = _measurement(row, sensors, tilt)
+        measurement = reader.read(row)
         if rng is not None and noise is not None:
             measurement.wrench_left += rng.normal(0, [noise.force] * 3 + [noise.torque] * 3)
             measurement.wrench_right += rng.normal(0, [noise.force] * 3 + [noise.torque] * 3)
