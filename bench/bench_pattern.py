@@ -62,7 +62,8 @@ def control_loop(rate: float, seconds: float, joints: bool, use_submit: bool) ->
 
 def _figures(us: np.ndarray) -> str:
     return (f"median {np.median(us):6.2f} us, p99 {np.percentile(us, 99):7.1f} us, p99.9 "
-            f"{np.percentile(us, 99.9):7.1f} us, max {us.max():8.1f} us, over 1 ms: {(us > 1000).sum()} of {len(us)}")
+            f"{np.percentile(us, 99.9):7.1f} us, max {us.max():8.1f} us, over 100 us: {(us > 100).sum()}, "
+            f"over 1 ms: {(us > 1000).sum()} of {len(us)}")
 
 
 def main() -> None:

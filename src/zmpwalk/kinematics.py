@@ -42,6 +42,7 @@ from numpy.typing import NDArray
 from zmpwalk.errors import InvalidParameterError, UnreachableError, ZmpwalkError
 from zmpwalk.leg_chain import LegChain
 from zmpwalk.robots.model import JOINT_NAMES, RobotModel
+from zmpwalk.slices import Parts, run_to_end
 
 if TYPE_CHECKING:
     from zmpwalk.patterns.result import WalkingPattern
@@ -234,6 +235,13 @@ def _leg_ik_yaw_rates(leg: Leg, px: Array, py: Array, pz: Array, yaw: Array,
                       angles: Array, rates: Array | None) -> Array:
     """:func:`leg_ik_yaw_rates` on component arrays (n,), writing the rows of ``angles`` and ``rates`` (6, n);
     returns the reach excess [m] (n,)."""
+    return run_to_end(_leg_ik_yaw_rates_in_parts(leg, px, py, pz, yaw, velocity, knee_forward, angles, rates))
+
+
+def _leg_ik_yaw_rates_in_parts(leg: Leg, px: Array, py: Array, pz: Array, yaw: Array,
+                               velocity: tuple[Array, Array, Array, Array] | None, knee_forward: bool,
+                               angles: Array, rates: Array | None) -> Parts[Array]:
+    """:func:`_leg_ik_yaw_rates` in two parts, the angles and the rates (:mod:`zmpwalk.slices`)."""
     c, s = np.cos(yaw), np.sin(yaw)
     dx, dy, dz = leg.hip[0] - px, leg.hip[1] - py, leg.hip[2] - pz
     rx, ry, rz = c * dx + s * dy, c * dy - s * dx, dz
@@ -265,6 +273,7 @@ def _leg_ik_yaw_rates(leg: Leg, px: Array, py: Array, pz: Array, yaw: Array,
     angles[0], angles[1], angles[2], angles[3], angles[4], angles[5] = q1, q2, q3, q4, q5, q6
     if velocity is None or rates is None:
         return excess
+    yield
     vx, vy, vz, w = velocity
     drx = -(c * vx + s * vy) + w * ry
     dry = -(c * vy - s * vx) - w * rx
@@ -454,6 +463,24 @@ def joint_trajectory(
         UnreachableError: First time an ankle is out of reach, with the largest excess.
         JointLimitError: First joint to leave its range (when ``check_limits``).
     """
+    return run_to_end(joint_trajectory_in_parts(time, position_pelvis_in_world, yaw_pelvis_in_world,
+                                                velocity_pelvis_in_world, yaw_rate_pelvis, feet, robot, knee_forward,
+                                                check_limits))
+
+
+def joint_trajectory_in_parts(
+    time: Array,
+    position_pelvis_in_world: Array,
+    yaw_pelvis_in_world: Array,
+    velocity_pelvis_in_world: Array,
+    yaw_rate_pelvis: Array,
+    feet: tuple[tuple[Array, Array, Array, Array], tuple[Array, Array, Array, Array]],
+    robot: RobotModel,
+    knee_forward: bool = True,
+    check_limits: bool = True,
+) -> Parts[JointTrajectory]:
+    """:func:`joint_trajectory` in parts (:mod:`zmpwalk.slices`): with closed-form legs, each leg's angles and
+    rates, then the joint ranges; an imported robot's legs in one part."""
     n = len(time)
     c, s = np.cos(yaw_pelvis_in_world), np.sin(yaw_pelvis_in_world)
     angles, velocities = np.empty((n, 12)), np.empty((n, 12))
@@ -474,13 +501,14 @@ def joint_trajectory(
             vx = velocity[:, 0] - velocity_pelvis_in_world[:, 0] + yaw_rate_pelvis * ry  # in the rotating frame
             vy = velocity[:, 1] - velocity_pelvis_in_world[:, 1] - yaw_rate_pelvis * rx
             rows = slice(6 * index, 6 * index + 6)
-            excess = _leg_ik_yaw_rates(
+            excess = yield from _leg_ik_yaw_rates_in_parts(
                 Leg.of(robot, side), c * rx + s * ry, c * ry - s * rx, position[:, 2] - position_pelvis_in_world[:, 2],
                 yaw - yaw_pelvis_in_world,
                 (c * vx + s * vy, c * vy - s * vx, velocity[:, 2] - velocity_pelvis_in_world[:, 2],
                  yaw_rate - yaw_rate_pelvis),
                 knee_forward, rows_angles[rows], rows_rates[rows])
             _check_reach(excess, time, "left" if side > 0 else "right", "inverse kinematics")
+            yield
         angles, velocities = rows_angles.T, rows_rates.T
     else:  # an imported robot's legs: angles from _base_under_com, rates from J q' = twist
         for index, (side, (position, _, velocity, yaw_rate)) in enumerate(zip((1, -1), feet, strict=True)):

@@ -31,9 +31,11 @@ Behaviour:
 **Inside a hard real-time loop** use :meth:`OnlineWalker.submit` instead of
 :meth:`~OnlineWalker.command`: it only stores the command (microseconds), and
 the same whole check (the step and its stop, every sample at the control rate)
-runs in slices (the plan, with the hyperbolic generator each stage's pendulum, the reach check, then
-:data:`SLICE_ROWS` samples of the pattern and, in the next tick, of the legs), one slice per tick, while the step
-under way goes on. The command is queued when its check completes, or its
+runs in slices while the step under way goes on: the footsteps, each stage (with the hyperbolic generator
+each stage's pendulum), then blocks of :data:`SLICE_ROWS` samples, each in parts (the pattern's swing ankle,
+pelvis, sway and feet; each leg's angles and rates; the joint ranges or, without joints, the legs' reach),
+each part tens of microseconds (:mod:`zmpwalk.slices`). A tick runs parts until :data:`WORK_BUDGET` has
+passed, so its cost is bounded by the budget plus one part. The command is queued when its check completes, or its
 rejection is kept in :attr:`OnlineWalker.rejection` (no tick ever raises). A
 walk submitted from standstill starts :data:`START_DELAY` later, by which time
 it is checked. Should a step end before the check of the next command is done
@@ -44,7 +46,7 @@ step under way was planned with it.
 
 from __future__ import annotations
 
-from collections.abc import Generator
+import time
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -59,24 +61,24 @@ from zmpwalk.errors import (
     ZmpwalkError,
 )
 from zmpwalk.footsteps import Stance
-from zmpwalk.kinematics import JointLimitError, joint_trajectory
+from zmpwalk.kinematics import JointLimitError, check_leg_reach, joint_trajectory, joint_trajectory_in_parts
 from zmpwalk.patterns.polynomial import (
     Boundary,
     Samples,
     Stage,
     StageTable,
     check_pelvis,
-    check_reach,
     closing_command,
-    evaluate,
+    evaluate_in_parts,
     first_sample_at,
     hyperbolic_stages,
     infeasible_command,
-    plan_next,
+    plan_next_in_parts,
 )
 from zmpwalk.patterns.result import SUPPORT_NAMES, check_rate
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
+from zmpwalk.slices import Parts, run_to_end
 
 Array = NDArray[np.float64]
 
@@ -88,7 +90,7 @@ _ZMP, _SUPPORT = slice(12, 14), 14
 _JOINTS, _JOINT_RATES = slice(15, 27), slice(27, 39)
 _WIDTH = 15
 _WIDTH_WITH_JOINTS = 39
-SLICE_ROWS = 100  # samples per slice of submit()'s check: the pattern in one tick, the legs in the next
+SLICE_ROWS = 200  # samples per block of submit()'s check (each block's pattern and legs in parts of tens of us)
 START_DELAY = 0.2  # [s] a walk submitted from standstill starts this much later (its check is done by then)
 HINT_RATE = 100.0  # [Hz] sampling of the search for the largest stride that fits, in a rejection
 HINT_CONFIRMATIONS = 5  # tries at the control rate, each HINT_SHRINK smaller
@@ -173,16 +175,17 @@ class _Job:
     stance: Stance
     boundary: Boundary
     start: int  # index of the tick at which its step begins
-    planning: Generator[None, None, _Plan | None]
+    planning: Parts[_Plan | None]
     origin: tuple[Stance, Boundary]  # the walker's end of plan when submitted: the job is stale once it changes
 
 
 _UNFINISHED = object()
+WORK_BUDGET = 30e-6  # [s] a tick runs slices of a submitted command's check until this much time has passed
 # the rejections that name the largest stride that fits: the legs, or (hyperbolic) the ZMP leaving the feet
 _TOO_LARGE = (UnreachableError, JointLimitError, InfeasiblePatternError)
 
 
-def _step(planning: Generator[None, None, _Plan | None]) -> object:
+def _step(planning: Parts[_Plan | None]) -> object:
     """One slice of a planning; its result when done, else :data:`_UNFINISHED`."""
     try:
         next(planning)
@@ -191,13 +194,13 @@ def _step(planning: Generator[None, None, _Plan | None]) -> object:
     return _UNFINISHED
 
 
-def _finish(planning: Generator[None, None, _Plan | None]) -> _Plan | None:
-    """Run a planning to its end."""
+def _slices(planning: Parts[_Plan | None]) -> object:
+    """Slices of a planning until :data:`WORK_BUDGET` has passed; its result when done, else
+    :data:`_UNFINISHED`."""
+    deadline = time.perf_counter() + WORK_BUDGET
     while True:
-        try:
-            next(planning)
-        except StopIteration as done:
-            result: _Plan | None = done.value
+        result = _step(planning)
+        if result is not _UNFINISHED or time.perf_counter() >= deadline:
             return result
 
 
@@ -268,7 +271,7 @@ class OnlineWalker:
         if boundary.at_rest:
             boundary = Boundary(max(boundary.time, self.time))
         try:
-            plan = _finish(self._checked(command, stance, boundary, self.rate))
+            plan = run_to_end(self._checked(command, stance, boundary, self.rate))
         except _TOO_LARGE as error:
             raise self._infeasible(command, stance, boundary, error) from None
         self._job = None  # a command given now supersedes one still being checked
@@ -329,7 +332,7 @@ class OnlineWalker:
             if job is None:  # pragma: no cover - submit always sets a job
                 return
         try:
-            plan = _finish(job.planning) if finish else _step(job.planning)
+            plan = run_to_end(job.planning) if finish else _slices(job.planning)
         except ZmpwalkError as error:
             self._job = None
             self._rejection = (job.command, error, job.stance, job.boundary)
@@ -341,7 +344,7 @@ class OnlineWalker:
         self._pending = plan if isinstance(plan, _Plan) else None
 
     def _checked(self, command: StepCommand, stance: Stance, boundary: Boundary, rate: float,
-                 sliced: bool = False) -> Generator[None, None, _Plan | None]:
+                 sliced: bool = False) -> Parts[_Plan | None]:
         """Plan a command and the stop it leads to when no other follows, sampled (and the legs solved) at
         ``rate``, yielding between slices: planned and checked together, so that no accepted command can make
         a later tick fail, and no tick plans. Returns None for a stop while standing."""
@@ -360,12 +363,12 @@ class OnlineWalker:
         """The rejection of a command the legs cannot follow, naming the largest stride that fits: searched
         at :data:`HINT_RATE` at most, then confirmed (or reduced) at the control rate."""
         coarse = min(self.rate, HINT_RATE)
-        error = infeasible_command(command, cause, lambda c: _finish(self._checked(c, stance, boundary, coarse)))
+        error = infeasible_command(command, cause, lambda c: run_to_end(self._checked(c, stance, boundary, coarse)))
         for _ in range(HINT_CONFIRMATIONS):
             if not error.largest or coarse == self.rate:
                 break
             try:
-                _finish(self._checked(replace(command, forward=error.largest.get("forward", 0.0),
+                run_to_end(self._checked(replace(command, forward=error.largest.get("forward", 0.0),
                                               side=error.largest.get("side", 0.0),
                                               turn=error.largest.get("turn", 0.0)), stance, boundary, self.rate))
                 break
@@ -375,12 +378,16 @@ class OnlineWalker:
         return error
 
     def _plan(self, command: StepCommand, stance: Stance, boundary: Boundary, rate: float,
-              sliced: bool) -> Generator[None, None, _Plan | None]:
+              sliced: bool) -> Parts[_Plan | None]:
         """Plan, sample (and solve the legs of) one command from a stance at ``rate`` [Hz], yielding after the
-        plan, after the reach check and after every :data:`SLICE_ROWS` samples; None for a stop while standing."""
+        plan and between the parts of every :data:`SLICE_ROWS` samples; None for a stop while standing.
+
+        The legs' reach is checked at every sample: by their inverse kinematics with ``joints``, else by the
+        hip-to-ankle distance."""
         hyperbolic = self._pelvis == "hyperbolic"
-        stages, next_stance, next_boundary = plan_next(self.robot, self._schedule, stance, boundary, command,
-                                                       reach=False, pelvis="cubic" if hyperbolic else self._pelvis)
+        stages, next_stance, next_boundary = yield from plan_next_in_parts(
+            self.robot, self._schedule, stance, boundary, command, reach=False,
+            pelvis="cubic" if hyperbolic else self._pelvis)
         if not stages:
             return None
         yield
@@ -390,24 +397,29 @@ class OnlineWalker:
                 pendulum.append(stage)
                 yield
             stages, next_boundary = pendulum, pendulum[-1].end
-        check_reach(stages, self.robot)
-        yield
         # the samples of these stages, split from the neighbours' exactly as the batch path splits them
         first_index = first_sample_at(stages[0].start, rate)
         stop_index = first_sample_at(next_boundary.time, rate)
         rows = np.empty((max(stop_index - first_index, 0), self._width))
         table = StageTable(stages)
+        yield
         # in slices for submit(); an imported robot's legs in one pass (its base velocities are differences
         # along the step)
         size = SLICE_ROWS if sliced and self.robot.legs is None else max(len(rows), 1)
         scalars: list[tuple[str, float, float, float]] = []
         for begin in range(0, len(rows), size):
-            end = min(begin + size, len(rows))
-            samples = self._sample(table, np.arange(first_index + begin, first_index + end) / rate, rows[begin:end])
-            scalars += _scalars(rows[begin:end])
-            if self.joints:  # the pattern, then the legs: two slices of about equal cost
-                yield
-                self._fill_joints(rows[begin:end], samples)
+            block = rows[begin:min(begin + size, len(rows))]
+            times = np.arange(first_index + begin, first_index + begin + len(block)) / rate
+            samples = yield from evaluate_in_parts(table, times, self.robot)
+            self._fill_pattern(block, samples)
+            yield
+            scalars += _scalars(block)
+            yield
+            if self.joints:
+                yield from self._fill_joints(block, samples)
+            else:
+                check_leg_reach(samples.time, block[:, _PELVIS], samples.pelvis_yaw, samples.left_position,
+                                samples.right_position, self.robot)
             yield
         standing = None
         if next_boundary.at_rest:  # the row of standing still (one IK) in a slice of its own
@@ -484,9 +496,8 @@ class OnlineWalker:
             if index < plan.first_index + len(plan.rows):
                 return plan
 
-    def _sample(self, table: StageTable, times: Array, rows: Array) -> Samples:
-        """Fill ``rows`` with the pattern at ``times`` [s] (the legs: :meth:`_fill_joints`)."""
-        samples = evaluate(table, times, self.robot)
+    def _fill_pattern(self, rows: Array, samples: Samples) -> None:
+        """Fill ``rows`` with the pattern's samples (the legs: :meth:`_fill_joints`)."""
         rows[:, 0:2] = samples.pelvis_xy
         rows[:, 2] = self.robot.pelvis_height
         rows[:, _PELVIS_YAW] = samples.pelvis_yaw
@@ -496,12 +507,11 @@ class OnlineWalker:
         rows[:, _RIGHT_YAW] = samples.right_yaw
         rows[:, _ZMP] = samples.zmp_xy
         rows[:, _SUPPORT] = samples.support
-        return samples
 
-    def _fill_joints(self, rows: Array, samples: Samples) -> None:
+    def _fill_joints(self, rows: Array, samples: Samples) -> Parts[None]:
         n = len(samples.time)
         pelvis = np.column_stack([samples.pelvis_xy, np.full(n, self.robot.pelvis_height)])
-        trajectory = joint_trajectory(
+        trajectory = yield from joint_trajectory_in_parts(
             samples.time, pelvis, samples.pelvis_yaw, np.column_stack([samples.pelvis_velocity_xy, np.zeros(n)]),
             samples.pelvis_yaw_rate,
             ((samples.left_position, samples.left_yaw, samples.left_velocity, samples.left_yaw_rate),

@@ -63,6 +63,7 @@ from zmpwalk.patterns.result import (
 )
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
+from zmpwalk.slices import Parts, run_to_end
 
 Array = NDArray[np.float64]
 
@@ -366,6 +367,13 @@ def evaluate(table: StageTable, time: Array, robot: RobotModel, index: NDArray[n
     Works on one-dimensional component arrays throughout (numpy broadcasting
     over a trailing axis of 2 or 3 is many times slower than plain vector ops).
     """
+    return run_to_end(evaluate_in_parts(table, time, robot, index))
+
+
+def evaluate_in_parts(table: StageTable, time: Array, robot: RobotModel,
+                      index: NDArray[np.intp] | None = None) -> Parts[Samples]:
+    """:func:`evaluate` in parts of about equal cost (swing ankle, pelvis base, sway, feet, the rest), yielding
+    between them (:mod:`zmpwalk.slices`)."""
     t = np.asarray(time, dtype=float)
     k = table.index_at(t) if index is None else index
     n = len(t)
@@ -395,9 +403,11 @@ def evaluate(table: StageTable, time: Array, robot: RobotModel, index: NDArray[n
     dyaw = table.swing_dyaw[k]
     swing_yaw = table.swing_yaw0[k] + dyaw * b
     swing_yaw_rate = dyaw * b1
+    yield
     # --- pelvis base: Eqs. 12-13 cubic (Hermite form of Eq. 4) plus the side-walking shift of Eqs. 15-16
     quintic = table.quintic[k] if table.quintic.any() else None  # per sample, None: all cubic
     h10, h01, h11, g10, g01, g11, k10, k01, k11 = _mixed(_cubic_basis, _quintic_basis, quintic, tau)
+    yield
     components = []
     for base0, sag, m0, m1, lat in (
         (table.base0_x, table.sag_x, table.m0_x, table.m1_x, table.lat_x),
@@ -416,6 +426,7 @@ def evaluate(table: StageTable, time: Array, robot: RobotModel, index: NDArray[n
             component[0] = component[0] + lat_k * q
             component[1] = component[1] + lat_k * q1
             component[2] = component[2] + lat_k * q2
+    yield
     # --- pelvis sway: Eqs. 18-20 on the modified time t_bar (sigma = 2 t_bar, or 2 t_bar - 1)
     amp = table.amp[k]
     out_time, back_time = table.out_time[k], table.back_time[k]
@@ -443,6 +454,7 @@ def evaluate(table: StageTable, time: Array, robot: RobotModel, index: NDArray[n
     pelvis_vy = vy * inv_T + sway1 * ny
     pelvis_ax = accx * inv_T2 + sway2 * nx
     pelvis_ay = accy * inv_T2 + sway2 * ny
+    yield
     # --- feet to left/right, pelvis yaw as the mean of the feet (Eq. 23)
     left_swings = table.swing_left[k]
     right_swings = ~left_swings
@@ -456,6 +468,7 @@ def evaluate(table: StageTable, time: Array, robot: RobotModel, index: NDArray[n
         np.where(left_swings, ankle, swing_z)])
     left_velocity = np.column_stack([swing_vx * left_swings, swing_vy * left_swings, swing_vz * left_swings])
     right_velocity = np.column_stack([swing_vx * right_swings, swing_vy * right_swings, swing_vz * right_swings])
+    yield
     support_yaw = table.support_yaw[k]
     left_yaw = np.where(left_swings, swing_yaw, support_yaw)
     right_yaw = np.where(left_swings, support_yaw, swing_yaw)
@@ -603,6 +616,14 @@ def plan_next(
         ZmpwalkError: The command is infeasible for this robot (reach, overlap, timing, and for the
             hyperbolic pelvis a ZMP outside the feet).
     """
+    return run_to_end(plan_next_in_parts(robot, schedule, stance, boundary, command, reach, pelvis))
+
+
+def plan_next_in_parts(
+    robot: RobotModel, schedule: Schedule, stance: Stance, boundary: Boundary, command: StepCommand,
+    reach: bool = True, pelvis: str = "cubic",
+) -> Parts[tuple[list[Stage], Stance, Boundary]]:
+    """:func:`plan_next` in parts (:mod:`zmpwalk.slices`): the footsteps, then each stage."""
     check_pelvis(pelvis)
     if boundary.at_rest and command.stop:
         return [], stance, boundary
@@ -613,6 +634,7 @@ def plan_next(
     stages: list[Stage] = []
     start = boundary
     for plan in plans:
+        yield
         stage = build_stage(plan, boundary, pelvis == "quintic")
         stages.append(stage)
         boundary = stage.end
