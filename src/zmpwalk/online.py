@@ -391,12 +391,9 @@ class OnlineWalker:
         if not stages:
             return None
         yield
-        if hyperbolic:  # the pendulum's pelvis, one stage per slice
-            pendulum = []
-            for stage in hyperbolic_stages(stages, boundary, self.robot):
-                pendulum.append(stage)
-                yield
-            stages, next_boundary = pendulum, pendulum[-1].end
+        if hyperbolic:  # the pendulum's pelvis
+            stages = yield from hyperbolic_stages(stages, boundary, self.robot)
+            next_boundary = stages[-1].end
         # the samples of these stages, split from the neighbours' exactly as the batch path splits them
         first_index = first_sample_at(stages[0].start, rate)
         stop_index = first_sample_at(next_boundary.time, rate)

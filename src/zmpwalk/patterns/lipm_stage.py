@@ -73,6 +73,7 @@ from zmpwalk.footsteps import Pose2D, StagePlan, foot_corners
 from zmpwalk.patterns.hyperbolic import COAST, Piece, propagate, run_pieces, solve_step, solve_zmps
 from zmpwalk.patterns.result import PHASE_TIME_TOL
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.slices import Parts, run_to_end
 from zmpwalk.zmp import convex_hull, point_margin
 
 Array = NDArray[np.float64]
@@ -219,6 +220,13 @@ def lipm_pelvis(plan: StagePlan, position: tuple[float, float], velocity: tuple[
     Raises:
         InfeasiblePatternError: No steady step for the stage's timing, or a ZMP outside its polygon.
     """
+    return run_to_end(lipm_pelvis_in_parts(plan, position, velocity, robot, next_plan))
+
+
+def lipm_pelvis_in_parts(plan: StagePlan, position: tuple[float, float], velocity: tuple[float, float],
+                         robot: RobotModel, next_plan: StagePlan | None = None
+                         ) -> Parts[tuple[LipmPelvis, tuple[float, float], tuple[float, float]]]:
+    """:func:`lipm_pelvis` in parts (:mod:`zmpwalk.slices`): the pendulum, then the ZMP check span by span."""
     a = math.sqrt(robot.gravity / robot.pendulum_length)
     yaw = plan.support_pose.yaw
     heading, left = _heading(yaw)
@@ -264,7 +272,8 @@ def lipm_pelvis(plan: StagePlan, position: tuple[float, float], velocity: tuple[
     (along, (u_end, du_end)), (across, (w_end, dw_end)) = axes
     end_position = u_end * heading + w_end * left
     end_velocity = du_end * heading + dw_end * left
-    margin = _zmp_margin(plan, along, across, robot)
+    yield
+    margin = yield from _zmp_margin(plan, along, across, robot)
     pelvis = LipmPelvis(yaw, along, across, margin)
     return pelvis, (float(end_position[0]), float(end_position[1])), (float(end_velocity[0]), float(end_velocity[1]))
 
@@ -295,8 +304,9 @@ def axis_at(a: float, axis_starts: Array, position: Array, velocity: Array, zmp:
     return x, v, acceleration
 
 
-def _zmp_margin(plan: StagePlan, along: LipmAxis, across: LipmAxis, robot: RobotModel) -> float:
-    """Smallest margin of the stage's ZMP in its support polygons [m]; raises where it is outside."""
+def _zmp_margin(plan: StagePlan, along: LipmAxis, across: LipmAxis, robot: RobotModel) -> Parts[float]:
+    """Smallest margin of the stage's ZMP in its support polygons [m]; raises where it is outside (a part per
+    span of constant or linear ZMP)."""
     T, d = plan.duration, plan.parameters.dsp_time
     grounded = plan.kind in GROUNDED_KINDS
     support = foot_corners(plan.support_pose, -plan.swing, robot)
@@ -319,6 +329,7 @@ def _zmp_margin(plan: StagePlan, along: LipmAxis, across: LipmAxis, robot: Robot
             margin = point_margin(x, y, polygon)
             if margin < worst:
                 worst, where = margin, (t, x, y)
+        yield
     if worst < -ZMP_TOLERANCE:
         t, x, y = where
         raise InfeasiblePatternError(

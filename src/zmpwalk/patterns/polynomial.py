@@ -50,7 +50,7 @@ from zmpwalk.commands import MAX_STRIDE, MAX_TURN, StepCommand
 from zmpwalk.errors import InfeasibleCommandError, InvalidParameterError, UnreachableError, ZmpwalkError
 from zmpwalk.footsteps import GROUNDED_STRETCH, LEFT, Pose2D, StagePlan, Stance, grounded_stage, plan_command
 from zmpwalk.kinematics import check_leg_reach
-from zmpwalk.patterns.lipm_stage import PIECES, LipmPelvis, axis_at, lipm_pelvis
+from zmpwalk.patterns.lipm_stage import PIECES, LipmPelvis, axis_at, lipm_pelvis_in_parts
 from zmpwalk.patterns.result import (
     SUPPORT_DOUBLE,
     SUPPORT_LEFT,
@@ -639,7 +639,7 @@ def plan_next_in_parts(
         stages.append(stage)
         boundary = stage.end
     if pelvis == "hyperbolic":
-        stages = list(hyperbolic_stages(stages, start, robot))
+        stages = yield from hyperbolic_stages(stages, start, robot)
         boundary = stages[-1].end
     if reach:
         check_reach(stages, robot)
@@ -648,25 +648,29 @@ def plan_next_in_parts(
     return stages, next_stance, boundary
 
 
-def hyperbolic_stages(stages: list[Stage], boundary: Boundary, robot: RobotModel) -> Iterator[Stage]:
-    """``stages`` (one command's, from ``boundary``) with the hyperbolic pelvis, one at a time (a planner that
-    works in slices takes them one per tick)."""
+def hyperbolic_stages(stages: list[Stage], boundary: Boundary, robot: RobotModel) -> Parts[list[Stage]]:
+    """``stages`` (one command's, from ``boundary``) with the hyperbolic pelvis, in parts (:mod:`zmpwalk.slices`:
+    a planner that works in slices takes a few per tick)."""
+    result = []
     for number, stage in enumerate(stages):
         first_swing = stages[number + 1].plan if stage.plan.kind == "start" else None
-        stage = hyperbolic_stage(stage, boundary, robot, first_swing)
+        stage = yield from hyperbolic_stage(stage, boundary, robot, first_swing)
         boundary = stage.end
-        yield stage
+        result.append(stage)
+    return result
 
 
-def hyperbolic_stage(stage: Stage, boundary: Boundary, robot: RobotModel, next_plan: StagePlan | None) -> Stage:
+def hyperbolic_stage(stage: Stage, boundary: Boundary, robot: RobotModel, next_plan: StagePlan | None
+                     ) -> Parts[Stage]:
     """``stage`` with the hyperbolic pelvis of :func:`~zmpwalk.patterns.lipm_stage.lipm_pelvis` from ``boundary``
-    (``next_plan``: the first swing, for a start stage)."""
+    (``next_plan``: the first swing, for a start stage), in parts."""
     plan = stage.plan
     position = boundary.pelvis_position
     if position is None:  # standing: above the middle of the ankles
         position = _pair(0.5 * (np.array([plan.support_pose.x, plan.support_pose.y])
                                 + [plan.swing_start.x, plan.swing_start.y]))
-    pelvis, end_position, end_velocity = lipm_pelvis(plan, position, boundary.pelvis_velocity, robot, next_plan)
+    pelvis, end_position, end_velocity = yield from lipm_pelvis_in_parts(plan, position, boundary.pelvis_velocity,
+                                                                         robot, next_plan)
     end = Boundary(time=boundary.time + plan.duration, pelvis_velocity=end_velocity, at_rest=plan.stop,
                    pelvis_position=end_position)
     return replace(stage, lipm=pelvis, end=end)
