@@ -501,6 +501,7 @@ def joint_trajectory_in_parts(
             vx = velocity[:, 0] - velocity_pelvis_in_world[:, 0] + yaw_rate_pelvis * ry  # in the rotating frame
             vy = velocity[:, 1] - velocity_pelvis_in_world[:, 1] - yaw_rate_pelvis * rx
             rows = slice(6 * index, 6 * index + 6)
+            yield
             excess = yield from _leg_ik_yaw_rates_in_parts(
                 Leg.of(robot, side), c * rx + s * ry, c * ry - s * rx, position[:, 2] - position_pelvis_in_world[:, 2],
                 yaw - yaw_pelvis_in_world,

@@ -29,19 +29,18 @@ Behaviour:
   is queued, so a :meth:`~OnlineWalker.tick` only reads a row.
 
 **Inside a hard real-time loop** use :meth:`OnlineWalker.submit` instead of
-:meth:`~OnlineWalker.command`: it only stores the command (microseconds), and
-the same whole check (the step and its stop, every sample at the control rate)
-runs in slices while the step under way goes on: the footsteps, each stage (with the hyperbolic generator
-each stage's pendulum), then blocks of :data:`SLICE_ROWS` samples, each in parts (the pattern's swing ankle,
-pelvis, sway and feet; each leg's angles and rates; the joint ranges or, without joints, the legs' reach),
-each part tens of microseconds (:mod:`zmpwalk.slices`). A tick runs parts until :data:`WORK_BUDGET` has
-passed, so its cost is bounded by the budget plus one part. The command is queued when its check completes, or its
-rejection is kept in :attr:`OnlineWalker.rejection` (no tick ever raises). A
-walk submitted from standstill starts :data:`START_DELAY` later, by which time
-it is checked. Should a step end before the check of the next command is done
-(a command submitted in the last ticks of a step), the rest of the check runs in
-that tick. :meth:`OnlineWalker.stop` costs nothing while walking: the stop of the
-step under way was planned with it.
+:meth:`~OnlineWalker.command`: it only stores the command (microseconds), and the same whole check (the
+step and its stop, every sample at the control rate) runs in slices while the step under way goes on: the
+footsteps, each stage (with the hyperbolic generator each stage's pendulum), then blocks of
+:data:`SLICE_ROWS` samples, each in parts (the pattern's swing ankle, pelvis, sway and feet; each leg's
+angles and rates; the joint ranges or, without joints, the legs' reach), each part tens of microseconds
+(:mod:`zmpwalk.slices`). A tick runs parts for :data:`WORK_FRACTION` of the control period (20 us at
+1 kHz), so its cost is bounded by that budget plus one part. The command is queued when its check
+completes, or its rejection is kept in :attr:`OnlineWalker.rejection` (no tick ever raises). A walk
+submitted from standstill starts :data:`START_DELAY` later, by which time it is checked. Should a step end
+before the check of the next command is done (a command submitted in the last ticks of a step), the rest
+of the check runs in that tick. :meth:`OnlineWalker.stop` costs nothing while walking: the stop of the step
+under way was planned with it.
 """
 
 from __future__ import annotations
@@ -91,7 +90,7 @@ _JOINTS, _JOINT_RATES = slice(15, 27), slice(27, 39)
 _WIDTH = 15
 _WIDTH_WITH_JOINTS = 39
 SLICE_ROWS = 200  # samples per block of submit()'s check (each block's pattern and legs in parts of tens of us)
-START_DELAY = 0.2  # [s] a walk submitted from standstill starts this much later (its check is done by then)
+START_DELAY = 0.35  # [s] a walk submitted from standstill starts this much later (its check is done by then)
 HINT_RATE = 100.0  # [Hz] sampling of the search for the largest stride that fits, in a rejection
 HINT_CONFIRMATIONS = 5  # tries at the control rate, each HINT_SHRINK smaller
 HINT_SHRINK = 0.98
@@ -158,13 +157,17 @@ class _Plan:
     first_index: int
     closing: _Plan | None = None  # the automatic stop after this plan, planned and checked with it
     standing: Array | None = None  # the row of standing still after it, where it ends at rest
-    scalars: list[tuple[str, float, float, float]] = field(default_factory=list)  # per row: support, 3 yaws
+    scalars: list[list[float]] = field(default_factory=list)  # per row: support code, 3 yaws
 
 
-def _scalars(rows: Array) -> list[tuple[str, float, float, float]]:
-    """Each row's support name and pelvis, left and right yaws as Python values (a tick reads them as they are)."""
-    columns = rows[:, [_SUPPORT, _PELVIS_YAW, _LEFT_YAW, _RIGHT_YAW]].tolist()
-    return [(SUPPORT_NAMES[int(code)], pelvis, left, right) for code, pelvis, left, right in columns]
+_SUPPORT_OF_CODE = {float(code): name for code, name in enumerate(SUPPORT_NAMES)}
+
+
+def _scalars(rows: Array) -> list[list[float]]:
+    """Each row's support code and pelvis, left and right yaws as Python floats (a tick reads them as they are;
+    :data:`_SUPPORT_OF_CODE` names the support)."""
+    result: list[list[float]] = rows[:, [_SUPPORT, _PELVIS_YAW, _LEFT_YAW, _RIGHT_YAW]].tolist()
+    return result
 
 
 @dataclass
@@ -180,7 +183,7 @@ class _Job:
 
 
 _UNFINISHED = object()
-WORK_BUDGET = 30e-6  # [s] a tick runs slices of a submitted command's check until this much time has passed
+WORK_FRACTION = 0.02  # [-] a tick runs parts of a submitted command's check for this fraction of the control period
 # the rejections that name the largest stride that fits: the legs, or (hyperbolic) the ZMP leaving the feet
 _TOO_LARGE = (UnreachableError, JointLimitError, InfeasiblePatternError)
 
@@ -194,10 +197,9 @@ def _step(planning: Parts[_Plan | None]) -> object:
     return _UNFINISHED
 
 
-def _slices(planning: Parts[_Plan | None]) -> object:
-    """Slices of a planning until :data:`WORK_BUDGET` has passed; its result when done, else
-    :data:`_UNFINISHED`."""
-    deadline = time.perf_counter() + WORK_BUDGET
+def _slices(planning: Parts[_Plan | None], budget: float) -> object:
+    """Parts of a planning until ``budget`` [s] has passed; its result when done, else :data:`_UNFINISHED`."""
+    deadline = time.perf_counter() + budget
     while True:
         result = _step(planning)
         if result is not _UNFINISHED or time.perf_counter() >= deadline:
@@ -332,7 +334,7 @@ class OnlineWalker:
             if job is None:  # pragma: no cover - submit always sets a job
                 return
         try:
-            plan = run_to_end(job.planning) if finish else _slices(job.planning)
+            plan = run_to_end(job.planning) if finish else _slices(job.planning, WORK_FRACTION / self.rate)
         except ZmpwalkError as error:
             self._job = None
             self._rejection = (job.command, error, job.stance, job.boundary)
@@ -403,7 +405,7 @@ class OnlineWalker:
         # in slices for submit(); an imported robot's legs in one pass (its base velocities are differences
         # along the step)
         size = SLICE_ROWS if sliced and self.robot.legs is None else max(len(rows), 1)
-        scalars: list[tuple[str, float, float, float]] = []
+        scalars: list[list[float]] = []
         for begin in range(0, len(rows), size):
             block = rows[begin:min(begin + size, len(rows))]
             times = np.arange(first_index + begin, first_index + begin + len(block)) / rate
@@ -450,15 +452,15 @@ class OnlineWalker:
         self._index = index + 1
         # one copy per tick: the caller's arrays never alias the walker's buffers
         if current is None:
-            row, (support, pelvis_yaw, left_yaw, right_yaw) = self._standing.copy(), self._standing_scalars
+            row, (code, pelvis_yaw, left_yaw, right_yaw) = self._standing.copy(), self._standing_scalars
         else:
             offset = index - current.first_index
-            row, (support, pelvis_yaw, left_yaw, right_yaw) = current.rows[offset].copy(), current.scalars[offset]
+            row, (code, pelvis_yaw, left_yaw, right_yaw) = current.rows[offset].copy(), current.scalars[offset]
         if self._job is not None:
             self._work(finish=False)
         return WalkingSample(
             time=index / self.rate,
-            support=support,
+            support=_SUPPORT_OF_CODE[code],
             position_pelvis_in_world=row[_PELVIS],
             yaw_pelvis_in_world=pelvis_yaw,
             position_left_ankle_in_world=row[_LEFT],

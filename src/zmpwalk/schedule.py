@@ -41,6 +41,8 @@ step up as follows:
 
 from __future__ import annotations
 
+import bisect
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from functools import lru_cache
@@ -87,37 +89,38 @@ class ShapeParameters:
 
 
 class _Grid:
-    """Rows of one table, grouped by step time, for 2-D piecewise-linear lookup."""
+    """Rows of one table, grouped by step time, for 2-D piecewise-linear lookup (plain Python on a few rows: a
+    lookup is tens of microseconds, inside a planner that works in slices)."""
 
     def __init__(self, rows: list[list[float]], columns: list[str], key: str, source: str) -> None:
         data = np.asarray(rows, dtype=float)
         if data.ndim != 2 or data.shape[1] != len(columns):
             raise FileFormatError(source, f"every row needs {len(columns)} values: {', '.join(columns)}")
         self.columns = columns
-        self.durations = np.unique(data[:, 0])
-        self.by_duration: dict[float, np.ndarray] = {}
+        self.durations: list[float] = np.unique(data[:, 0]).tolist()
+        self.by_duration: dict[float, list[list[float]]] = {}
         key_index = columns.index(key)
         for duration in self.durations:
             block = data[data[:, 0] == duration]
-            self.by_duration[float(duration)] = block[np.argsort(block[:, key_index])]
+            self.by_duration[duration] = block[np.argsort(block[:, key_index])].tolist()
         self.key_index = key_index
 
     def lookup(
-        self, duration: float, key: float, prepend: Callable[[float], np.ndarray] | None = None
+        self, duration: float, key: float, prepend: Callable[[float], list[float]] | None = None
     ) -> tuple[dict[str, float], str]:
         """Interpolated row at (duration, key), and how it was obtained."""
         source = "table"
         durations = self.durations
-        exact = np.isclose(durations, duration, rtol=0.0, atol=1e-12)
-        if np.any(exact):
-            pairs = [(float(durations[int(np.argmax(exact))]), 1.0)]
+        exact = [d for d in durations if abs(d - duration) <= EXACT]
+        if exact:
+            pairs = [(exact[0], 1.0)]
         elif duration <= durations[0] or duration >= durations[-1]:
             nearest = durations[0] if duration <= durations[0] else durations[-1]
             source = "extrapolated"
-            pairs = [(float(nearest), 1.0)]
+            pairs = [(nearest, 1.0)]
         else:
-            upper = int(np.searchsorted(durations, duration))
-            t_low, t_high = float(durations[upper - 1]), float(durations[upper])
+            upper = bisect.bisect_left(durations, duration)
+            t_low, t_high = durations[upper - 1], durations[upper]
             weight = (duration - t_low) / (t_high - t_low)
             pairs = [(t_low, 1.0 - weight), (t_high, weight)]
             source = "interpolated"
@@ -125,7 +128,7 @@ class _Grid:
         for tabulated, weight in pairs:
             block = self.by_duration[tabulated]
             if prepend is not None:
-                block = np.vstack([prepend(tabulated)[None, :], block])
+                block = [prepend(tabulated), *block]
             row, row_source = _interpolate_rows(block, self.key_index, key)
             if row_source != "table" and source != "extrapolated":
                 source = row_source
@@ -134,23 +137,44 @@ class _Grid:
         return result, source
 
 
-def _interpolate_rows(block: np.ndarray, key_index: int, key: float) -> tuple[np.ndarray, str]:
-    """Linear interpolation along ``key`` in one step time's rows, column by column.
+EXACT = 1e-12  # [s] or table units: a query this close to a tabulated value is that value
+
+
+def _interpolate_rows(block: list[list[float]], key_index: int, key: float) -> tuple[list[float], str]:
+    """Linear interpolation along ``key`` in one step time's rows (sorted by ``key``), column by column.
 
     NaN cells ('x') are skipped: the column uses its defined rows only.
     """
-    out = np.empty(block.shape[1])
-    keys = block[:, key_index]
+    keys = [row[key_index] for row in block]
     source = "table"
-    if key < keys[0] - 1e-12 or key > keys[-1] + 1e-12:
+    if key < keys[0] - EXACT or key > keys[-1] + EXACT:
         source = "extrapolated"
-    elif not np.any(np.isclose(keys, key, atol=1e-12)):
+    elif not any(abs(k - key) <= EXACT + 1e-5 * abs(key) for k in keys):
         source = "interpolated"
-    for column in range(block.shape[1]):
-        values = block[:, column]
-        defined = ~np.isnan(values)
-        out[column] = float(np.interp(key, keys[defined], values[defined]))
+    out = []
+    for column in range(len(block[0])):
+        defined = [(row[key_index], row[column]) for row in block if not math.isnan(row[column])]
+        out.append(_interp(key, [k for k, _ in defined], [v for _, v in defined]))
     return out, source
+
+
+def _interp(x: float, xp: list[float], fp: list[float]) -> float:
+    """``numpy.interp(x, xp, fp)`` for one ``x`` and increasing ``xp``, operation for operation (the same
+    floating-point result): the end values outside, ``slope (x - xp[j]) + fp[j]`` inside."""
+    if not xp:
+        raise ValueError("array of sample points is empty")
+    if x >= xp[-1]:
+        return fp[-1]
+    if x < xp[0]:
+        return fp[0]
+    j = bisect.bisect_right(xp, x) - 1
+    slope = (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j])
+    value = slope * (x - xp[j]) + fp[j]
+    if math.isnan(value):  # as numpy: try from the other end
+        value = slope * (x - xp[j + 1]) + fp[j + 1]
+        if math.isnan(value) and fp[j] == fp[j + 1]:
+            value = fp[j]
+    return value
 
 
 # the [turn] table's columns: Table 3's, keyed by the turn of one step [rad]
@@ -197,13 +221,11 @@ class Schedule:
                     result.append((mode, float(duration), float(row[grid.key_index])))
         return result
 
-    def on_spot_row(self, duration: float) -> np.ndarray:
+    def on_spot_row(self, duration: float) -> list[float]:
         """Stepping on the spot as a Table 3 (or turn table) row, side step (turn) 0, at a tabulated step time."""
         on_spot, _ = self._forward.lookup(duration, 0.0)
-        return np.array([
-            duration, 0.0, on_spot["sway"], on_spot["up_ratio"], self._forward_alpha1,
-            self._forward_beta1, self._forward_d1, self._forward_d1,
-        ])
+        return [duration, 0.0, on_spot["sway"], on_spot["up_ratio"], self._forward_alpha1,
+                self._forward_beta1, self._forward_d1, self._forward_d1]
 
     @classmethod
     def from_file(cls, path: Path) -> Schedule:

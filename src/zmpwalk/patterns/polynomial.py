@@ -381,6 +381,7 @@ def evaluate_in_parts(table: StageTable, time: Array, robot: RobotModel,
     d = table.dsp[k]
     elapsed = t - table.start[k]
     tau = elapsed / T
+    yield
     # --- swing ankle: Eq. 11 (cycloid) along, Eqs. 14-17 (half cosine) across, Fig. 12 height
     swing_span = T - d
     raw = (elapsed - 0.5 * d) / swing_span
