@@ -390,6 +390,7 @@ def evaluate_in_parts(table: StageTable, time: Array, robot: RobotModel,
     rate = in_swing / swing_span
     b, b1, c, c1 = _blend_and_cycloid(s)
     h, h1, _ = curves.lift_profile(s, table.up_ratio[k])
+    yield
     b1 *= rate
     c1 *= rate
     ax, ay = table.along_x[k], table.along_y[k]
@@ -419,6 +420,7 @@ def evaluate_in_parts(table: StageTable, time: Array, robot: RobotModel,
         slope = g10 * m0k + g01 * sagk + g11 * m1k
         curvature = k10 * m0k + k01 * sagk + k11 * m1k
         components.append([position, slope, curvature, lat])
+        yield
     if np.any(table.lat_profile != SHIFT_NONE):
         q, q1, q2 = _mixed(lambda t, p: side_shift_profile(t, p, False), lambda t, p: side_shift_profile(t, p, True),
                            quintic, tau, table.lat_profile[k])
@@ -476,6 +478,7 @@ def evaluate_in_parts(table: StageTable, time: Array, robot: RobotModel,
     left_rate = swing_yaw_rate * left_swings
     right_rate = swing_yaw_rate * right_swings
     support = np.where(in_swing, np.where(left_swings, SUPPORT_RIGHT, SUPPORT_LEFT), SUPPORT_DOUBLE)
+    yield
     if table.hyperbolic.any():
         pelvis_x, pelvis_y, pelvis_vx, pelvis_vy, pelvis_ax, pelvis_ay = _hyperbolic_pelvis(
             table, k, elapsed, robot, (pelvis_x, pelvis_y, pelvis_vx, pelvis_vy, pelvis_ax, pelvis_ay))
