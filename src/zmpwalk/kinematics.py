@@ -42,7 +42,7 @@ from numpy.typing import NDArray
 from zmpwalk.errors import InvalidParameterError, UnreachableError, ZmpwalkError
 from zmpwalk.leg_chain import LegChain
 from zmpwalk.robots.model import JOINT_NAMES, RobotModel
-from zmpwalk.slices import Parts, run_to_end
+from zmpwalk.slices import Parts, run_to_end, whole
 
 if TYPE_CHECKING:
     from zmpwalk.patterns.result import WalkingPattern
@@ -436,7 +436,7 @@ class JointTrajectory:
         return {name: self.angles[:, i] for i, name in enumerate(self.names)}
 
 
-def joint_trajectory(
+def joint_trajectory_in_parts(
     time: Array,
     position_pelvis_in_world: Array,
     yaw_pelvis_in_world: Array,
@@ -446,8 +446,10 @@ def joint_trajectory(
     robot: RobotModel,
     knee_forward: bool = True,
     check_limits: bool = True,
-) -> JointTrajectory:
-    """Joint angles (closed-form IK) and velocities (Jacobian) of both legs with an upright pelvis.
+) -> Parts[JointTrajectory]:
+    """Joint angles (closed-form IK) and velocities (Jacobian) of both legs with an upright pelvis, in parts
+    (:mod:`zmpwalk.slices`: with closed-form legs, each leg's angles and rates, then the joint ranges; an
+    imported robot's legs in one part). :func:`joint_trajectory` runs it whole.
 
     Args:
         time: [s], (n,).
@@ -463,24 +465,6 @@ def joint_trajectory(
         UnreachableError: First time an ankle is out of reach, with the largest excess.
         JointLimitError: First joint to leave its range (when ``check_limits``).
     """
-    return run_to_end(joint_trajectory_in_parts(time, position_pelvis_in_world, yaw_pelvis_in_world,
-                                                velocity_pelvis_in_world, yaw_rate_pelvis, feet, robot, knee_forward,
-                                                check_limits))
-
-
-def joint_trajectory_in_parts(
-    time: Array,
-    position_pelvis_in_world: Array,
-    yaw_pelvis_in_world: Array,
-    velocity_pelvis_in_world: Array,
-    yaw_rate_pelvis: Array,
-    feet: tuple[tuple[Array, Array, Array, Array], tuple[Array, Array, Array, Array]],
-    robot: RobotModel,
-    knee_forward: bool = True,
-    check_limits: bool = True,
-) -> Parts[JointTrajectory]:
-    """:func:`joint_trajectory` in parts (:mod:`zmpwalk.slices`): with closed-form legs, each leg's angles and
-    rates, then the joint ranges; an imported robot's legs in one part."""
     n = len(time)
     c, s = np.cos(yaw_pelvis_in_world), np.sin(yaw_pelvis_in_world)
     angles, velocities = np.empty((n, 12)), np.empty((n, 12))
@@ -530,6 +514,9 @@ def joint_trajectory_in_parts(
     if check_limits:
         check_joint_limits(time, angles, robot)
     return JointTrajectory(time, angles, velocities, position_base_in_world=base)
+
+
+joint_trajectory = whole(joint_trajectory_in_parts, "joint_trajectory")  # the same, run whole
 
 
 def _check_reach(excess: Array, time: Array, label: str, detail: str) -> None:
