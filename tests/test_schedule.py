@@ -152,3 +152,19 @@ def test_a_scaled_robot_walks_hubos_pattern_scaled_in_time_by_the_pendulum_and_i
     assert scaled.zmp_in_world[:, 0] == pytest.approx(reference.zmp_in_world[:, 0] * leg_factor, abs=1e-9)
     # sideways: the hip spacing is HUBO's, so the sway and its ZMP are HUBO's at the scaled times
     assert scaled.zmp_in_world[:, 1] == pytest.approx(reference.zmp_in_world[:, 1], abs=1e-9)
+
+
+def test_the_lookups_interpolation_is_numpys_to_the_last_bit():
+    """zmpwalk.schedule._interp (plain Python, for lookups of a few rows) against numpy.interp: the same floats,
+    at the nodes, between them and outside, on seeded random tables of 1 to 6 rows."""
+    import numpy as np
+
+    from zmpwalk.schedule import _interp
+
+    rng = np.random.default_rng(7)
+    for _ in range(2000):
+        n = int(rng.integers(1, 7))
+        xp = np.sort(rng.choice(np.linspace(0.0, 0.4, 41), size=n, replace=False))
+        fp = rng.uniform(-2.0, 2.0, n)
+        for x in [*xp, *rng.uniform(-0.1, 0.5, 5)]:
+            assert _interp(float(x), xp.tolist(), fp.tolist()) == float(np.interp(x, xp, fp))  # exactly
