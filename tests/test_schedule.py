@@ -168,3 +168,22 @@ def test_the_lookups_interpolation_is_numpys_to_the_last_bit():
         fp = rng.uniform(-2.0, 2.0, n)
         for x in [*xp, *rng.uniform(-0.1, 0.5, 5)]:
             assert _interp(float(x), xp.tolist(), fp.tolist()) == float(np.interp(x, xp, fp))  # exactly
+
+
+def test_a_table_without_alpha_serves_stride_zero_and_names_the_missing_alpha_otherwise(hubo):
+    """A user's Table 2 with only stride-0 rows ('x' for alpha): stepping on the spot plans (alpha has no effect
+    there, Eq. 13); a stride is one clear error naming alpha (it was numpy's 'array of sample points is empty')."""
+    from zmpwalk.errors import FileFormatError
+
+    data = {"forward": {"d1": 0.2, "alpha1": 1.0, "beta1": 1.0,
+                        "columns": ["duration", "stride", "sway", "alpha", "up_ratio"],
+                        "rows": [[0.8, 0.0, 0.035, math.nan, 0.47]]},
+            "side": {"columns": ["duration", "side", "sway", "up_ratio", "alpha1", "beta1", "d1_open", "d1_recovery"],
+                     "rows": [[0.8, 0.05, 0.035, 0.47, 0.8, 0.8, 0.22, 0.18]]}}
+    schedule = Schedule(data, "mine.toml")
+    on_the_spot, _ = schedule.stage_parameters(StepCommand(0.8), hubo)
+    assert on_the_spot.sway == pytest.approx(0.035, abs=TOL)
+    with pytest.raises(FileFormatError, match=r"mine\.toml.*alpha.*0\.8 s"):
+        schedule.stage_parameters(StepCommand(0.8, 0.1), hubo)
+    given, _ = schedule.stage_parameters(StepCommand(0.8, 0.1, alpha=1.5), hubo)  # the command's own alpha
+    assert given.alpha == pytest.approx(1.5, abs=TOL)

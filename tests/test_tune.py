@@ -134,3 +134,28 @@ def test_timing_tunes_v_y_and_the_double_support_time_within_their_ranges(tmp_pa
     parameters, _ = Schedule.from_file(path).stage_parameters(StepCommand(0.8), load_robot("hubo"))
     assert (parameters.dsp_time, parameters.lateral_velocity) == pytest.approx(
         (values["dsp_time"], values["lateral_velocity"]), rel=1e-5)
+
+
+def test_the_cli_reports_each_tuned_condition_on_a_log(tmp_path, capsys):
+    """Written to a file (not a terminal), the progress is one line per condition, not a redrawn bar."""
+    schedule = tmp_path / "small.toml"
+    schedule.write_text('''[forward]
+d1 = 0.2
+alpha1 = 1
+beta1 = 1
+columns = ["duration", "stride", "sway", "alpha", "up_ratio"]
+rows = [[0.8, 0.0, 0.035, nan, 0.47]]
+
+[side]
+columns = ["duration", "side", "sway", "up_ratio", "alpha1", "beta1", "d1_open", "d1_recovery"]
+rows = [[0.8, 0.05, 0.035, 0.47, 0.8, 0.8, 0.22, 0.18]]
+
+[turn]
+columns = ["duration", "turn", "sway", "up_ratio", "alpha1", "beta1", "d1_open", "d1_recovery"]
+rows = [[0.8, 0.13, 0.035, 0.47, 1.0, 1.0, 0.2, 0.2]]
+''', encoding="utf-8")
+    main(["tune", "--robot", "hubo", "--schedule", str(schedule), "--out", str(tmp_path / "t.toml"),
+          "--trials", "1", "--steps", "2", "--workers", "1"])
+    err = capsys.readouterr().err
+    assert [line for line in err.splitlines() if "conditions tuned" in line][-1].startswith("3/3 conditions tuned")
+    assert "\r" not in err

@@ -519,8 +519,11 @@ def _tune(args: argparse.Namespace) -> int:
     if args.workers is not None and args.workers < 1:
         raise _UsageError(f"--workers = {args.workers} must be >= 1")
     data = read_toml(args.schedule) if args.schedule else None
-    show = None if args.json or not sys.stderr.isatty() else (
-        lambda done, total, best: _progress(f"conditions (best {best * 1e3:+.1f} mm)", done, total))
+    show = None if args.json else (
+        (lambda done, total, best: _progress(f"conditions (best {best * 1e3:+.1f} mm)", done, total))
+        if sys.stderr.isatty() else  # a log file: one line per condition (a tune runs for minutes)
+        (lambda done, total, best: print(f"{done}/{total} conditions tuned, best {best * 1e3:+.1f} mm",
+                                         file=sys.stderr, flush=True)))
     started = time.perf_counter()
     result = tune(args.robot, trials=args.trials, seed=args.seed, workers=args.workers, storage=args.storage,
                   steps=args.steps, data=data, progress=show, scheduler=args.dask, timing=args.timing)

@@ -160,9 +160,10 @@ def _interpolate_rows(block: list[list[float]], key_index: int, key: float) -> t
 
 def _interp(x: float, xp: list[float], fp: list[float]) -> float:
     """``numpy.interp(x, xp, fp)`` for one ``x`` and increasing ``xp``, operation for operation (the same
-    floating-point result): the end values outside, ``slope (x - xp[j]) + fp[j]`` inside."""
+    floating-point result): the end values outside, ``slope (x - xp[j]) + fp[j]`` inside; NaN where the
+    column has no value at all."""
     if not xp:
-        raise ValueError("array of sample points is empty")
+        return math.nan
     if x >= xp[-1]:
         return fp[-1]
     if x < xp[0]:
@@ -190,6 +191,7 @@ class Schedule:
     """
 
     def __init__(self, data: dict[str, Any], source: str = "<schedule>") -> None:
+        self._source = source
         try:
             forward = data["forward"]
             side = data["side"]
@@ -264,6 +266,11 @@ class Schedule:
         stride = abs(command.forward) / stride_scale
         row, source = self._forward.lookup(duration, stride)
         alpha = row["alpha"]
+        if math.isnan(alpha):  # no row near this step time gives alpha: only stride-0 rows ('x'), where it is moot
+            if stride > 0.0 and command.alpha is None:
+                raise FileFormatError(self._source, f"Table 2 gives no alpha near step time {duration:g} s (only "
+                                      f"stride-0 rows, 'x'); a stride of {command.forward:g} m needs a row with one")
+            alpha = 1.0  # Eq. 13: v1 = alpha f / T is 0 at stride 0 whatever alpha
         sway = row["sway"] * lateral_scale
         up_ratio = row["up_ratio"]
         open_alpha1 = recovery_alpha1 = self._forward_alpha1
