@@ -172,7 +172,7 @@ def _scalars(rows: Array) -> list[list[float]]:
 
 @dataclass
 class _Job:
-    """A submitted command under check: where it starts and its planning, one slice per tick."""
+    """A submitted command under check: where it starts and its planning, in parts run a few per tick."""
 
     command: StepCommand
     stance: Stance
@@ -282,7 +282,7 @@ class OnlineWalker:
     def submit(self, command: StepCommand) -> None:
         """Queue ``command`` like :meth:`command`, without planning in the caller's tick.
 
-        Only the command's type is checked here; its whole check runs one slice per :meth:`tick`
+        Only the command's type is checked here; its whole check runs in parts, a few per :meth:`tick`
         (module docstring). When it completes the command is :attr:`queued`; when it fails the
         error is in :attr:`rejection` and the walker goes on as if the command had not been given.
         A later :meth:`submit` or :meth:`command` replaces one still being checked.
