@@ -16,6 +16,7 @@ from zmpwalk.errors import InvalidParameterError
 from zmpwalk.kinematics import leg_chains, pattern_joint_trajectory, rest_mass
 from zmpwalk.patterns.polynomial import generate
 from zmpwalk.robots import load_robot
+from zmpwalk.robots.model import JOINT_NAMES
 
 TALOS = Path(__file__).resolve().parents[2] / "shared" / "robots" / "pal_talos" / "scene_position.xml"
 
@@ -255,3 +256,20 @@ def test_odometry_follows_a_loaded_sole_rolling_on_its_edge() -> None:
     expected = before + stabilizer.robot.ankle_height * (normals[1] - normals[0])[:2]  # upright torso, heading 0
     assert np.asarray(stabilizer._feet[0]) == pytest.approx(expected, abs=1e-12)
     assert abs(stabilizer._feet[0][0] - before[0]) > 0.5 * stabilizer.robot.ankle_height * 0.02
+
+
+def test_a_torso_turned_from_its_plan_turns_the_swinging_foot_back_to_its_planned_heading() -> None:
+    """Standing on the left foot with the torso measured 0.05 rad left of its plan (a sole slipped in yaw): the
+    right foot turns by -0.05 rad relative to the pelvis, i.e. to its planned heading in world (its hip yaw
+    moves by as much); the loaded foot keeps its joints; without a measured yaw nothing turns."""
+    stabilizer, inputs, _ = standing()
+    inputs = {**inputs, "support": 1}
+    reference = np.asarray(inputs["joint_angles"])
+    angles = run(stabilizer, inputs, 3000, loads=(2.0, 0.0), yaw=0.05)
+    assert stabilizer._landing_yaw[1] == pytest.approx(-0.05, abs=1e-6)  # [rad] 15 landing time constants
+    assert stabilizer._landing_yaw[0] == 0.0
+    right_hip_yaw = 6 + JOINT_NAMES.index("hip_yaw")
+    assert angles[right_hip_yaw] - reference[right_hip_yaw] == pytest.approx(-0.05, abs=2e-3)  # [rad]
+    plain, inputs, _ = standing()
+    run(plain, {**inputs, "support": 1}, 3000, loads=(2.0, 0.0))
+    assert plain._landing_yaw == [0.0, 0.0]

@@ -31,7 +31,8 @@ separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega 
 5. **Torso attitude**: the pelvis is turned against the measured roll and pitch (and their rates).
 6. **Landing and stepping**: the swinging foot aims at its planned place in world from the odometry's
    base, seen through the measured pelvis attitude, moved by :attr:`StabilizerGains.step_gain` times the
-   DCM error, towards where the body falls (the capture point of Pratt et al. 2006); the correction is
+   DCM error, towards where the body falls (the capture point of Pratt et al. 2006), and turns by the
+   torso's measured yaw error so that it lands at its planned heading in world; the corrections are
    released once the foot carries load.
 7. **Floor slope**: in double support both soles lie on the floor, so their attitude (IMU and measured leg
    kinematics) is the floor's; with unit normal ``n`` the CoM must stand ``l (n_x, n_y) / n_z`` uphill of
@@ -92,6 +93,8 @@ class StabilizerGains:
             ahead of its plan the body will come to rest over the ZMP), 0 lands it where planned.
         step_deadband: The part of the DCM error's length that does not move the aim [m] (nominal walking
             stays within it, so only a push makes the foot step aside).
+        landing_yaw_limit: Largest turn of a swinging foot towards its planned heading in world [rad] (the
+            torso's measured yaw error, which a sole slipping in yaw leaves; 0 turns it off).
     """
 
     dcm: float = 3.0  # [1/s]
@@ -116,6 +119,7 @@ class StabilizerGains:
     slope_time_constant: float = 0.5  # [s]
     step_gain: float = 1.0  # [-]
     step_deadband: float = 0.03  # [m]
+    landing_yaw_limit: float = 0.1  # [rad]
 
     def __post_init__(self) -> None:
         for name, value in vars(self).items():
@@ -234,6 +238,7 @@ class Stabilizer:
         self._height = 0.0
         self._feet = [[0.0, 0.0], [0.0, 0.0]]  # estimated ankle positions in world (leg odometry) [m]
         self._landing = [[0.0, 0.0], [0.0, 0.0]]  # landing corrections of the feet in world [m]
+        self._landing_yaw = [0.0, 0.0]  # yaw landing corrections of the feet relative to the pelvis [rad]
         self._anchor = 0
         self._floor_normal = [0.0, 0.0, 1.0]  # filtered, in world (gravity up)
         self._sole_normals = [(0.0, 0.0), (0.0, 0.0)]  # horizontal parts of each sole's normal in world, last tick
@@ -429,9 +434,15 @@ class Stabilizer:
         step_x, step_y = step * ex, step * ey
         landing_rate, release_rate = dt / g.landing_time_constant, dt / g.landing_release
         landing_limit = g.landing_limit
+        # the swinging foot also turns by the torso's measured yaw error, so that it lands at its planned heading
+        # in world (a sole that slipped in yaw leaves the torso turned by as much)
+        yaw_aim = min(max(math.remainder(yaw - heading, math.tau), -g.landing_yaw_limit), g.landing_yaw_limit)
         for foot in range(2):
             land = self._landing[foot]
-            if (support == 1 and foot == 1) or (support == 2 and foot == 0):  # swinging
+            swinging = (support == 1 and foot == 1) or (support == 2 and foot == 0)
+            self._landing_yaw[foot] += (landing_rate * (yaw_aim - self._landing_yaw[foot]) if swinging
+                                        else -release_rate * self._landing_yaw[foot])
+            if swinging:
                 # the foot's planned place seen from the estimated base through the measured attitude, less the
                 # pelvis turn and shift applied to every foot below: what puts it there in world
                 px, py, pz = planned_relative[foot]
@@ -455,7 +466,7 @@ class Stabilizer:
             # minus pelvis_turn x position, pelvis_turn = (roll, pitch, 0)
             changes[leg] = (landing[0] - shift[0] - turn_pitch * pz, landing[1] - shift[1] + turn_roll * pz,
                             (-self._height / 2 if leg == 0 else self._height / 2) - (turn_roll * py - turn_pitch * px),
-                            foot_turn[0] - turn_roll, foot_turn[1] - turn_pitch, 0.0)
+                            foot_turn[0] - turn_roll, foot_turn[1] - turn_pitch, self._landing_yaw[leg])
         deltas = np.linalg.solve(self._jacobians(rotations, translations, ankles), changes[:, :, None])[:, :, 0]
         result = reference_angles.copy()
         result[0:6] += deltas[0, self._scatter[0]]
