@@ -42,7 +42,7 @@ from numpy.typing import NDArray
 from zmpwalk.errors import InvalidParameterError, UnreachableError, ZmpwalkError
 from zmpwalk.leg_chain import LegChain
 from zmpwalk.robots.model import JOINT_NAMES, RobotModel
-from zmpwalk.slices import Parts, run_to_end, whole
+from zmpwalk.slices import Parts, whole
 
 if TYPE_CHECKING:
     from zmpwalk.patterns.result import WalkingPattern
@@ -230,18 +230,12 @@ def leg_ik_yaw_rates(leg: Leg, position_ankle_in_pelvis: Array, yaw_foot_in_pelv
     return LegSolution(angles.T, excess), (None if rates is None else rates.T)
 
 
-def _leg_ik_yaw_rates(leg: Leg, px: Array, py: Array, pz: Array, yaw: Array,
-                      velocity: tuple[Array, Array, Array, Array] | None, knee_forward: bool,
-                      angles: Array, rates: Array | None) -> Array:
-    """:func:`leg_ik_yaw_rates` on component arrays (n,), writing the rows of ``angles`` and ``rates`` (6, n);
-    returns the reach excess [m] (n,)."""
-    return run_to_end(_leg_ik_yaw_rates_in_parts(leg, px, py, pz, yaw, velocity, knee_forward, angles, rates))
-
-
 def _leg_ik_yaw_rates_in_parts(leg: Leg, px: Array, py: Array, pz: Array, yaw: Array,
                                velocity: tuple[Array, Array, Array, Array] | None, knee_forward: bool,
                                angles: Array, rates: Array | None) -> Parts[Array]:
-    """:func:`_leg_ik_yaw_rates` in two parts, the angles and the rates (:mod:`zmpwalk.slices`)."""
+    """:func:`leg_ik_yaw_rates` on component arrays (n,), writing the rows of ``angles`` and ``rates`` (6, n);
+    In two parts, the angles and the rates (:mod:`zmpwalk.slices`); :func:`_leg_ik_yaw_rates` runs it whole.
+    returns the reach excess [m] (n,)."""
     c, s = np.cos(yaw), np.sin(yaw)
     dx, dy, dz = leg.hip[0] - px, leg.hip[1] - py, leg.hip[2] - pz
     rx, ry, rz = c * dx + s * dy, c * dy - s * dx, dz
@@ -291,6 +285,9 @@ def _leg_ik_yaw_rates_in_parts(leg: Leg, px: Array, py: Array, pz: Array, yaw: A
     dq3 = -(dq4 + dq5)
     rates[0], rates[1], rates[2], rates[3], rates[4], rates[5] = dq1, dq2, dq3, dq4, dq5, dq6
     return excess
+
+
+_leg_ik_yaw_rates = whole(_leg_ik_yaw_rates_in_parts, "_leg_ik_yaw_rates")  # the same, run whole
 
 
 def leg_ik_scalar(leg: Leg, ankle: tuple[float, float, float], foot_yaw: float,

@@ -73,7 +73,7 @@ from zmpwalk.footsteps import Pose2D, StagePlan, foot_corners
 from zmpwalk.patterns.hyperbolic import COAST, Piece, propagate, run_pieces, solve_step, solve_zmps
 from zmpwalk.patterns.result import PHASE_TIME_TOL
 from zmpwalk.robots.model import RobotModel
-from zmpwalk.slices import Parts, run_to_end
+from zmpwalk.slices import Parts, whole
 from zmpwalk.zmp import convex_hull, point_margin
 
 Array = NDArray[np.float64]
@@ -204,9 +204,11 @@ def _drift(plan: StagePlan) -> Array:
     return float((after - before) @ left) / plan.duration * left
 
 
-def lipm_pelvis(plan: StagePlan, position: tuple[float, float], velocity: tuple[float, float], robot: RobotModel,
-                next_plan: StagePlan | None = None) -> tuple[LipmPelvis, tuple[float, float], tuple[float, float]]:
+def lipm_pelvis_in_parts(plan: StagePlan, position: tuple[float, float], velocity: tuple[float, float],
+                         robot: RobotModel, next_plan: StagePlan | None = None
+                         ) -> Parts[tuple[LipmPelvis, tuple[float, float], tuple[float, float]]]:
     """The hyperbolic pelvis of one stage from the inherited state (see the module docstring).
+    In parts (the pendulum, then the ZMP check span by span; :mod:`zmpwalk.slices`); :func:`lipm_pelvis` runs it whole.
 
     Args:
         plan: The stage's footsteps and timing.
@@ -220,13 +222,6 @@ def lipm_pelvis(plan: StagePlan, position: tuple[float, float], velocity: tuple[
     Raises:
         InfeasiblePatternError: No steady step for the stage's timing, or a ZMP outside its polygon.
     """
-    return run_to_end(lipm_pelvis_in_parts(plan, position, velocity, robot, next_plan))
-
-
-def lipm_pelvis_in_parts(plan: StagePlan, position: tuple[float, float], velocity: tuple[float, float],
-                         robot: RobotModel, next_plan: StagePlan | None = None
-                         ) -> Parts[tuple[LipmPelvis, tuple[float, float], tuple[float, float]]]:
-    """:func:`lipm_pelvis` in parts (:mod:`zmpwalk.slices`): the pendulum, then the ZMP check span by span."""
     a = math.sqrt(robot.gravity / robot.pendulum_length)
     yaw = plan.support_pose.yaw
     heading, left = _heading(yaw)
@@ -276,6 +271,9 @@ def lipm_pelvis_in_parts(plan: StagePlan, position: tuple[float, float], velocit
     margin = yield from _zmp_margin(plan, along, across, robot)
     pelvis = LipmPelvis(yaw, along, across, margin)
     return pelvis, (float(end_position[0]), float(end_position[1])), (float(end_velocity[0]), float(end_velocity[1]))
+
+
+lipm_pelvis = whole(lipm_pelvis_in_parts, "lipm_pelvis")  # the same, run whole
 
 
 def axis_at(a: float, axis_starts: Array, position: Array, velocity: Array, zmp: Array, elapsed: Array

@@ -63,7 +63,7 @@ from zmpwalk.patterns.result import (
 )
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
-from zmpwalk.slices import Parts, run_to_end
+from zmpwalk.slices import Parts, whole
 
 Array = NDArray[np.float64]
 
@@ -361,19 +361,15 @@ class Samples:
     zmp_xy: Array  # [m], cart-table ZMP of Eqs. 1-2
 
 
-def evaluate(table: StageTable, time: Array, robot: RobotModel, index: NDArray[np.intp] | None = None) -> Samples:
+def evaluate_in_parts(table: StageTable, time: Array, robot: RobotModel,
+                      index: NDArray[np.intp] | None = None) -> Parts[Samples]:
     """Evaluate the stages at ``time`` (each sample in stage ``index``, default: its own stage).
+    In parts of about equal cost (swing ankle, pelvis base, sway, feet, the rest; :mod:`zmpwalk.slices`);
+    :func:`evaluate` runs it whole.
 
     Works on one-dimensional component arrays throughout (numpy broadcasting
     over a trailing axis of 2 or 3 is many times slower than plain vector ops).
     """
-    return run_to_end(evaluate_in_parts(table, time, robot, index))
-
-
-def evaluate_in_parts(table: StageTable, time: Array, robot: RobotModel,
-                      index: NDArray[np.intp] | None = None) -> Parts[Samples]:
-    """:func:`evaluate` in parts of about equal cost (swing ankle, pelvis base, sway, feet, the rest), yielding
-    between them (:mod:`zmpwalk.slices`)."""
     t = np.asarray(time, dtype=float)
     k = table.index_at(t) if index is None else index
     n = len(t)
@@ -495,6 +491,9 @@ def evaluate_in_parts(table: StageTable, time: Array, robot: RobotModel,
     )
 
 
+evaluate = whole(evaluate_in_parts, "evaluate")  # the same, run whole
+
+
 def _hyperbolic_pelvis(table: StageTable, k: NDArray[np.intp], elapsed: Array, robot: RobotModel,
                        curves_xy: tuple[Array, ...]) -> tuple[Array, ...]:
     """Pelvis x, y, their rates and accelerations: the hyperbolic pelvis where a stage has one, else ``curves_xy``."""
@@ -598,11 +597,12 @@ def check_reach(stages: Sequence[Stage], robot: RobotModel) -> None:
             raise
 
 
-def plan_next(
+def plan_next_in_parts(
     robot: RobotModel, schedule: Schedule, stance: Stance, boundary: Boundary, command: StepCommand,
     reach: bool = True, pelvis: str = "cubic",
-) -> tuple[list[Stage], Stance, Boundary]:
+) -> Parts[tuple[list[Stage], Stance, Boundary]]:
     """Stages of one command from a stance and boundary state; nothing is changed on error.
+    In parts (the footsteps, then each stage; :mod:`zmpwalk.slices`); :func:`plan_next` runs it whole.
 
     From standstill a walk begins with a *start* stage: one step time in double
     support in which the pelvis sways towards the first swinging foot and comes
@@ -620,14 +620,6 @@ def plan_next(
         ZmpwalkError: The command is infeasible for this robot (reach, overlap, timing, and for the
             hyperbolic pelvis a ZMP outside the feet).
     """
-    return run_to_end(plan_next_in_parts(robot, schedule, stance, boundary, command, reach, pelvis))
-
-
-def plan_next_in_parts(
-    robot: RobotModel, schedule: Schedule, stance: Stance, boundary: Boundary, command: StepCommand,
-    reach: bool = True, pelvis: str = "cubic",
-) -> Parts[tuple[list[Stage], Stance, Boundary]]:
-    """:func:`plan_next` in parts (:mod:`zmpwalk.slices`): the footsteps, then each stage."""
     check_pelvis(pelvis)
     if boundary.at_rest and command.stop:
         return [], stance, boundary
@@ -650,6 +642,9 @@ def plan_next_in_parts(
     if command.stop:
         next_stance = Stance(next_stance.left, next_stance.right, 0)
     return stages, next_stance, boundary
+
+
+plan_next = whole(plan_next_in_parts, "plan_next")  # the same, run whole
 
 
 def hyperbolic_stages(stages: list[Stage], boundary: Boundary, robot: RobotModel) -> Parts[list[Stage]]:
