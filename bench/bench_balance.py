@@ -1,7 +1,7 @@
 """Walks with and without the stabilizer, per robot and scenario: the tables of docs/balance.md.
 
 Run: python bench/bench_balance.py [--quick]. Prints Markdown tables and the stabilizer's cost per tick;
-asserts nothing. TALOS needs ../shared/robots (skipped when absent). Runs on all cores.
+asserts nothing. TALOS and Booster T1 need ../shared/robots (skipped when absent). Runs on all cores.
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ from zmpwalk.scenarios import load_scenario
 from zmpwalk.sim import simulate
 
 TALOS = Path(__file__).resolve().parents[2] / "shared" / "robots" / "pal_talos" / "scene_position.xml"
+T1 = Path(__file__).resolve().parents[2] / "shared" / "robots" / "booster_t1" / "scene.xml"
 HUBO_SCENARIOS = ("fig10", "fig27", "fig28", "fig29", "fig30", "fig31", "turn45", "demo")
 TALOS_WALKS = {
     "10 x 10 cm, 0.8 s": [StepCommand(duration=0.8, forward=0.1)] * 10,
@@ -34,10 +35,19 @@ TALOS_WALKS = {
     "side 6 x 5 cm, 0.9 s": [StepCommand(duration=0.9, side=0.05)] * 6,
     "turn 3 x 15 deg, 1.0 s": [StepCommand(duration=1.0, turn=math.radians(15))] * 3,
 }
+T1_WALKS = {
+    "10 x 10 cm, 0.9 s": [StepCommand(duration=0.9, forward=0.1)] * 10,
+    "10 x 10 cm, 0.8 s": [StepCommand(duration=0.8, forward=0.1)] * 10,
+    "10 x 15 cm, 0.8 s": [StepCommand(duration=0.8, forward=0.15)] * 10,
+    "side 6 x 5 cm, 0.9 s": [StepCommand(duration=0.9, side=0.05)] * 6,
+    "turn 3 x 15 deg, 1.0 s": [StepCommand(duration=1.0, turn=math.radians(15))] * 3,
+}
+PATHS = {"talos": TALOS, "t1": T1}
+WALKS = {"talos": TALOS_WALKS, "t1": T1_WALKS}
 
 
 def robot(name: str, kp: float | None) -> RobotModel:
-    model = load_robot(TALOS if name == "talos" else name)
+    model = load_robot(PATHS.get(name, name))
     if kp is not None and model.servos is not None:
         model = dataclasses.replace(model, servos=dataclasses.replace(model.servos, kp=kp, kv=kp / 50))
     return model
@@ -46,7 +56,7 @@ def robot(name: str, kp: float | None) -> RobotModel:
 def case(job: tuple[str, float | None, str, bool]) -> str:
     name, kp, walk, balance = job
     model = robot(name, kp)
-    commands = TALOS_WALKS[walk] if name == "talos" else load_scenario(walk)
+    commands = WALKS[name][walk] if name in WALKS else load_scenario(walk)
     pattern = generate(model, commands, rate=1000.0)
     joints = pattern_joint_trajectory(pattern, check_limits=False)
     start = time.perf_counter()
@@ -89,18 +99,19 @@ def stabilizer_cost() -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--quick", action="store_true", help="fig27 and one TALOS walk only")
+    parser.add_argument("--quick", action="store_true", help="fig27 and one walk of each imported robot only")
     args = parser.parse_args()
     jobs: list[tuple[str, float | None, str, bool]] = []
     scenarios = ("fig27",) if args.quick else HUBO_SCENARIOS
     for walk in scenarios:
         for kp in (None, 3000.0):
             jobs += [("hubo", kp, walk, False), ("hubo", kp, walk, True)]
-    if TALOS.is_file():
-        walks = list(TALOS_WALKS)[:1] if args.quick else list(TALOS_WALKS)
-        jobs += [("talos", None, walk, balance) for walk in walks for balance in (False, True)]
-    else:
-        print(f"TALOS skipped: {TALOS} is absent", file=sys.stderr)
+    for name, path in PATHS.items():
+        if path.is_file():
+            walks = list(WALKS[name])[:1] if args.quick else list(WALKS[name])
+            jobs += [(name, None, walk, balance) for walk in walks for balance in (False, True)]
+        else:
+            print(f"{name} skipped: {path} is absent", file=sys.stderr)
     print(stabilizer_cost())
     print("| robot | walk | stabilizer | result | CoP - ZMP RMS [mm] | final feet error [mm] | "
           "least sole force, last 2 s [N] | torso attitude spread, last 2 s [rad] | wall time [s] |")

@@ -273,3 +273,48 @@ def test_a_torso_turned_from_its_plan_turns_the_swinging_foot_back_to_its_planne
     plain, inputs, _ = standing()
     run(plain, {**inputs, "support": 1}, 3000, loads=(2.0, 0.0))
     assert plain._landing_yaw == [0.0, 0.0]
+
+
+T1 = Path(__file__).resolve().parents[2] / "shared" / "robots" / "booster_t1" / "scene.xml"
+
+
+def test_servos_softer_than_kappa_m_g_l_get_an_encoder_loop_of_that_stiffness() -> None:
+    """Step 8: G = kappa m g l / k - 1 where the servo is softer, 0 where it is stiffer (HUBO's 20 000
+    N m/rad), and the output moves by G times its own tracking error, nothing else changing."""
+    hubo, inputs, _ = standing()
+    assert not hubo.servo_gain.any()
+    robot = hubo.robot
+    assert robot.servos is not None
+    soft = dataclasses.replace(robot, servos=dataclasses.replace(robot.servos, kp=100.0))
+    stiffened = Stabilizer(soft, 1000.0)
+    plain = Stabilizer(soft, 1000.0, StabilizerGains(servo_stiffness=0.0))
+    weight_moment = robot.mass * robot.gravity * robot.pendulum_length  # the box legs' links sum to the mass
+    assert stiffened.servo_gain == pytest.approx(np.full(12, 1.7 * weight_moment / 100.0 - 1.0), rel=1e-9)
+    sagging = np.asarray(inputs["joint_angles"]).copy()
+    sagging[3] -= 0.05  # the left knee 0.05 rad short of its target
+    for _ in range(3):
+        measurement = measured(plain, inputs, joint_angles=sagging)
+        without = plain.update(**inputs, measurement=measurement)  # type: ignore[arg-type]
+        measurement = measured(stiffened, inputs, joint_angles=sagging)
+        with_loop = stiffened.update(**inputs, measurement=measurement)  # type: ignore[arg-type]
+        expected = without + stiffened.servo_gain * (without - sagging)
+        assert with_loop == pytest.approx(expected, abs=1e-12)
+    assert with_loop[3] - without[3] == pytest.approx(stiffened.servo_gain[3] * (without[3] - sagging[3]), abs=1e-12)
+    assert with_loop[3] - without[3] > 0.04  # [rad] the knee's target moves on, towards the sag's side
+
+
+@pytest.mark.skipif(not T1.is_file(), reason="../shared/robots is absent")
+def test_booster_t1_walks_ten_steps_on_its_own_servos_with_the_stabilizer() -> None:
+    """Booster T1's 75 N m/rad servos, its own model: 10 steps of 10 cm at 0.9 s (the HUBO tables scaled),
+    the last 2 s standing. Measured: walks, 0.984 m, feet 25.1 mm from their plan, 123 N on the lighter sole."""
+    from zmpwalk.sim import simulate
+
+    robot = load_robot(T1)
+    pattern = generate(robot, [StepCommand(duration=0.9, forward=0.1)] * 10, rate=1000.0)
+    joints = pattern_joint_trajectory(pattern, check_limits=False)
+    result = simulate(robot, joints, pattern, stabilizer=Stabilizer(robot, 1000.0))
+    assert not result.fell
+    assert result.distance == pytest.approx(1.0, abs=0.05)  # [m] the base moved as far as the plan
+    assert result.final_feet_error < 0.04  # [m]
+    assert result.end_max_speed < 0.05  # [m/s] standing still over the last 2 s
+    assert result.end_min_sole_force > 0.15 * robot.mass * robot.gravity  # [N] both soles loaded

@@ -38,6 +38,12 @@ separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega 
    kinematics) is the floor's; with unit normal ``n`` the CoM must stand ``l (n_x, n_y) / n_z`` uphill of
    its plan for the ZMP to stay where planned, and the CoM admittance is pulled to that offset instead of
    to zero.
+8. **Servo stiffness**: a position servo of stiffness ``k`` that carries an unplanned torque ``tau`` sags
+   by ``tau / k``; a leg joint whose servo is softer than :attr:`StabilizerGains.servo_stiffness` times
+   ``m g l`` per radian (the weight's moment on the pendulum length: the sag angle is then the same on a
+   robot of any size) gets an outer loop on its encoder, ``u = q_d + G (q_d - q)`` with
+   ``G = kappa m g l / k - 1``, so that the servo acts with ``kappa m g l`` (Booster T1: 75 -> 294 N m/rad;
+   TALOS: 1000 -> 1427).
 
 All corrections are small offsets of the feet relative to the pelvis, mapped onto the joints through each
 leg's Jacobian at the pattern's angles (``Delta q = J^{-1} Delta x``): nothing is planned or solved
@@ -95,6 +101,8 @@ class StabilizerGains:
             stays within it, so only a push makes the foot step aside).
         landing_yaw_limit: Largest turn of a swinging foot towards its planned heading in world [rad] (the
             torso's measured yaw error, which a sole slipping in yaw leaves; 0 turns it off).
+        servo_stiffness: ``kappa``: each leg servo softer than ``kappa m g l`` per radian (m the robot's mass,
+            l its pendulum length) is stiffened to it by an outer loop on its encoder [-]; 0 turns it off.
     """
 
     dcm: float = 3.0  # [1/s]
@@ -120,6 +128,7 @@ class StabilizerGains:
     step_gain: float = 1.0  # [-]
     step_deadband: float = 0.03  # [m]
     landing_yaw_limit: float = 0.1  # [rad]
+    servo_stiffness: float = 1.7  # [-] of m g l per rad
 
     def __post_init__(self) -> None:
         for name, value in vars(self).items():
@@ -224,6 +233,12 @@ class Stabilizer:
         self._gather = gather
         self._scatter = [list(chain.role_order) for chain in self.chains]
         self._eye = np.eye(3)
+        # 8. the outer loop's gain per joint column: G = kappa m g l / k - 1 where the servo is softer
+        stiffness = servo_stiffness(robot)
+        wanted = self.gains.servo_stiffness * self._mass * robot.gravity * robot.pendulum_length
+        self.servo_gain = (np.zeros(12) if stiffness is None
+                           else np.maximum(wanted / np.maximum(stiffness, 1e-9) - 1.0, 0.0))
+        self._stiffen = bool(self.servo_gain.any())
         self.reset()
 
     def reset(self) -> None:
@@ -471,6 +486,8 @@ class Stabilizer:
         result = reference_angles.copy()
         result[0:6] += deltas[0, self._scatter[0]]
         result[6:12] += deltas[1, self._scatter[1]]
+        if self._stiffen:  # --- 8. servo stiffness: the encoder loop on the soft servos
+            result += self.servo_gain * (result - columns[:12])
         state = self.state  # written in place: the control path allocates no state
         state.zmp_desired[:] = pdx, pdy
         state.zmp_measured[:] = zmx, zmy
@@ -538,6 +555,17 @@ class Stabilizer:
         along = min(max(rx * ax + ry * ay, 0.0), length)
         across = min(max(-rx * ay + ry * ax, -lx), lx)
         return centres[0][0] + along * ax - across * ay, centres[0][1] + along * ay + across * ax
+
+
+def servo_stiffness(robot: RobotModel) -> Array | None:
+    """Stiffness of each leg joint's position servo [N m/rad], (12,) in the joint-column order; None where the
+    robot gives none (a robot file without ``[servos]``)."""
+    if robot.plant is not None:
+        return np.array([j.actuator.kp if j.actuator is not None and j.actuator.kind == "position" else np.inf
+                         for j in robot.plant.joints])
+    if robot.servos is not None:
+        return np.full(12, robot.servos.kp)
+    return None
 
 
 def _rotate2(x: float, y: float, angle: float) -> tuple[float, float]:
