@@ -509,6 +509,7 @@ def joint_trajectory_in_parts(
             angles[:, 6 * index:6 * index + 6] = leg_angles[:, order]
             velocities[:, 6 * index:6 * index + 6] = rates[:, order]
     if check_limits:
+        yield  # the joint ranges: a part of their own
         check_joint_limits(time, angles, robot)
     return JointTrajectory(time, angles, velocities, position_base_in_world=base)
 

@@ -410,6 +410,7 @@ class OnlineWalker:
             block = rows[begin:min(begin + size, len(rows))]
             times = np.arange(first_index + begin, first_index + begin + len(block)) / rate
             samples = yield from evaluate_in_parts(table, times, self.robot)
+            yield
             self._fill_pattern(block, samples)
             yield
             scalars += _scalars(block)
