@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import pytest
 
@@ -159,3 +160,23 @@ rows = [[0.8, 0.13, 0.035, 0.47, 1.0, 1.0, 0.2, 0.2]]
     err = capsys.readouterr().err
     assert [line for line in err.splitlines() if "conditions tuned" in line][-1].startswith("3/3 conditions tuned")
     assert "\r" not in err
+
+
+ROBOTS = Path(__file__).resolve().parents[2] / "shared" / "robots"
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+@pytest.mark.skipif(not (ROBOTS / "booster_t1" / "scene.xml").is_file(), reason="../shared/robots is absent")
+def test_booster_t1s_tuned_tables_plan_its_forward_walks_inside_the_soles_where_hubos_do_not():
+    """examples/schedule_t1_tuned.toml (zmpwalk tune on T1's own model): every forward row of the grid plans
+    10 steps with the ZMP inside T1's 100 mm soles at every 1 kHz sample (its file says +3.4 to +8.4 mm);
+    HUBO's tables, scaled, leave them (-8.6 mm at 0.95 s)."""
+    robot = load_robot(ROBOTS / "booster_t1" / "scene.xml")
+    tuned = Schedule.from_file(EXAMPLES / "schedule_t1_tuned.toml")
+    time_scale, stride_scale, _ = robot.schedule_scale
+    for duration, stride in ((0.95, 0.1), (0.8, 0.2), (0.7, 0.2)):
+        commands = [StepCommand(duration=duration * time_scale, forward=stride * stride_scale)] * 10
+        margin = float(generate(robot, commands, rate=1000.0, schedule=tuned).zmp_margin().min())
+        assert margin > 0.003, (duration, stride, margin)  # [m]
+    hubo = generate(robot, [StepCommand(duration=0.95 * time_scale, forward=0.1 * stride_scale)] * 10, rate=1000.0)
+    assert float(hubo.zmp_margin().min()) < -0.005  # [m]
