@@ -318,3 +318,18 @@ def test_booster_t1_walks_ten_steps_on_its_own_servos_with_the_stabilizer() -> N
     assert result.final_feet_error < 0.04  # [m]
     assert result.end_max_speed < 0.05  # [m/s] standing still over the last 2 s
     assert result.end_min_sole_force > 0.15 * robot.mass * robot.gravity  # [N] both soles loaded
+
+
+def test_a_sole_that_takes_the_load_with_no_tick_of_both_loaded_is_placed_by_the_measured_legs() -> None:
+    """After a push the swinging foot can land as the other lifts, with no tick where both carry load: the
+    newly loaded sole is placed from the last one by the measured kinematics (its old place, from the last
+    double support, is a step behind), and becomes the odometry's reference."""
+    stabilizer, inputs, _ = standing()
+    run(stabilizer, inputs, 5, loads=(2.0, 0.0))
+    assert stabilizer._anchor == 0
+    stabilizer._feet[1] = [-1.0, -1.0]  # where the right sole was a step ago
+    run(stabilizer, inputs, 1, loads=(0.0, 2.0))
+    assert stabilizer._anchor == 1
+    left, right = (np.asarray(a) for a in inputs["ankles_in_world"])  # type: ignore[attr-defined]
+    expected = np.asarray(stabilizer._feet[0]) + (right - left)[:2]  # upright, heading 0: the legs as planned
+    assert np.asarray(stabilizer._feet[1]) == pytest.approx(expected, abs=1e-9)

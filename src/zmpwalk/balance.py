@@ -341,11 +341,15 @@ class Stabilizer:
             self._feet[anchor][0] += h * (now[0] - last[0])
             self._feet[anchor][1] += h * (now[1] - last[1])
         self._sole_normals = sole_normals
-        if loaded0 and loaded1:
-            d = _rotate3(rot, _sub3(relative[1 - anchor], relative[anchor]))
-            self._feet[1 - anchor] = [self._feet[anchor][0] + d[0], self._feet[anchor][1] + d[1]]
-        elif loaded0 != loaded1:
-            anchor = self._anchor = 0 if loaded0 else 1
+        loaded_now = 0 if loaded0 else 1
+        if (loaded0 and loaded1) or (loaded0 != loaded1 and loaded_now != anchor):
+            # Both carry load, or the load passed to the other sole with no tick of both (a hurried step after
+            # a push): the other sole is placed from the reference one by the measured kinematics.
+            other_foot = 1 - anchor
+            d = _rotate3(rot, _sub3(relative[other_foot], relative[anchor]))
+            self._feet[other_foot] = [self._feet[anchor][0] + d[0], self._feet[anchor][1] + d[1]]
+        if loaded0 != loaded1:
+            anchor = self._anchor = loaded_now
         foot_anchor = self._feet[anchor]
         # --- 6. floor slope: the soles' normal in world (IMU and measured kinematics), low-pass filtered
         normal = self._floor_normal
