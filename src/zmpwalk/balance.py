@@ -11,7 +11,8 @@ separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega 
 
 1. **DCM tracking.** The CoM ``c`` is estimated from the encoders and the IMU, anchored at the sole that
    has carried load the longest, whose place in world comes from leg odometry (while both soles carry load
-   the newer one is placed from it by the measured kinematics, tick by tick; while the reference sole rolls
+   the newer one is placed from it by the measured kinematics, tick by tick, as is a sole that takes the load
+   with no tick of both loaded; while the reference sole rolls
    on an edge, its ankle moves by the ankle height times the change of the sole normal's horizontal part),
    so a step landed short shows as a DCM error; the divergent component of motion ``xi = c + c' / omega``
    must follow the pattern's.
