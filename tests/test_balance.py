@@ -306,7 +306,7 @@ def test_servos_softer_than_kappa_m_g_l_get_an_encoder_loop_of_that_stiffness() 
 @pytest.mark.skipif(not T1.is_file(), reason="../shared/robots is absent")
 def test_booster_t1_walks_ten_steps_on_its_own_servos_with_the_stabilizer() -> None:
     """Booster T1's 75 N m/rad servos, its own model: 10 steps of 10 cm at 0.9 s (the HUBO tables scaled),
-    the last 2 s standing. Measured: walks, 0.984 m, feet 25.1 mm from their plan, 123 N on the lighter sole."""
+    the last 2 s standing. Measured: walks, 0.98 m, feet 25.2 mm from their plan, 122 N on the lighter sole."""
     from zmpwalk.sim import simulate
 
     robot = load_robot(T1)
