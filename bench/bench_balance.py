@@ -30,17 +30,18 @@ T1 = Path(__file__).resolve().parents[2] / "shared" / "robots" / "booster_t1" / 
 HUBO_SCENARIOS = ("fig10", "fig27", "fig28", "fig29", "fig30", "fig31", "turn45", "demo")
 
 
-def forward(*walks: tuple[float, float]) -> dict[str, list[StepCommand]]:
-    """Ten steps of each (stride [m], step time [s]), then the side walk and the turn every robot walks."""
+def walks_of(*forward: tuple[float, float]) -> dict[str, list[StepCommand]]:
+    """Ten steps of each forward walk (stride [m], step time [s]), then the side walk and the turn every robot
+    walks."""
     named = {f"10 x {stride * 100:.0f} cm, {duration} s": [StepCommand(duration=duration, forward=stride)] * 10
-             for stride, duration in walks}
+             for stride, duration in forward}
     named["side 6 x 5 cm, 0.9 s"] = [StepCommand(duration=0.9, side=0.05)] * 6
     named["turn 3 x 15 deg, 1.0 s"] = [StepCommand(duration=1.0, turn=math.radians(15))] * 3
     return named
 
 
-TALOS_WALKS = forward((0.1, 0.8), (0.15, 0.9), (0.2, 1.0))
-T1_WALKS = forward((0.1, 0.9), (0.1, 0.8), (0.15, 0.8))
+TALOS_WALKS = walks_of((0.1, 0.8), (0.15, 0.9), (0.2, 1.0))
+T1_WALKS = walks_of((0.1, 0.9), (0.1, 0.8), (0.15, 0.8))
 PATHS = {"talos": TALOS, "t1": T1}
 WALKS = {"talos": TALOS_WALKS, "t1": T1_WALKS}
 

@@ -289,7 +289,8 @@ def test_servos_softer_than_kappa_m_g_l_get_an_encoder_loop_of_that_stiffness() 
     stiffened = Stabilizer(soft, 1000.0)
     plain = Stabilizer(soft, 1000.0, StabilizerGains(servo_stiffness=0.0))
     weight_moment = robot.mass * robot.gravity * robot.pendulum_length  # the box legs' links sum to the mass
-    assert stiffened.servo_gain == pytest.approx(np.full(12, 1.7 * weight_moment / 100.0 - 1.0), rel=1e-9)
+    kappa = StabilizerGains().servo_stiffness
+    assert stiffened.servo_gain == pytest.approx(np.full(12, kappa * weight_moment / 100.0 - 1.0), rel=1e-9)
     sagging = np.asarray(inputs["joint_angles"]).copy()
     sagging[3] -= 0.05  # the left knee 0.05 rad short of its target
     for _ in range(3):
