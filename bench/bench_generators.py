@@ -70,9 +70,10 @@ def walk_time(name: str) -> float:
 
 
 def loop_times(name: str, seconds: float = 30.0) -> np.ndarray:
-    """Every iteration [us] of a 1 kHz loop with joints: steps submitted as the one before starts, walks of five
-    steps from standstill with their automatic stop, 1 s standing between walks. Set up as docs/speed.md
-    advises: everything loaded before the loop is frozen out of the garbage collector's full passes."""
+    """Every iteration [us] of a 1 kHz loop with joints: steps commanded as the one before starts (checked in
+    parts over the ticks), walks of five steps from standstill with their automatic stop, 1 s standing between
+    walks. Set up as docs/speed.md advises: everything loaded before the loop is frozen out of the garbage
+    collector's full passes."""
     walker = OnlineWalker(load_robot("hubo"), rate=1000.0, joints=True, generator=name)
     gc.collect()
     gc.freeze()
@@ -82,7 +83,7 @@ def loop_times(name: str, seconds: float = 30.0) -> np.ndarray:
     for _ in range(round(seconds * 1000)):
         start = time.perf_counter()
         if given < len(steps) and walker.queued is None and walker.checking is None and not standing:
-            walker.submit(steps[given])
+            walker.command(steps[given])
             given += 1
         walker.tick()
         iterations.append(time.perf_counter() - start)
@@ -123,7 +124,7 @@ def speed() -> None:
             continue
         us = loop_times(name)
         cells.append(f"median {np.median(us):.1f} us, p99.9 {np.percentile(us, 99.9):.0f} us, max {us.max():.0f} us")
-    print("| online loop at 1 kHz with joints, submit(), 30 s | " + " | ".join(cells) + " |")
+    print("| online loop at 1 kHz with joints, command(), 30 s | " + " | ".join(cells) + " |")
 
 
 if __name__ == "__main__":

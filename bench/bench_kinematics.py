@@ -67,7 +67,7 @@ def main() -> None:
         k = 0
         for _ in range(int(60 * rate)):
             if walker.queued is None:
-                walker.command(commands[k % 3])
+                walker.command(commands[k % 3], wait=True)
                 k += 1
             t0 = time.perf_counter_ns()
             walker.tick()

@@ -25,7 +25,7 @@ def tick_times(rate: float, seconds: float) -> np.ndarray:
     index = 0
     for _ in range(int(seconds * rate)):
         if walker.queued is None:
-            walker.command(commands[index % len(commands)])  # queued off the tick, as a controller would
+            walker.command(commands[index % len(commands)], wait=True)  # queued off the tick, as a controller would
             index += 1
         start = time.perf_counter_ns()
         walker.tick()
@@ -33,22 +33,22 @@ def tick_times(rate: float, seconds: float) -> np.ndarray:
     return np.array(durations) / 1e3  # [us]
 
 
-def control_loop(rate: float, seconds: float, joints: bool, use_submit: bool) -> tuple[np.ndarray, np.ndarray]:
+def control_loop(rate: float, seconds: float, joints: bool, wait: bool) -> tuple[np.ndarray, np.ndarray]:
     """What a robot's loop sees: every iteration timed (tick plus any command given in it). Walks of five
     steps, each step commanded in the loop as the one before it starts (the first from standstill), then
-    the automatic stop and 1 s of standing. Returns the iterations' and the commands' times [us]."""
+    the automatic stop and 1 s of standing. ``wait``: each command checked whole in its call (command(step,
+    wait=True)) instead of in parts over the ticks. Returns the iterations' and the commands' times [us]."""
     walker = OnlineWalker(load_robot("hubo"), rate=rate, joints=joints)
     gc.collect()
     gc.freeze()  # as docs/speed.md advises: what was loaded before the loop is out of the GC's full passes
     steps = [StepCommand(0.8, 0.2), StepCommand(0.8, 0.1, turn=0.1), StepCommand(0.8, side=0.05),
              StepCommand(0.7, 0.15), StepCommand(0.95, 0.1)]
-    give = walker.submit if use_submit else walker.command
     iterations, commands = [], []
     given, standing = 0, 0
     for _ in range(round(seconds * rate)):
         start = time.perf_counter()
         if given < len(steps) and walker.queued is None and walker.checking is None and not standing:
-            give(steps[given])
+            walker.command(steps[given], wait=wait)
             commands.append(time.perf_counter() - start)
             given += 1
         walker.tick()
@@ -88,21 +88,21 @@ def main() -> None:
           f"(planning alone {statistics.median(plans) * 1e3:.1f} ms)")
     command_times = []
     walker = OnlineWalker(robot, rate=1000.0)
-    walker.command(StepCommand(0.8, 0.2))
+    walker.command(StepCommand(0.8, 0.2), wait=True)
     walker.tick()
     for _ in range(200):
         start = time.perf_counter()
-        walker.command(StepCommand(0.8, 0.2))
+        walker.command(StepCommand(0.8, 0.2), wait=True)
         command_times.append(time.perf_counter() - start)
-    print(f"OnlineWalker.command() at 1 kHz (plan + sample one step): median "
+    print(f"OnlineWalker.command(step, wait=True) at 1 kHz (the whole check in the call): median "
           f"{statistics.median(command_times) * 1e3:.2f} ms")
     print("Control loop at 1 kHz with joints, 60 s, every iteration timed (commands given inside the loop, "
           "first commands from standstill and automatic stops included)")
-    for use_submit in (True, False):
-        loop, given = control_loop(1000.0, 60.0, True, use_submit)
-        name = "submit()" if use_submit else "command()"
-        print(f"  with {name:9}: iterations {_figures(loop)}")
-        print(f"  {'':15}{name} alone: median {np.median(given):.1f} us, max {given.max():.1f} us "
+    for wait in (False, True):
+        loop, given = control_loop(1000.0, 60.0, True, wait)
+        name = "command(step, wait=True)" if wait else "command(step)"
+        print(f"  with {name:24}: iterations {_figures(loop)}")
+        print(f"  {'':30}{name} alone: median {np.median(given):.1f} us, max {given.max():.1f} us "
               f"({len(given)} commands)")
 
 

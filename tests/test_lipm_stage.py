@@ -125,11 +125,11 @@ def test_random_walks_keep_the_zmp_in_the_feet_and_end_at_rest(hubo):
 def test_a_stride_that_would_take_the_zmp_out_of_the_feet_is_rejected_with_the_largest_that_fits(hubo):
     walker = OnlineWalker(hubo, rate=200.0, generator="hyperbolic")
     with pytest.raises(InfeasibleCommandError, match=r"keeps the ZMP in the feet .* at most forward = ") as error:
-        walker.command(StepCommand(0.6, 0.4))
+        walker.command(StepCommand(0.6, 0.4), wait=True)
     largest = error.value.largest["forward"]
     assert 0.0 < largest < 0.4
     assert not walker.walking and walker.queued is None  # unchanged
-    walker.command(StepCommand(0.6, largest))  # the named stride is accepted from the same place
+    walker.command(StepCommand(0.6, largest), wait=True)  # the named stride is accepted from the same place
     assert walker.queued is not None
 
 

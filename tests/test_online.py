@@ -42,7 +42,7 @@ def _drive(walker, commands, ticks):
     out = []
     for _ in range(ticks):
         if pending and walker.queued is None:
-            walker.command(pending.pop(0))
+            walker.command(pending.pop(0), wait=True)
         out.append(_rows(walker.tick()))
     return np.array(out)
 
@@ -66,16 +66,16 @@ def test_walker_stands_still_until_commanded(hubo):
         sample = walker.tick()
     np.testing.assert_array_equal(_rows(sample), _rows(first))
     assert sample.support == "double" and sample.time == pytest.approx(0.5)
-    walker.command(StepCommand(0.8, 0.2))
+    walker.command(StepCommand(0.8, 0.2), wait=True)
     assert walker.walking
 
 
 def test_queued_command_is_replaced_before_it_starts(hubo):
     walker = OnlineWalker(hubo, rate=100)
-    walker.command(StepCommand(0.8, 0.1))
+    walker.command(StepCommand(0.8, 0.1), wait=True)
     walker.tick()
-    walker.command(StepCommand(0.8, 0.2))
-    walker.command(StepCommand(0.8, 0.25))  # replaces the 0.2 before it starts
+    walker.command(StepCommand(0.8, 0.2), wait=True)
+    walker.command(StepCommand(0.8, 0.25), wait=True)  # replaces the 0.2 before it starts
     assert walker.queued == StepCommand(0.8, 0.25)
 
 
@@ -88,14 +88,14 @@ def test_rejected_command_leaves_the_walker_exactly_as_it_was(hubo):
     rows = []
     for tick in range(1200):
         if pending and walker.queued is None:
-            walker.command(pending.pop(0))
+            walker.command(pending.pop(0), wait=True)
         if tick % 97 == 0:
             queued = walker.queued
             for bad in (StepCommand(0.8, 0.9), StepCommand(0.1, 0.1), StepCommand(0.3, 0.3)):
                 with pytest.raises((UnreachableError, InvalidParameterError)):
-                    walker.command(bad)
+                    walker.command(bad, wait=True)
             with pytest.raises(InvalidParameterError):
-                walker.command("forward please")  # type: ignore[arg-type]
+                walker.command("forward please", wait=True)  # type: ignore[arg-type]
             assert walker.queued == queued
         rows.append(_rows(walker.tick()))
     np.testing.assert_array_equal(np.array(rows), expected)
@@ -107,7 +107,7 @@ def test_rejected_command_leaves_the_walker_exactly_as_it_was(hubo):
 def test_stop_request_ends_in_the_ready_posture(hubo, steps, stop_after):
     walker = OnlineWalker(hubo, rate=100)
     for duration, forward in steps:
-        walker.command(StepCommand(duration, forward))
+        walker.command(StepCommand(duration, forward), wait=True)
         while walker.queued is not None:
             walker.tick()
     for _ in range(stop_after):
@@ -156,7 +156,7 @@ def test_commands_at_any_tick_keep_the_motion_continuous(hubo, generator, action
             previous = rows
         queued = walker.queued
         try:
-            walker.stop() if action == "stop" else walker.command(action)
+            walker.stop() if action == "stop" else walker.command(action, wait=True)
         except ZmpwalkError:
             assert walker.queued == queued  # a rejected command changes nothing
     assert largest < 2.0 / rate  # [m] less than 2 m/s between two ticks: no jump anywhere
@@ -168,11 +168,11 @@ def test_commands_at_any_tick_keep_the_motion_continuous(hubo, generator, action
 def test_a_command_whose_stop_is_infeasible_is_rejected_by_command_not_by_a_later_tick(joints, command, error):
     walker = OnlineWalker(load_robot("hubo"), rate=100, joints=joints)
     with pytest.raises(ZmpwalkError, match=f"closing step this command would end with.*{error}"):
-        walker.command(command)
+        walker.command(command, wait=True)
     assert not walker.walking and walker.queued is None  # unchanged
     for _ in range(300):  # and it goes on standing, and walking when asked
         walker.tick()
-    walker.command(StepCommand(duration=0.8, forward=0.1))
+    walker.command(StepCommand(duration=0.8, forward=0.1), wait=True)
     for _ in range(600):
         walker.tick()
     assert not walker.walking  # stopped by itself with the stop planned at command()
@@ -237,7 +237,7 @@ def test_hostile_commands_are_rejected_by_command_never_by_tick(hubo, joints, ac
             command = StepCommand(**fields)  # type: ignore[arg-type]
             queued = walker.queued
             try:
-                walker.command(command)
+                walker.command(command, wait=True)
             except ZmpwalkError as error:
                 assert walker.queued == queued
                 event("rejected by command()")
@@ -247,11 +247,11 @@ def test_hostile_commands_are_rejected_by_command_never_by_tick(hubo, joints, ac
             assert error.parameter in str(error) and "expected" in str(error)
             continue
         event("accepted")
-        reference.command(command)
+        reference.command(command, wait=True)
     assert not walker.walking  # every accepted walk ended standing
 
 
-# --------------------------------------------------------------------- submit(): the check in slices
+# --------------------------------------------------------------------- command(): the check in slices
 
 def _sample_row(sample):
     return np.concatenate([_rows(sample), sample.joint_angles, sample.joint_velocities])
@@ -259,39 +259,61 @@ def _sample_row(sample):
 
 @pytest.mark.parametrize("rate", [100.0, 1000.0])
 @pytest.mark.parametrize("generator", ["polynomial", "hyperbolic"])
-def test_submitted_commands_give_the_same_walk_as_commands(hubo, rate, generator):
-    """submit() (checked one slice per tick) against command() (checked at once): sample for sample, joint
-    angles and rates included; the walk from standstill starts START_DELAY later, as documented."""
+def test_commands_checked_in_slices_give_the_same_walk_as_commands_checked_at_once(hubo, rate, generator):
+    """command() (checked in parts, a few per tick) against command(wait=True) (checked at once): sample for
+    sample, joint angles and rates included; the walk from standstill starts START_DELAY later, as documented."""
     from zmpwalk.online import START_DELAY
 
     commands = [StepCommand(0.8, 0.2), StepCommand(0.7, 0.1, turn=0.1), StepCommand(0.8, side=0.05),
                 StepCommand(0.95, -0.1)]
     delay = round(START_DELAY * rate)
     direct, sliced = (OnlineWalker(hubo, rate=rate, joints=True, generator=generator) for _ in range(2))
-    sliced.submit(commands[0])
+    sliced.command(commands[0])
     direct_rows, sliced_rows = [], []
     for _ in range(delay):  # both stand still meanwhile
         direct_rows.append(_sample_row(direct.tick()))
         sliced_rows.append(_sample_row(sliced.tick()))
-    direct.command(commands[0])
+    direct.command(commands[0], wait=True)
     pending = commands[1:]
     for tick in range(round(9.0 * rate)):
         if pending and direct.queued is None and tick % 7 == 3:  # a command soon after each step starts
-            direct.command(pending[0])
-            sliced.submit(pending.pop(0))
+            direct.command(pending[0], wait=True)
+            sliced.command(pending.pop(0))
         direct_rows.append(_sample_row(direct.tick()))
         sliced_rows.append(_sample_row(sliced.tick()))
     np.testing.assert_array_equal(np.array(sliced_rows), np.array(direct_rows))
     assert not direct.walking and not sliced.walking and sliced.rejection is None
 
 
-def test_a_submitted_command_that_fails_its_check_is_kept_as_the_rejection_and_changes_nothing(hubo):
+@pytest.mark.parametrize("rate", [100.0, 1000.0])
+def test_a_command_given_as_the_step_before_starts_is_checked_before_its_own_step(hubo, rate, monkeypatch):
+    """The check is paced by its parts (at least its share of the parts left per tick), not only by time: a
+    command given as the step before it starts, or from standstill, is checked before its step begins, so no
+    tick runs the rest of a check at once. With no time budget at all (as on a machine too slow for any part
+    to fit in it), so that the pacing by parts alone is tested."""
+    monkeypatch.setattr("zmpwalk.online.WORK_FRACTION", 0.0)
+    steps = [StepCommand(0.8, 0.2), StepCommand(0.7, 0.15), StepCommand(0.7, 0.1, turn=0.1),
+             StepCommand(0.8, side=0.05), StepCommand(0.95, 0.1), StepCommand(0.7, 0.2)]
+    walker = OnlineWalker(hubo, rate=rate, joints=True)
+    checks = 0
+    for _ in range(round(12.0 * rate)):
+        if steps and walker.queued is None and walker.checking is None:
+            walker.command(steps.pop(0))
+            checks += 1
+        job = walker._job
+        if job is not None:
+            assert walker._index < job.start  # unfinished only before its step begins
+        walker.tick()
+    assert checks == 6 and not steps and walker.rejection is None and not walker.walking
+
+
+def test_a_command_that_fails_its_check_is_kept_as_the_rejection_and_changes_nothing(hubo):
     reference, walker = OnlineWalker(hubo, rate=1000, joints=True), OnlineWalker(hubo, rate=1000, joints=True)
-    reference.command(StepCommand(0.8, 0.1))
-    walker.command(StepCommand(0.8, 0.1))
+    reference.command(StepCommand(0.8, 0.1), wait=True)
+    walker.command(StepCommand(0.8, 0.1), wait=True)
     for tick in range(4000):
         if tick == 100:
-            walker.submit(StepCommand(1.0, 0.3, foot_lift=0.15))  # its stop leaves the ankle pitch range
+            walker.command(StepCommand(1.0, 0.3, foot_lift=0.15))  # its stop leaves the ankle pitch range
             assert walker.checking is not None
         np.testing.assert_array_equal(_sample_row(walker.tick()), _sample_row(reference.tick()))
     error = walker.rejection
@@ -300,15 +322,15 @@ def test_a_submitted_command_that_fails_its_check_is_kept_as_the_rejection_and_c
     assert walker.checking is None and not walker.walking
 
 
-def test_a_command_submitted_in_the_last_tick_of_a_step_is_still_taken(hubo):
+def test_a_command_given_in_the_last_tick_of_a_step_is_still_taken(hubo):
     walker = OnlineWalker(hubo, rate=1000, joints=True)
-    walker.command(StepCommand(0.8, 0.1))
+    walker.command(StepCommand(0.8, 0.1), wait=True)
     while walker.queued is not None or walker._current is None:  # the first step under way
         walker.tick()
     current = walker._current
     while walker._index < current.first_index + len(current.rows) - 1:
         walker.tick()
-    walker.submit(StepCommand(0.8, 0.15))  # one tick before its step begins: checked in that tick
+    walker.command(StepCommand(0.8, 0.15))  # one tick before its step begins: checked in that tick
     walker.tick()
     walker.tick()
     assert walker._current.command == StepCommand(0.8, 0.15) and walker.rejection is None
@@ -316,10 +338,10 @@ def test_a_command_submitted_in_the_last_tick_of_a_step_is_still_taken(hubo):
 
 def test_stop_while_walking_takes_the_stop_planned_with_the_step(hubo):
     walker = OnlineWalker(hubo, rate=200)
-    walker.command(StepCommand(0.8, 0.2))
+    walker.command(StepCommand(0.8, 0.2), wait=True)
     for _ in range(300):
         walker.tick()
-    walker.command(StepCommand(0.8, 0.2))
+    walker.command(StepCommand(0.8, 0.2), wait=True)
     walker.stop()  # replaces the queued step with the stop of the step under way
     assert walker.queued is not None and walker.queued.stop
     for _ in range(2000):
@@ -332,14 +354,15 @@ def test_stop_while_walking_takes_the_stop_planned_with_the_step(hubo):
 @pytest.mark.parametrize("generator", ["polynomial", "hyperbolic"])
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(actions=st.lists(st.tuples(st.integers(0, 150), _hostile_fields(), st.booleans()), min_size=1, max_size=8))
-def test_hostile_submitted_commands_never_make_a_tick_raise(hubo, generator, actions):
-    """submit() and command() mixed at random ticks with hostile values: no tick raises, every rejection kept in
-    walker.rejection names a parameter, the motion stays continuous, and every walk ends standing."""
+def test_hostile_commands_never_make_a_tick_raise(hubo, generator, actions):
+    """command() and command(wait=True) mixed at random ticks with hostile values: no tick raises, every
+    rejection kept in walker.rejection names a parameter, the motion stays continuous, and every walk ends
+    standing."""
     rate = 100.0
     walker = OnlineWalker(hubo, rate=rate, joints=True, generator=generator)
     previous, largest = None, 0.0
-    for wait, fields, use_submit in [*actions, (1500, None, False)]:
-        for _ in range(wait):
+    for ticks, fields, checked_in_ticks in [*actions, (1500, None, False)]:
+        for _ in range(ticks):
             sample = walker.tick()
             rows = np.concatenate([sample.position_pelvis_in_world, sample.position_left_ankle_in_world,
                                    sample.position_right_ankle_in_world])  # positions (the cubic's ZMP jumps)
@@ -353,7 +376,7 @@ def test_hostile_submitted_commands_never_make_a_tick_raise(hubo, generator, act
             break
         try:
             command = StepCommand(**fields)  # type: ignore[arg-type]
-            (walker.submit if use_submit else walker.command)(command)
+            walker.command(command, wait=not checked_in_ticks)
         except ZmpwalkError as error:
             assert isinstance(error, InvalidParameterError) and error.parameter
     assert largest < hubo.max_foot_speed / rate  # [m] nothing moves faster than the swing foot's limit: no jump
@@ -362,8 +385,8 @@ def test_hostile_submitted_commands_never_make_a_tick_raise(hubo, generator, act
 
 @pytest.mark.parametrize("seed", [1, 2, 3])
 def test_online_samples_with_joints_equal_the_batch_path_on_random_walks(hubo, seed):
-    """Positions, ZMP, joint angles and joint rates of OnlineWalker (commands given by submit() as each step
-    starts) against generate + pattern_joint_trajectory of the same commands: 1e-9."""
+    """Positions, ZMP, joint angles and joint rates of OnlineWalker (commands given as each step
+    starts, checked at once) against generate + pattern_joint_trajectory of the same commands: 1e-9."""
     from zmpwalk.kinematics import pattern_joint_trajectory
 
     rng = np.random.default_rng(seed)
@@ -384,7 +407,7 @@ def test_online_samples_with_joints_equal_the_batch_path_on_random_walks(hubo, s
     pending, samples = list(commands), []
     for _ in range(len(pattern.time)):
         if pending and walker.queued is None:
-            walker.command(pending.pop(0))
+            walker.command(pending.pop(0), wait=True)
         samples.append(walker.tick())
     np.testing.assert_allclose([_rows(s) for s in samples], _pattern_rows(pattern), atol=1e-9, rtol=0)
     np.testing.assert_allclose([s.joint_angles for s in samples], joints.angles, atol=1e-9, rtol=0)

@@ -423,7 +423,7 @@ def test_online_walker_with_the_quintic_pelvis_reproduces_the_offline_pattern(hu
     pending, rows = list(commands), []
     for _ in range(len(pattern.time)):
         if pending and walker.queued is None:
-            walker.command(pending.pop(0))
+            walker.command(pending.pop(0), wait=True)
         sample = walker.tick()
         rows.append(np.concatenate([sample.position_pelvis_in_world, sample.zmp_in_world]))
     expected = np.column_stack([pattern.position_pelvis_in_world, pattern.zmp_in_world])

@@ -234,8 +234,8 @@ def _leg_ik_yaw_rates_in_parts(leg: Leg, px: Array, py: Array, pz: Array, yaw: A
                                velocity: tuple[Array, Array, Array, Array] | None, knee_forward: bool,
                                angles: Array, rates: Array | None) -> Parts[Array]:
     """:func:`leg_ik_yaw_rates` on component arrays (n,), writing the rows of ``angles`` and ``rates`` (6, n);
-    In two parts, the angles and the rates (:mod:`zmpwalk.slices`); :func:`_leg_ik_yaw_rates` runs it whole.
-    returns the reach excess [m] (n,)."""
+    returns the reach excess [m] (n,). In parts of tens of microseconds, the angles then the rates
+    (:mod:`zmpwalk.slices`); :func:`_leg_ik_yaw_rates` runs it whole."""
     c, s = np.cos(yaw), np.sin(yaw)
     dx, dy, dz = leg.hip[0] - px, leg.hip[1] - py, leg.hip[2] - pz
     rx, ry, rz = c * dx + s * dy, c * dy - s * dx, dz
@@ -245,6 +245,7 @@ def _leg_ik_yaw_rates_in_parts(leg: Leg, px: Array, py: Array, pz: Array, yaw: A
     cos4 = np.clip((distance * distance - a * a - b * b) / (2 * a * b), -1.0, 1.0)
     q4 = np.arccos(cos4)
     sin4 = np.sqrt(1.0 - cos4 * cos4)  # sin(arccos k) without trigonometry
+    yield
     if not knee_forward:
         q4, sin4 = -q4, -sin4
     q6 = np.arctan2(ry, rz)
@@ -252,6 +253,7 @@ def _leg_ik_yaw_rates_in_parts(leg: Leg, px: Array, py: Array, pz: Array, yaw: A
     u_z = np.sqrt(u_squared)
     big_y, big_x = -a * sin4, a * cos4 + b
     q5 = np.arctan2(big_y, big_x) - np.arctan2(rx, u_z)
+    yield
     # The hip rotation Rz(q1) Rx(q2) Ry(q3) = Rz(yaw) Rx(-q6) Ry(-(q4 + q5)) of a flat foot, in closed form
     # (Eq. 2 of Lim et al.): with the ankle below the hip (r_z > 0) q1 = yaw, q2 = -q6, q3 = -(q4 + q5);
     # above it (r_z < 0, not a walking posture) both q1 and q3 turn by pi and q2 = atan2(-r_y, |r_z|).
@@ -273,6 +275,7 @@ def _leg_ik_yaw_rates_in_parts(leg: Leg, px: Array, py: Array, pz: Array, yaw: A
     dry = -(c * vy - s * vx) - w * rx
     drz = -vz
     d_distance = (rx * drx + ry * dry + rz * drz) / distance
+    yield
     with np.errstate(divide="ignore", invalid="ignore"):  # a stretched leg has no joint rates (J singular;
         dq4 = -distance * d_distance / (a * b * sin4)  # such a sample is beyond reach, which the caller rejects)
         du = (ry * dry + rz * drz) / u_z
@@ -571,10 +574,26 @@ def _base_under_com(position_com_in_world: Array, yaw_pelvis_in_world: Array, fe
     return base, solutions
 
 
+_BOUNDS: dict[int, tuple[dict[str, tuple[float, float]], Array, Array]] = {}  # id(joint_limits) -> bounds
+
+
+def joint_bounds(robot: RobotModel) -> tuple[Array, Array]:
+    """Lower and upper ranges of the columns of :data:`JOINT_COLUMNS` [rad], each (12,) (made once per
+    robot's table of limits: the online check reads them in every block of samples)."""
+    limits = robot.joint_limits
+    cached = _BOUNDS.get(id(limits))
+    if cached is None or cached[0] is not limits:
+        if len(_BOUNDS) > 64:
+            _BOUNDS.clear()
+        cached = (limits, np.array([robot.limits_of(column)[0] for column in JOINT_COLUMNS]),
+                  np.array([robot.limits_of(column)[1] for column in JOINT_COLUMNS]))
+        _BOUNDS[id(limits)] = cached
+    return cached[1], cached[2]
+
+
 def check_joint_limits(time: Array, angles: Array, robot: RobotModel) -> None:
     """Raise :class:`JointLimitError` for the first sample and joint outside the robot's ranges."""
-    lower = np.array([robot.limits_of(column)[0] for column in JOINT_COLUMNS])
-    upper = np.array([robot.limits_of(column)[1] for column in JOINT_COLUMNS])
+    lower, upper = joint_bounds(robot)
     outside = (angles < lower) | (angles > upper)
     if np.any(outside):
         sample = int(np.argmax(outside.any(axis=1)))

@@ -8,43 +8,45 @@
         sample = walker.tick()          # one sample per control period
         send(sample.position_pelvis_in_world, ...)
         if operator_has_new_step:
-            walker.command(next_step)   # queues or replaces the next step's command
+            walker.command(next_step)   # stored in microseconds; checked a few parts per tick
+        if walker.rejection is not None:
+            ...                         # the last command could not be followed (the walk goes on without it)
 
 Behaviour:
 
 * The walker starts standing in the ready posture. The first command starts a
   walk (with the start stage of :func:`zmpwalk.patterns.polynomial.plan_next`).
-* :meth:`OnlineWalker.command` queues the command that runs after the step
-  now under way, or replaces the one queued before it started. The command is
-  planned and checked at once: a rejected command raises and leaves the walker
-  exactly as it was (the queued command, if any, stays).
+* :meth:`OnlineWalker.command` gives the command that runs after the step now under way, replacing one
+  given before it started. It only stores the command (microseconds). Its whole check, the step and the
+  stop it would end with, every sample at the control rate (the pattern, the legs' angles and rates, the
+  joint ranges or, without joints, the legs' reach), runs while the step under way goes on, cut into parts
+  of tens of microseconds (:mod:`zmpwalk.slices`): the footsteps, each stage (with the hyperbolic generator
+  each stage's pendulum), then blocks of :data:`SLICE_ROWS` samples, each in parts (the swing ankle, each
+  pelvis axis, the sway, each foot; each leg's angles and rates in parts; the joint ranges). A tick runs
+  parts for :data:`WORK_FRACTION` of the control period (20 us at 1 kHz), so its cost is bounded by that
+  budget plus one part. When the check completes the command is :attr:`~OnlineWalker.queued`; when it
+  fails the reason is kept in :attr:`~OnlineWalker.rejection` and the walk goes on as if the command had
+  not been given (no tick ever raises). A walk commanded from standstill starts :data:`START_DELAY`
+  later, by which time it is checked. Should a step end before the check of the next command is done (a
+  command given in the last ticks of a step), the rest of the check runs in that tick.
+* ``command(step, wait=True)`` runs the same check whole in the call (milliseconds: scripts, tests,
+  loops without a hard deadline): a rejected command raises and leaves the walker exactly as it was (the
+  queued command, if any, stays), and a walk from standstill starts at once.
 * If no command is queued when the step under way ends, the walker stops
   safely: a closing step of the last step time (the swinging foot lands beside
   the other one) and a settle stage, after which it stands still in the ready
   posture until the next command. :meth:`OnlineWalker.stop` asks for the same
   explicitly. That closing step is planned, sampled and checked (reach, joint
-  ranges) when the command before it is accepted: a command whose own stop is
-  infeasible is rejected, so no accepted command makes a later tick fail.
+  ranges) with the command before it: a command whose own stop is
+  infeasible is rejected, so no accepted command makes a later tick fail, and
+  :meth:`~OnlineWalker.stop` and the automatic stop cost a tick nothing.
 * The trajectories of a command (and of its stop) are sampled when the command
-  is queued, so a :meth:`~OnlineWalker.tick` only reads a row.
-
-**Inside a hard real-time loop** use :meth:`OnlineWalker.submit` instead of
-:meth:`~OnlineWalker.command`: it only stores the command (microseconds), and the same whole check (the
-step and its stop, every sample at the control rate) runs in slices while the step under way goes on: the
-footsteps, each stage (with the hyperbolic generator each stage's pendulum), then blocks of
-:data:`SLICE_ROWS` samples, each in parts (the pattern's swing ankle, pelvis, sway and feet; each leg's
-angles and rates; the joint ranges or, without joints, the legs' reach), each part tens of microseconds
-(:mod:`zmpwalk.slices`). A tick runs parts for :data:`WORK_FRACTION` of the control period (20 us at
-1 kHz), so its cost is bounded by that budget plus one part. The command is queued when its check
-completes, or its rejection is kept in :attr:`OnlineWalker.rejection` (no tick ever raises). A walk
-submitted from standstill starts :data:`START_DELAY` later, by which time it is checked. Should a step end
-before the check of the next command is done (a command submitted in the last ticks of a step), the rest
-of the check runs in that tick. :meth:`OnlineWalker.stop` costs nothing while walking: the stop of the step
-under way was planned with it.
+  is checked, so a :meth:`~OnlineWalker.tick` only reads a row.
 """
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field, replace
 
@@ -60,7 +62,15 @@ from zmpwalk.errors import (
     ZmpwalkError,
 )
 from zmpwalk.footsteps import Stance
-from zmpwalk.kinematics import JointLimitError, check_leg_reach, joint_trajectory, joint_trajectory_in_parts
+from zmpwalk.kinematics import (
+    JointLimitError,
+    Leg,
+    check_joint_limits,
+    check_leg_reach,
+    joint_trajectory,
+    joint_trajectory_in_parts,
+    leg_ik_scalar,
+)
 from zmpwalk.patterns.polynomial import (
     Boundary,
     Samples,
@@ -89,8 +99,8 @@ _ZMP, _SUPPORT = slice(12, 14), 14
 _JOINTS, _JOINT_RATES = slice(15, 27), slice(27, 39)
 _WIDTH = 15
 _WIDTH_WITH_JOINTS = 39
-SLICE_ROWS = 200  # samples per block of submit()'s check (each block's pattern and legs in parts of tens of us)
-START_DELAY = 0.35  # [s] a walk submitted from standstill starts this much later (its check is done by then)
+SLICE_ROWS = 200  # samples per block of a command's check (each block's pattern and legs in parts of tens of us)
+START_DELAY = 0.6  # [s] a walk commanded from standstill starts this much later (its check is done by then)
 HINT_RATE = 100.0  # [Hz] sampling of the search for the largest stride that fits, in a rejection
 HINT_CONFIRMATIONS = 5  # tries at the control rate, each HINT_SHRINK smaller
 HINT_SHRINK = 0.98
@@ -172,18 +182,22 @@ def _scalars(rows: Array) -> list[list[float]]:
 
 @dataclass
 class _Job:
-    """A submitted command under check: where it starts and its planning, in parts run a few per tick."""
+    """A command under check: where it starts and its planning, in parts run a few per tick."""
 
     command: StepCommand
     stance: Stance
     boundary: Boundary
     start: int  # index of the tick at which its step begins
     planning: Parts[_Plan | None]
-    origin: tuple[Stance, Boundary]  # the walker's end of plan when submitted: the job is stale once it changes
+    origin: tuple[Stance, Boundary]  # the walker's end of plan when given: the job is stale once it changes
+    expected: int  # parts its check is expected to take
+    parts: int = 0  # parts run so far
 
 
 _UNFINISHED = object()
-WORK_FRACTION = 0.02  # [-] a tick runs parts of a submitted command's check for this fraction of the control period
+WORK_FRACTION = 0.02  # [-] a tick runs parts of a command's check for this fraction of the control period
+PARTS_PER_BLOCK = 40  # parts of a block of SLICE_ROWS samples (a first guess of a check's length, before one has run)
+FINISH_EARLY = 0.95  # [-] a check is paced to end within this fraction of the ticks before its step begins
 # the rejections that name the largest stride that fits: the legs, or (hyperbolic) the ZMP leaving the feet
 _TOO_LARGE = (UnreachableError, JointLimitError, InfeasiblePatternError)
 
@@ -197,13 +211,21 @@ def _step(planning: Parts[_Plan | None]) -> object:
     return _UNFINISHED
 
 
-def _slices(planning: Parts[_Plan | None], budget: float) -> object:
-    """Parts of a planning until ``budget`` [s] has passed; its result when done, else :data:`_UNFINISHED`."""
-    deadline = time.perf_counter() + budget
+def _slices(job: _Job, budget: float, quota: int) -> object:
+    """Parts of a job's planning: at least ``quota``, and more while the next one, as long as the mean of
+    this tick's, ends within ``budget`` [s]; the planning's result when done, else :data:`_UNFINISHED`."""
+    begin = time.perf_counter()
+    count = 0
     while True:
-        result = _step(planning)
-        if result is not _UNFINISHED or time.perf_counter() >= deadline:
-            return result
+        result = _step(job.planning)
+        count += 1
+        if result is not _UNFINISHED:
+            break
+        elapsed = time.perf_counter() - begin
+        if count >= quota and elapsed * (count + 1) > budget * count:
+            break
+    job.parts += count
+    return result
 
 
 class OnlineWalker:
@@ -243,6 +265,7 @@ class OnlineWalker:
         self._pending: _Plan | None = None
         self._job: _Job | None = None
         self._rejection: tuple[StepCommand, ZmpwalkError, Stance, Boundary] | None = None
+        self._check_parts = 0  # parts the last completed check took
         self._set_standing(self._standing_row(self._stance))
 
     @property
@@ -260,54 +283,58 @@ class OnlineWalker:
         """The command waiting for the step under way to end, if any."""
         return self._pending.command if self._pending else None
 
-    def command(self, command: StepCommand) -> None:
-        """Queue ``command`` after the step under way, replacing a queued one.
+    def command(self, command: StepCommand, *, wait: bool = False) -> None:
+        """Give ``command`` for after the step under way, replacing one given before it started.
 
-        Raises:
-            ZmpwalkError: The command is not feasible from where the walk will
-                be when it starts; the walker is unchanged.
-        """
-        if not isinstance(command, StepCommand):
-            raise InvalidParameterError("command", command, "a StepCommand")
-        stance, boundary = self._stance, self._boundary
-        if boundary.at_rest:
-            boundary = Boundary(max(boundary.time, self.time))
-        try:
-            plan = run_to_end(self._checked(command, stance, boundary, self.rate))
-        except _TOO_LARGE as error:
-            raise self._infeasible(command, stance, boundary, error) from None
-        self._job = None  # a command given now supersedes one still being checked
-        self._pending = plan  # None: a stop while standing
+        Only the command's type is checked here (microseconds); its whole check runs in parts, a few per
+        :meth:`tick` (module docstring). When it completes the command is :attr:`queued`; when it fails
+        the reason is in :attr:`rejection` and the walker goes on as if the command had not been given. A
+        later command replaces one still being checked.
 
-    def submit(self, command: StepCommand) -> None:
-        """Queue ``command`` like :meth:`command`, without planning in the caller's tick.
-
-        Only the command's type is checked here; its whole check runs in parts, a few per :meth:`tick`
-        (module docstring). When it completes the command is :attr:`queued`; when it fails the
-        error is in :attr:`rejection` and the walker goes on as if the command had not been given.
-        A later :meth:`submit` or :meth:`command` replaces one still being checked.
+        Args:
+            command: The step.
+            wait: Check it whole in this call instead (milliseconds), raise if it is rejected, and start a
+                walk from standstill at once rather than :data:`START_DELAY` later.
 
         Raises:
             InvalidParameterError: ``command`` is not a :class:`StepCommand`.
+            ZmpwalkError: With ``wait``: the command is not feasible from where the walk will be when it
+                starts; the walker is unchanged.
         """
         if not isinstance(command, StepCommand):
             raise InvalidParameterError("command", command, "a StepCommand")
         stance, boundary = self._stance, self._boundary
         origin = (stance, boundary)
+        if wait:
+            if boundary.at_rest:
+                boundary = Boundary(max(boundary.time, self.time))
+            try:
+                plan = run_to_end(self._checked(command, stance, boundary, self.rate))
+            except _TOO_LARGE as error:
+                raise self._infeasible(command, stance, boundary, error) from None
+            self._job = None  # a command given now supersedes one still being checked
+            self._rejection = None
+            self._pending = plan  # None: a stop while standing
+            return
         if boundary.at_rest:
             boundary = Boundary(max(boundary.time, self.time + START_DELAY))
+        self._rejection = None
         start = first_sample_at(boundary.time, self.rate)
+        # parts to expect: as many as the last check took, at least a guess from the samples (the step, its
+        # stop and the settle, and from standstill the start stage; blocks of SLICE_ROWS)
+        blocks = math.ceil((3.0 if self._current is not None else 4.0) * command.duration * self.rate / SLICE_ROWS)
+        expected = max(self._check_parts, PARTS_PER_BLOCK * blocks)
         self._job = _Job(command, stance, boundary, start,
-                         self._checked(command, stance, boundary, self.rate, sliced=True), origin)
+                         self._checked(command, stance, boundary, self.rate, sliced=True), origin, expected)
 
     @property
     def checking(self) -> StepCommand | None:
-        """The submitted command whose check is under way, if any."""
+        """The command whose check is under way, if any."""
         return self._job.command if self._job is not None else None
 
     @property
     def rejection(self) -> ZmpwalkError | None:
-        """Why the last submitted command was rejected (None: no rejection since the last submit).
+        """Why the last command was rejected (None: none since the last :meth:`command`).
 
         Where the legs are the cause, the error names the largest stride that fits, searched by bisection
         the first time this is read (tens of milliseconds): read it outside the hard real-time part of the
@@ -322,25 +349,33 @@ class OnlineWalker:
         return error
 
     def _work(self, finish: bool) -> None:
-        """One slice of the submitted command's check (all of it when ``finish``)."""
+        """One slice of the given command's check (all of it when ``finish``)."""
         job = self._job
         if job is None:
             return
         if job.origin[0] is not self._stance or job.origin[1] is not self._boundary:
             # the step it was to follow has changed (a queued command started meanwhile): check it again from
             # the new end of the walk
-            self.submit(job.command)
+            self.command(job.command)
             job = self._job
-            if job is None:  # pragma: no cover - submit always sets a job
+            if job is None:  # pragma: no cover - command() always sets a job
                 return
+        plan: object
         try:
-            plan = run_to_end(job.planning) if finish else _slices(job.planning, WORK_FRACTION / self.rate)
+            if finish:  # every part left, counted
+                plan = _slices(job, math.inf, 0)
+            else:  # paced so that the check ends before its step begins: at least its share of the parts left
+                ticks_left = max(int(FINISH_EARLY * (job.start - self._index)), 1)
+                expected = max(job.expected, job.parts + job.parts // 8 + 1)  # a longer check than expected
+                quota = -(-(expected - job.parts) // ticks_left)
+                plan = _slices(job, WORK_FRACTION / self.rate, quota)
         except ZmpwalkError as error:
             self._job = None
             self._rejection = (job.command, error, job.stance, job.boundary)
             return
         if plan is _UNFINISHED:
             return
+        self._check_parts = job.parts
         self._job = None
         self._rejection = None
         self._pending = plan if isinstance(plan, _Plan) else None
@@ -402,7 +437,7 @@ class OnlineWalker:
         rows = np.empty((max(stop_index - first_index, 0), self._width))
         table = StageTable(stages)
         yield
-        # in slices for submit(); an imported robot's legs in one pass (its base velocities are differences
+        # in slices for command(); an imported robot's legs in one pass (its base velocities are differences
         # along the step)
         size = SLICE_ROWS if sliced and self.robot.legs is None else max(len(rows), 1)
         scalars: list[list[float]] = []
@@ -485,7 +520,7 @@ class OnlineWalker:
             if plan is None:
                 self._current = None
                 return None
-            if index < plan.first_index:  # a walk submitted from standstill begins START_DELAY later
+            if index < plan.first_index:  # a walk commanded from standstill begins START_DELAY later
                 self._current = None
                 return None
             self._pending = None
@@ -536,7 +571,16 @@ class OnlineWalker:
         row[_RIGHT_YAW] = stance.right.yaw
         row[_ZMP] = middle
         row[_SUPPORT] = 0
-        if self.joints:
+        if self.joints and self.robot.legs is None:  # closed-form legs: the scalar IK (microseconds)
+            c, s = math.cos(row[_PELVIS_YAW]), math.sin(row[_PELVIS_YAW])
+            for index, (side, ankle, yaw) in enumerate(((1, row[_LEFT], row[_LEFT_YAW]),
+                                                        (-1, row[_RIGHT], row[_RIGHT_YAW]))):
+                dx, dy, dz = (float(v) for v in ankle - row[_PELVIS])
+                row[15 + 6 * index:21 + 6 * index] = leg_ik_scalar(
+                    Leg.of(self.robot, side), (c * dx + s * dy, c * dy - s * dx, dz), float(yaw - row[_PELVIS_YAW]))
+            check_joint_limits(np.zeros(1), row[None, _JOINTS], self.robot)
+            row[_JOINT_RATES] = 0.0
+        elif self.joints:
             z, one = np.zeros((1, 3)), np.zeros(1)
             trajectory = joint_trajectory(
                 np.zeros(1), row[None, _PELVIS], row[None, _PELVIS_YAW], z, one,

@@ -40,7 +40,6 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -276,55 +275,35 @@ class StageTable:
     def __init__(self, stages: list[Stage]) -> None:
         self.stages = stages
 
-        def column(values: list[float] | list[bool] | list[int]) -> NDArray[Any]:
-            return np.array(values)
-
+        # every per-stage number in one array (one numpy call, not one per column), row j = column j
         plans = [s.plan for s in stages]
-        self.start = column([s.start for s in stages])
-        self.duration = column([s.duration for s in stages])
-        self.dsp = column([s.dsp_time for s in stages])
-        self.swing_left = column([p.swing == LEFT for p in plans])
-        self.standing = column([s.standing for s in stages])
-        self.grounded = column([s.grounded for s in stages])
-        self.support_x = column([p.support_pose.x for p in plans])
-        self.support_y = column([p.support_pose.y for p in plans])
-        self.support_yaw = column([p.support_pose.yaw for p in plans])
-        self.swing_x0 = column([p.swing_start.x for p in plans])
-        self.swing_y0 = column([p.swing_start.y for p in plans])
-        self.swing_yaw0 = column([p.swing_start.yaw for p in plans])
-        self.swing_dyaw = column([p.swing_end.yaw - p.swing_start.yaw for p in plans])
-        dx = column([p.swing_end.x - p.swing_start.x for p in plans])
-        dy = column([p.swing_end.y - p.swing_start.y for p in plans])
+        numbers = np.array([
+            (s.start, s.duration, s.dsp_time, p.support_pose.x, p.support_pose.y, p.support_pose.yaw,
+             p.swing_start.x, p.swing_start.y, p.swing_start.yaw, p.swing_end.yaw - p.swing_start.yaw,
+             p.swing_end.x - p.swing_start.x, p.swing_end.y - p.swing_start.y,
+             0.0 if s.grounded else p.parameters.foot_lift, p.parameters.up_ratio,
+             s.base_start[0], s.base_start[1], s.base_sagittal[0], s.base_sagittal[1],
+             s.base_lateral[0], s.base_lateral[1], s.base_slope_start[0], s.base_slope_start[1],
+             s.base_slope_end[0], s.base_slope_end[1], s.sway_direction[0], s.sway_direction[1],
+             s.sway_amplitude, s.sway_slope_start, s.sway_slope_end, s.sway_out_time, s.sway_back_time)
+            for s, p in zip(stages, plans, strict=True)], dtype=float).reshape(len(stages), 31).T.copy()
+        (self.start, self.duration, self.dsp, self.support_x, self.support_y, self.support_yaw,
+         self.swing_x0, self.swing_y0, self.swing_yaw0, self.swing_dyaw, dx, dy, self.lift, self.up_ratio,
+         self.base0_x, self.base0_y, self.sag_x, self.sag_y, self.lat_x, self.lat_y, self.m0_x, self.m0_y,
+         self.m1_x, self.m1_y, self.n_x, self.n_y, self.amp, self.w0, self.w1, self.out_time,
+         self.back_time) = numbers
+        flags = np.array([(p.swing == LEFT, s.standing, s.grounded, s.quintic, s.lipm is not None)
+                          for s, p in zip(stages, plans, strict=True)], dtype=bool).reshape(len(stages), 5).T.copy()
+        self.swing_left, self.standing, self.grounded, self.quintic, self.hyperbolic = flags
+        self.lat_profile = np.array([s.lateral_profile for s in stages])
         hx, hy = np.cos(self.support_yaw), np.sin(self.support_yaw)
         along = dx * hx + dy * hy
         self.along_x, self.along_y = along * hx, along * hy  # [m] cycloid part (Eq. 11)
         self.across_x, self.across_y = dx - self.along_x, dy - self.along_y  # [m] half-cosine part (Eqs. 14-17)
-        self.lift = column([0.0 if s.grounded else s.plan.parameters.foot_lift for s in stages])
-        self.up_ratio = column([p.parameters.up_ratio for p in plans])
-        self.base0_x = column([s.base_start[0] for s in stages])
-        self.base0_y = column([s.base_start[1] for s in stages])
-        self.sag_x = column([s.base_sagittal[0] for s in stages])
-        self.sag_y = column([s.base_sagittal[1] for s in stages])
-        self.lat_x = column([s.base_lateral[0] for s in stages])
-        self.lat_y = column([s.base_lateral[1] for s in stages])
-        self.lat_profile = column([s.lateral_profile for s in stages])
-        self.m0_x = column([s.base_slope_start[0] for s in stages])
-        self.m0_y = column([s.base_slope_start[1] for s in stages])
-        self.m1_x = column([s.base_slope_end[0] for s in stages])
-        self.m1_y = column([s.base_slope_end[1] for s in stages])
-        self.n_x = column([s.sway_direction[0] for s in stages])
-        self.n_y = column([s.sway_direction[1] for s in stages])
-        self.amp = column([s.sway_amplitude for s in stages])
-        self.w0 = column([s.sway_slope_start for s in stages])
-        self.w1 = column([s.sway_slope_end for s in stages])
-        self.out_time = column([s.sway_out_time for s in stages])
-        self.back_time = column([s.sway_back_time for s in stages])
-        self.quintic = column([s.quintic for s in stages])
-        self.hyperbolic = column([s.lipm is not None for s in stages])
         if self.hyperbolic.any():  # the pieces of each axis of the hyperbolic pelvis, (stages, PIECES)
             unused = np.full(PIECES, np.nan)
             pelvises = [s.lipm for s in stages]
-            self.lipm_yaw = column([p.yaw if p else 0.0 for p in pelvises])
+            self.lipm_yaw = np.array([p.yaw if p else 0.0 for p in pelvises])
             self.lipm_axes = [
                 [np.array([getattr(getattr(p, axis), name) if p else unused for p in pelvises], dtype=float)
                  for name in ("starts", "position", "velocity", "zmp")]
@@ -385,6 +364,7 @@ def evaluate_in_parts(table: StageTable, time: Array, robot: RobotModel,
     s = np.clip(raw, 0.0, 1.0)
     rate = in_swing / swing_span
     b, b1, c, c1 = _blend_and_cycloid(s)
+    yield
     h, h1, _ = curves.lift_profile(s, table.up_ratio[k])
     yield
     b1 *= rate
@@ -420,11 +400,13 @@ def evaluate_in_parts(table: StageTable, time: Array, robot: RobotModel,
     if np.any(table.lat_profile != SHIFT_NONE):
         q, q1, q2 = _mixed(lambda t, p: side_shift_profile(t, p, False), lambda t, p: side_shift_profile(t, p, True),
                            quintic, tau, table.lat_profile[k])
+        yield
         for component in components:
             lat_k = component[3][k]
             component[0] = component[0] + lat_k * q
             component[1] = component[1] + lat_k * q1
             component[2] = component[2] + lat_k * q2
+            yield
     yield
     # --- pelvis sway: Eqs. 18-20 on the modified time t_bar (sigma = 2 t_bar, or 2 t_bar - 1)
     amp = table.amp[k]
@@ -437,12 +419,14 @@ def evaluate_in_parts(table: StageTable, time: Array, robot: RobotModel,
     m_start = np.where(first_half, table.w0[k], 0.0)
     p_end = np.where(second_half, 0.0, amp)
     m_end = np.where(second_half, table.w1[k], 0.0)
+    yield
     sway, sway1, sway2 = _mixed(curves.hermite_cubic, curves.hermite_quintic, quintic,
                                 p_start, m_start, p_end, m_end, sigma)
     scale = np.where(first_half, 1.0 / out_time, np.where(second_half, 1.0 / back_time, 0.0))  # d sigma/dt
     sway = np.where(first_half | second_half, sway, amp)
     sway1 = sway1 * scale
     sway2 = sway2 * scale * scale
+    yield
     inv_T = 1.0 / T
     inv_T2 = inv_T * inv_T
     nx, ny = table.n_x[k], table.n_y[k]
@@ -462,6 +446,7 @@ def evaluate_in_parts(table: StageTable, time: Array, robot: RobotModel,
     left_position = np.column_stack([
         np.where(left_swings, swing_x, support_x), np.where(left_swings, swing_y, support_y),
         np.where(left_swings, swing_z, ankle)])
+    yield
     right_position = np.column_stack([
         np.where(left_swings, support_x, swing_x), np.where(left_swings, support_y, swing_y),
         np.where(left_swings, ankle, swing_z)])
