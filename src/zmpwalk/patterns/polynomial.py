@@ -177,36 +177,41 @@ class Stage:
 def build_stage(plan: StagePlan, boundary: Boundary, quintic: bool = False) -> Stage:
     """Fix a stage's trajectories from its plan and the inherited boundary state (``quintic``: the
     jerk-continuous pelvis curves, same boundary positions and velocities)."""
+    # plain floats throughout (a stage is planned in a control loop's tick: numpy's per-call cost on 2-vectors
+    # would be most of it)
     p = plan.parameters
     T = plan.duration
     support = plan.support_pose
-    n = np.array([-math.sin(support.yaw), math.cos(support.yaw)])
+    nx, ny = -math.sin(support.yaw), math.cos(support.yaw)  # unit vector across the support foot
     toward_support = 1.0 if plan.swing != LEFT else -1.0  # support is left when the right foot swings
     out_time, back_time = sway_times(plan)
     half_time_scale = back_time  # [s] per unit of 2*t_bar of the returning cubic
-    v_prev = np.array(boundary.pelvis_velocity)
-    sway_prev = np.array(boundary.sway_velocity)
-    w0 = float(sway_prev @ n)  # [m/s] sway speed inherited along this stage's direction
+    v_prev_x, v_prev_y = boundary.pelvis_velocity
+    w0 = boundary.sway_velocity[0] * nx + boundary.sway_velocity[1] * ny  # [m/s] sway speed along n
     if plan.stop:
         w1 = 0.0
-        v1 = np.zeros(2)
+        v1x = v1y = 0.0
     else:
         w1 = -toward_support * p.alpha1 * p.lateral_velocity / half_time_scale  # [m/s], Eq. 20
         yaw_end = 0.5 * (support.yaw + plan.swing_end.yaw)
-        v1 = p.alpha * plan.forward / T * np.array([math.cos(yaw_end), math.sin(yaw_end)])  # Eq. 13
-    middle_start = 0.5 * (np.array([support.x, support.y]) + [plan.swing_start.x, plan.swing_start.y])
-    middle_end = 0.5 * (np.array([support.x, support.y]) + [plan.swing_end.x, plan.swing_end.y])
-    shift = middle_end - middle_start
+        speed = p.alpha * plan.forward / T  # Eq. 13
+        v1x, v1y = speed * math.cos(yaw_end), speed * math.sin(yaw_end)
+    middle_start = (0.5 * (support.x + plan.swing_start.x), 0.5 * (support.y + plan.swing_start.y))
+    middle_end_x, middle_end_y = 0.5 * (support.x + plan.swing_end.x), 0.5 * (support.y + plan.swing_end.y)
+    shift_x, shift_y = middle_end_x - middle_start[0], middle_end_y - middle_start[1]
     profile = SHIFT_PROFILES.get(plan.kind, SHIFT_NONE)
-    lateral = float(shift @ n) * n if profile != SHIFT_NONE else np.zeros(2)
-    sagittal = shift - lateral
+    across = shift_x * nx + shift_y * ny if profile != SHIFT_NONE else 0.0
+    lateral = (across * nx, across * ny)
+    sagittal = (shift_x - lateral[0], shift_y - lateral[1])
     lateral_rate_start, lateral_rate_end = (QUINTIC_SHIFT_END_RATES if quintic else SHIFT_END_RATES)[profile]
-    v0_base = v_prev - w0 * n - lateral * lateral_rate_start / T
-    v_end = v1 + lateral * lateral_rate_end / T + w1 * n  # total pelvis velocity at t2
+    v0_base = (v_prev_x - w0 * nx - lateral[0] * lateral_rate_start / T,
+               v_prev_y - w0 * ny - lateral[1] * lateral_rate_start / T)
+    v_end = (v1x + lateral[0] * lateral_rate_end / T + w1 * nx,
+             v1y + lateral[1] * lateral_rate_end / T + w1 * ny)  # total pelvis velocity at t2
     end = Boundary(
         time=boundary.time + T,
-        pelvis_velocity=_pair(v_end),
-        sway_velocity=(float(w1 * n[0]), float(w1 * n[1])),
+        pelvis_velocity=v_end,
+        sway_velocity=(w1 * nx, w1 * ny),
         at_rest=plan.stop,
     )
     return Stage(
@@ -214,13 +219,13 @@ def build_stage(plan: StagePlan, boundary: Boundary, quintic: bool = False) -> S
         start=boundary.time,
         duration=T,
         dsp_time=p.dsp_time,
-        base_start=_pair(middle_start),
-        base_sagittal=_pair(sagittal),
-        base_lateral=_pair(lateral),
+        base_start=middle_start,
+        base_sagittal=sagittal,
+        base_lateral=lateral,
         lateral_profile=profile,
-        base_slope_start=_pair(v0_base * T),
-        base_slope_end=_pair(v1 * T),
-        sway_direction=_pair(n),
+        base_slope_start=(v0_base[0] * T, v0_base[1] * T),
+        base_slope_end=(v1x * T, v1y * T),
+        sway_direction=(nx, ny),
         sway_amplitude=toward_support * p.beta1 * p.sway,
         sway_slope_start=w0 * out_time,
         sway_slope_end=w1 * back_time,
