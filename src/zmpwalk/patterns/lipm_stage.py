@@ -208,7 +208,8 @@ def lipm_pelvis_in_parts(plan: StagePlan, position: tuple[float, float], velocit
                          robot: RobotModel, next_plan: StagePlan | None = None
                          ) -> Parts[tuple[LipmPelvis, tuple[float, float], tuple[float, float]]]:
     """The hyperbolic pelvis of one stage from the inherited state (see the module docstring).
-    In parts (the pendulum, then the ZMP check span by span; :mod:`zmpwalk.slices`); :func:`lipm_pelvis` runs it whole.
+    In parts (the targets, each axis of the pendulum, then the ZMP check span by span; :mod:`zmpwalk.slices`);
+    :func:`lipm_pelvis` runs it whole.
 
     Args:
         plan: The stage's footsteps and timing.
@@ -255,6 +256,7 @@ def lipm_pelvis_in_parts(plan: StagePlan, position: tuple[float, float], velocit
             target_p, target_v = steady_state(plan.swing_end, plan.swing, plan.support_pose, plan.forward, T, d,
                                               _drift(plan), robot)
         target_dcm = target_p + target_v / a
+    yield
     axes = []
     for direction, pieces, nominal in ((heading, along_pieces, along_nominal), (left, across_pieces, across_nominal)):
         x, v = float(p0 @ direction), float(v0 @ direction)
@@ -264,6 +266,7 @@ def lipm_pelvis_in_parts(plan: StagePlan, position: tuple[float, float], velocit
             centre = float(sole @ direction)
             zmps = dcm_zmps(a, x, v, pieces, (centre + nominal[0], centre + nominal[1]), float(target_dcm @ direction))
         axes.append(_axis(a, x, v, pieces, zmps))
+        yield
     (along, (u_end, du_end)), (across, (w_end, dw_end)) = axes
     end_position = u_end * heading + w_end * left
     end_velocity = du_end * heading + dw_end * left
@@ -276,9 +279,10 @@ def lipm_pelvis_in_parts(plan: StagePlan, position: tuple[float, float], velocit
 lipm_pelvis = whole(lipm_pelvis_in_parts, "lipm_pelvis")  # the same, run whole
 
 
-def axis_at(a: float, axis_starts: Array, position: Array, velocity: Array, zmp: Array, elapsed: Array
-            ) -> tuple[Array, Array, Array]:
+def axis_at_in_parts(a: float, axis_starts: Array, position: Array, velocity: Array, zmp: Array, elapsed: Array
+                     ) -> Parts[tuple[Array, Array, Array]]:
     """Position [m], velocity [m/s] and acceleration [m/s^2] of axes at ``elapsed`` [s] from their stage start.
+    In two parts (each sample's piece, then the pendulum; :mod:`zmpwalk.slices`).
 
     Args:
         a: ``sqrt(g / z_b)`` [1/s].
@@ -293,6 +297,7 @@ def axis_at(a: float, axis_starts: Array, position: Array, velocity: Array, zmp:
     x0, v0, c = position[rows, index], velocity[rows, index], zmp[rows, index]
     coasting = np.isnan(c)
     c = np.where(coasting, 0.0, c)
+    yield
     ch, sh = np.cosh(a * tau), np.sinh(a * tau)
     hyper_x = (x0 - c) * ch + v0 / a * sh + c  # Eq. 5
     hyper_v = (x0 - c) * a * sh + v0 * ch

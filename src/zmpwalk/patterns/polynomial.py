@@ -49,7 +49,7 @@ from zmpwalk.commands import MAX_STRIDE, MAX_TURN, StepCommand
 from zmpwalk.errors import InfeasibleCommandError, InvalidParameterError, UnreachableError, ZmpwalkError
 from zmpwalk.footsteps import GROUNDED_STRETCH, LEFT, Pose2D, StagePlan, Stance, grounded_stage, plan_command
 from zmpwalk.kinematics import check_leg_reach
-from zmpwalk.patterns.lipm_stage import PIECES, LipmPelvis, axis_at, lipm_pelvis_in_parts
+from zmpwalk.patterns.lipm_stage import PIECES, LipmPelvis, axis_at_in_parts, lipm_pelvis_in_parts
 from zmpwalk.patterns.result import (
     SUPPORT_DOUBLE,
     SUPPORT_LEFT,
@@ -466,8 +466,9 @@ def evaluate_in_parts(table: StageTable, time: Array, robot: RobotModel,
     support = np.where(in_swing, np.where(left_swings, SUPPORT_RIGHT, SUPPORT_LEFT), SUPPORT_DOUBLE)
     yield
     if table.hyperbolic.any():
-        pelvis_x, pelvis_y, pelvis_vx, pelvis_vy, pelvis_ax, pelvis_ay = _hyperbolic_pelvis(
+        pelvis_x, pelvis_y, pelvis_vx, pelvis_vy, pelvis_ax, pelvis_ay = yield from _hyperbolic_pelvis(
             table, k, elapsed, robot, (pelvis_x, pelvis_y, pelvis_vx, pelvis_vy, pelvis_ax, pelvis_ay))
+        yield
     l_over_g = robot.pendulum_length / robot.gravity
     zmp = np.column_stack([pelvis_x - l_over_g * pelvis_ax, pelvis_y - l_over_g * pelvis_ay])  # Eqs. 1-2
     return Samples(
@@ -485,12 +486,15 @@ evaluate = whole(evaluate_in_parts, "evaluate")  # the same, run whole
 
 
 def _hyperbolic_pelvis(table: StageTable, k: NDArray[np.intp], elapsed: Array, robot: RobotModel,
-                       curves_xy: tuple[Array, ...]) -> tuple[Array, ...]:
-    """Pelvis x, y, their rates and accelerations: the hyperbolic pelvis where a stage has one, else ``curves_xy``."""
+                       curves_xy: tuple[Array, ...]) -> Parts[tuple[Array, ...]]:
+    """Pelvis x, y, their rates and accelerations: the hyperbolic pelvis where a stage has one, else ``curves_xy``.
+    In parts (each axis, then the turn to world)."""
     a = math.sqrt(robot.gravity / robot.pendulum_length)
-    (u, du, ddu), (w, dw, ddw) = (
-        axis_at(a, starts[k], position[k], velocity[k], zmp[k], elapsed)
-        for starts, position, velocity, zmp in table.lipm_axes)
+    axes = []
+    for starts, position, velocity, zmp in table.lipm_axes:
+        axes.append((yield from axis_at_in_parts(a, starts[k], position[k], velocity[k], zmp[k], elapsed)))
+        yield
+    (u, du, ddu), (w, dw, ddw) = axes
     c, s = np.cos(table.lipm_yaw[k]), np.sin(table.lipm_yaw[k])  # the supporting foot's frame to world
     hyperbolic = table.hyperbolic[k]
     world = (u * c - w * s, u * s + w * c, du * c - dw * s, du * s + dw * c, ddu * c - ddw * s, ddu * s + ddw * c)
