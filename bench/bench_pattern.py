@@ -1,4 +1,6 @@
-"""Speed of the HUBO pattern: OnlineWalker.tick() at 100 Hz and 1 kHz, and a 100-step walk at 1 kHz.
+"""Speed of the HUBO pattern: OnlineWalker.tick() at 100 Hz and 1 kHz, the batch walks at 1 kHz, and the
+control loop at 1 kHz with joints, every iteration timed; PlaCo's walking loop side by side when PlaCo is
+installed (bench/placo_walk.py; optional, not a dependency).
 
 Run: python bench/bench_pattern.py. Prints figures; asserts nothing.
 """
@@ -6,8 +8,10 @@ Run: python bench/bench_pattern.py. Prints figures; asserts nothing.
 from __future__ import annotations
 
 import gc
+import importlib.util
 import statistics
 import time
+from importlib.metadata import version
 
 import numpy as np
 
@@ -116,6 +120,15 @@ def main() -> None:
         print(f"  with {name:24}: iterations {_figures(loop)}")
         print(f"  {'':30}{name} alone: median {np.median(given):.1f} us, max {given.max():.1f} us "
               f"({len(given)} commands)")
+    if importlib.util.find_spec("placo") is None:
+        print("PlaCo side by side: skipped (pip install placo to run it)")
+        return
+    from placo_walk import placo_loop
+
+    loop, distance = placo_loop(60.0)
+    print(f"  PlaCo {version('placo')} (its walking example's loop on HUBO's box model: trajectory, whole-body IK "
+          f"QP, a replan with the next command every 10 planning steps; walked {distance:.2f} m):")
+    print(f"  {'':30}iterations {_figures(loop)}")
 
 
 if __name__ == "__main__":
