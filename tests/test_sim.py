@@ -163,6 +163,22 @@ def test_disturbances_tilt_gravity_scale_masses_and_push_in_their_window():
             Disturbances(**fields)
 
 
+def test_the_reference_zmp_of_the_standing_before_a_walk_is_under_the_com():
+    """Standing still during the settle the ZMP is under the CoM (Eqs. 1-2 with no acceleration), not the walk's
+    first ZMP: the paper walk of Lim et al. starts with its ZMP 38 mm from the CoM (the start transient)."""
+    robot = load_robot("mju-biped")
+    pattern = paper_walk(robot, steps=2).sample(1000.0)
+    start_offset = np.linalg.norm(pattern.zmp_in_world[0] - pattern.position_pelvis_in_world[0, :2])
+    assert start_offset > 0.03  # [m]
+    result = simulate(robot, pattern_joint_trajectory(pattern), pattern, settle=0.2, hold=0.0)
+    before = result.time < pattern.time[0]
+    assert before.sum() == 200
+    np.testing.assert_array_equal(result.reference_zmp[before],
+                                  np.broadcast_to(pattern.position_pelvis_in_world[0, :2], (200, 2)))
+    first = int(np.argmax(~before))
+    np.testing.assert_allclose(result.reference_zmp[first], pattern.zmp_in_world[0], atol=1e-12)
+
+
 def test_loaded_soles_on_a_tilted_floor_do_not_creep():
     """On a 2 degree floor gravity pulls along the floor at the soles all the time; MuJoCo's soft contacts let a
     sole creep under it (the noslip solver runs on a tilted floor, Disturbances.apply). HUBO standing 2 s on

@@ -300,6 +300,12 @@ def simulate(
     pattern_time = np.clip(time, pattern.time[0], pattern.time[-1])
     reference = np.column_stack([np.interp(pattern_time, joints.time, joints.angles[:, j]) for j in range(12)])
     zmp_ref = np.column_stack([np.interp(pattern_time, pattern.time, pattern.zmp_in_world[:, i]) for i in range(2)])
+    # Standing still before the walk the ZMP is under the CoM (c'' = 0 in p = c - c'' l / g, Eqs. 1-2); the
+    # pattern's first sample is already the walk's (a start stage that accelerates, the start transient of
+    # Lim et al. whose ZMP jumps), which neither the feedforward nor the stabilizer may hold during the settle.
+    planned_com = pattern.position_pelvis_in_world if pattern.position_com_in_world is None \
+        else pattern.position_com_in_world
+    zmp_ref[time < pattern.time[0]] = planned_com[0, :2]
     base_planned = (pattern.position_pelvis_in_world if joints.position_base_in_world is None
                     else joints.position_base_in_world)
     set_initial_state(plant, data, base_planned[0], float(pattern.yaw_pelvis_in_world[0]), reference[0], penetration)
