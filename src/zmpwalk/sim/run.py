@@ -249,6 +249,7 @@ def simulate(
             (:func:`zmpwalk.sim.mjcf.robot_mjcf`; box models only).
         settle: Time the first pose is held before the walk [s] (the robot settles onto its soles; default
             :data:`SETTLE` for a robot's own model, 0 for the box models, which start at rest on their soles).
+            Standing still, its reference ZMP is the CoM's ground point, not the walk's first ZMP.
         hold: Time the last pose is held after the walk [s] (does it end standing still?; default :data:`HOLD`
             for a robot's own model, 0 for the box models).
         feedforward: Add the feedforwards of :func:`zmpwalk.sim.plant.static_feedforward` (gravity and the
