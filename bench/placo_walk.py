@@ -25,40 +25,40 @@ import numpy as np
 
 from zmpwalk import load_robot
 from zmpwalk.kinematics import LEG_JOINTS
-from zmpwalk.robots.model import RobotModel
+from zmpwalk.robots.model import Link, RobotModel
+from zmpwalk.sim.mjcf import SMALL_FRACTION
 
 AXES = {"hip_yaw": "0 0 1", "hip_roll": "1 0 0", "hip_pitch": "0 1 0", "knee": "0 1 0", "ankle_pitch": "0 1 0",
         "ankle_roll": "1 0 0"}
 COMMANDS = [(0.2, 0.0, 0.0), (0.1, 0.0, 0.1), (0.0, 0.05, 0.0), (0.15, 0.0, 0.0), (0.1, 0.0, 0.0)]  # dx, dy, dtheta
 
 
-def _inertial(mass: float, size: tuple[float, float, float], com: tuple[float, float, float]) -> str:
-    """A uniform box's mass properties [kg, m] as a URDF ``<inertial>``."""
-    x, y, z = size
-    return (f'<inertial><origin xyz="{com[0]} {com[1]} {com[2]}"/><mass value="{mass}"/>'
-            f'<inertia ixx="{mass * (y * y + z * z) / 12}" iyy="{mass * (x * x + z * z) / 12}" '
-            f'izz="{mass * (x * x + y * y) / 12}" ixy="0" ixz="0" iyz="0"/></inertial>')
+def _inertial(link: Link) -> str:
+    """A link's mass properties (a uniform box) as a URDF ``<inertial>``."""
+    ixx, iyy, izz = link.inertia
+    return (f'<inertial><origin xyz="{link.com[0]} {link.com[1]} {link.com[2]}"/><mass value="{link.mass}"/>'
+            f'<inertia ixx="{ixx}" iyy="{iyy}" izz="{izz}" ixy="0" ixz="0" iyz="0"/></inertial>')
 
 
 def box_urdf(robot: RobotModel) -> str:
     """HUBO's box model (a robot file with ``[bodies]``) as URDF text."""
     links = robot.links
-    small, tiny = 0.05 * links["thigh"].mass, (0.01, 0.01, 0.01)
-    torso = links["torso"]
-    parts = [f'<robot name="{robot.name}">',
-             f'<link name="trunk">{_inertial(torso.mass, torso.size, torso.com)}</link>']
+    small = links["thigh"].mass * SMALL_FRACTION  # the joint-only links, as in zmpwalk.sim.mjcf
+    joint_only = Link(small, (0.01, 0.01, 0.01), (0.0, 0.0, 0.0))
+    parts = [f'<robot name="{robot.name}">', f'<link name="trunk">{_inertial(links["torso"])}</link>']
     for side, label in ((1, "left"), (-1, "right")):
         offsets = {"hip_yaw": (0.0, side * robot.hip_spacing / 2, -robot.hip_drop),
                    "knee": (0.0, 0.0, -robot.thigh_length), "ankle_pitch": (0.0, 0.0, -robot.shank_length)}
-        bodies = {"hip_pitch": links["thigh"], "knee": links["shank"], "ankle_roll": links["foot"]}
+        thigh, foot = links["thigh"], links["foot"]
+        bodies = {"hip_pitch": Link(thigh.mass - 2 * small, thigh.size, thigh.com), "knee": links["shank"],
+                  "ankle_roll": Link(foot.mass - small, foot.size, (foot.com[0], side * foot.com[1], foot.com[2]))}
         parent = "trunk"
         for role in LEG_JOINTS:
             child = f"{label}_{role}_link"
-            body = bodies.get(role)
-            mass, size, com = (small, tiny, (0.0, 0.0, 0.0)) if body is None else (body.mass, body.size, body.com)
+            body = bodies.get(role, joint_only)
             lower, upper = robot.limits_of(f"{label}_{role}")
             x, y, z = offsets.get(role, (0.0, 0.0, 0.0))
-            parts += [f'<link name="{child}">{_inertial(mass, size, com)}</link>',
+            parts += [f'<link name="{child}">{_inertial(body)}</link>',
                       f'<joint name="{label}_{role}" type="revolute"><parent link="{parent}"/><child link="{child}"/>'
                       f'<origin xyz="{x} {y} {z}"/><axis xyz="{AXES[role]}"/>'
                       f'<limit lower="{max(lower, -3.1)}" upper="{min(upper, 3.1)}" effort="1000" velocity="100"/>'
