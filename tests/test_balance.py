@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from zmpwalk import balance_kernel as kernel
 from zmpwalk.balance import BalanceMeasurement, Stabilizer, StabilizerGains
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import InvalidParameterError
@@ -78,28 +79,42 @@ KINEMATICS_TOL = 1e-12  # [m], [-], [m/rad]
 
 
 @pytest.mark.parametrize("name", ["hubo", "talos"])
-def test_the_ticks_batched_kinematics_are_each_legs_own(name: str) -> None:
-    """The stabilizer computes both legs' kinematics (measured and reference poses) in one batch; it must be
-    each leg chain's own product of exponentials and Jacobian."""
+def test_the_ticks_compiled_kinematics_are_each_legs_own(name: str) -> None:
+    """The stabilizer's compiled tick computes each leg's product of exponentials, ankle point and Jacobian
+    from the role-ordered joint columns; they must be each leg chain's own."""
     if name == "talos" and not TALOS.is_file():
         pytest.skip("../shared/robots is absent")
     robot = load_robot(TALOS if name == "talos" else name)
     stabilizer = Stabilizer(robot, 1000.0)
     chains = leg_chains(robot)
     rng = np.random.default_rng(7)
-    references = np.array([c.reference for c in (chains[0], chains[0], chains[1], chains[1])])
+    frames = np.zeros((7, 12))
+    jacobian = np.zeros((6, 6))
     for _ in range(20):
-        poses = references + rng.normal(0, 0.3, (4, 6))
-        rotations, translations = stabilizer._kinematics(poses)
-        ankles = translations[:, 6] + (rotations[:, 6] @ stabilizer._ankles[:, :, None])[:, :, 0]
-        jacobians = stabilizer._jacobians(rotations, translations, ankles)
-        for row, chain in enumerate((chains[0], chains[0], chains[1], chains[1])):
-            own_rotations, own_translations = chain.transforms(poses[row][None])
-            assert np.abs(rotations[row] - own_rotations[0]).max() < KINEMATICS_TOL
-            assert np.abs(translations[row] - own_translations[0]).max() < KINEMATICS_TOL
-            assert np.abs(ankles[row] - chain.fk(poses[row][None])[0][0]).max() < KINEMATICS_TOL
-            if row % 2:
-                assert np.abs(jacobians[row // 2] - chain.jacobian(poses[row][None])[0]).max() < KINEMATICS_TOL
+        columns = np.zeros(12)  # role-ordered, as the pattern and the encoders give them
+        for leg, chain in enumerate(chains):
+            columns[6 * leg:6 * leg + 6] = (np.asarray(chain.reference) + rng.normal(0, 0.3, 6))[
+                list(chain.role_order)]
+        for leg, chain in enumerate(chains):
+            pose = columns[6 * leg:6 * leg + 6][np.argsort(chain.role_order)][None]  # chain-ordered
+            kernel.leg_kinematics(stabilizer._chain, leg, columns, frames)
+            ankle = kernel.ankle_in_base(stabilizer._params, leg, frames)
+            kernel.leg_jacobian(stabilizer._chain, leg, frames, ankle, jacobian)
+            own_rotations, own_translations = chain.transforms(pose)
+            assert np.abs(frames[:, :9].reshape(7, 3, 3) - own_rotations[0]).max() < KINEMATICS_TOL
+            assert np.abs(frames[:, 9:] - own_translations[0]).max() < KINEMATICS_TOL
+            assert np.abs(np.array(ankle) - chain.fk(pose)[0][0]).max() < KINEMATICS_TOL
+            assert np.abs(jacobian - chain.jacobian(pose)[0]).max() < KINEMATICS_TOL
+
+
+def test_the_compiled_solve_inverts_a_random_matrix() -> None:
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        a = rng.normal(size=(6, 6))
+        x = rng.normal(size=6)
+        b = a @ x
+        kernel.solve6(a.copy(), b)
+        assert np.abs(b - x).max() < 1e-9 * max(1.0, np.linalg.cond(a) / 1e3)
 
 
 def test_a_perfect_measurement_changes_nothing() -> None:
@@ -205,6 +220,32 @@ def test_bad_gains_are_rejected(field: str) -> None:
         Stabilizer(load_robot("hubo"), 5.0)
 
 
+def test_inputs_as_lists_give_the_same_targets_and_bad_inputs_are_rejected_leaving_the_state() -> None:
+    """The tick takes float64 vectors; lists and other dtypes are converted (same targets), short vectors and a
+    support other than 0, 1, 2 raise an InvalidParameterError naming the input, and the state is as it was."""
+    stabilizer, inputs, _ = standing()
+    twin = Stabilizer(stabilizer.robot, 1000.0)
+    run(stabilizer, inputs, 20, cop_shift=(0.01, -0.005))
+    run(twin, inputs, 20, cop_shift=(0.01, -0.005))
+    measurement = measured(stabilizer, inputs, cop_shift=(0.01, -0.005))
+    as_lists = {**inputs, "position_com_in_world": list(np.asarray(inputs["position_com_in_world"])),
+                "joint_angles": np.asarray(inputs["joint_angles"]).tolist()}
+    listed = BalanceMeasurement(list(measurement.wrench_left), measurement.wrench_right[::1], [0.0, 0.0],
+                                np.zeros(3, dtype=np.float32), list(measurement.joint_angles))
+    expected = stabilizer.update(**inputs, measurement=measurement).copy()  # type: ignore[arg-type]
+    assert np.abs(twin.update(**as_lists, measurement=listed) - expected).max() < 1e-12  # type: ignore[arg-type]
+    state = stabilizer._state.copy()
+    short = BalanceMeasurement(measurement.wrench_left[:5], measurement.wrench_right, measurement.attitude,
+                               measurement.rate, measurement.joint_angles)
+    with pytest.raises(InvalidParameterError, match=r"measurement\.wrench_left.*5 values.*6 values"):
+        stabilizer.update(**inputs, measurement=short)  # type: ignore[arg-type]
+    with pytest.raises(InvalidParameterError, match="support"):
+        stabilizer.update(**{**inputs, "support": 3}, measurement=measurement)  # type: ignore[arg-type]
+    with pytest.raises(InvalidParameterError, match="zmp_in_world"):
+        stabilizer.update(**{**inputs, "zmp_in_world": ["a", 0.0]}, measurement=measurement)  # type: ignore[arg-type]
+    assert np.array_equal(stabilizer._state, state)
+
+
 def test_stabilizer_carries_hubo_on_soft_servos() -> None:
     from zmpwalk.scenarios import load_scenario
     from zmpwalk.sim import simulate
@@ -272,7 +313,7 @@ def test_a_torso_turned_from_its_plan_turns_the_swinging_foot_back_to_its_planne
     assert angles[right_hip_yaw] - reference[right_hip_yaw] == pytest.approx(-0.05, abs=2e-3)  # [rad]
     plain, inputs, _ = standing()
     run(plain, {**inputs, "support": 1}, 3000, loads=(2.0, 0.0))
-    assert plain._landing_yaw == [0.0, 0.0]
+    assert np.all(plain._landing_yaw == 0.0)
 
 
 T1 = Path(__file__).resolve().parents[2] / "shared" / "robots" / "booster_t1" / "scene.xml"
