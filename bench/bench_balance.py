@@ -93,8 +93,8 @@ def stabilizer_cost() -> str:
                           joint_angles=joints.angles[k], measurement=measurement)
         ticks.append(time.perf_counter() - start)
     cost = np.array(ticks) * 1e6
-    return (f"stabilizer update, HUBO, {len(cost)} ticks: median {np.median(cost):.0f} us, p99 "
-            f"{np.percentile(cost, 99):.0f} us, max {cost.max():.0f} us")
+    return (f"stabilizer update, HUBO, {len(cost)} ticks: median {np.median(cost):.1f} us, p99 "
+            f"{np.percentile(cost, 99):.1f} us, p99.9 {np.percentile(cost, 99.9):.0f} us, max {cost.max():.0f} us")
 
 
 def main() -> None:

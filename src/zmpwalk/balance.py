@@ -57,7 +57,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -207,6 +206,7 @@ class Stabilizer:
 
         self._kernel = kernel
         self._tick = kernel.tick
+        self._convert = False  # convert the inputs before each tick (set once some were not float64 vectors)
         self.robot = robot
         self.gains = gains or StabilizerGains()
         self.dt = 1.0 / float(rate)
@@ -312,16 +312,26 @@ class Stabilizer:
         """
         m = measurement
         measured_yaw = math.nan if m.yaw is None else m.yaw
+        com, zmp, left, right = position_com_in_world, zmp_in_world, ankles_in_world[0], ankles_in_world[1]
+        wl, wr, attitude, rate, encoders = m.wrench_left, m.wrench_right, m.attitude, m.rate, m.joint_angles
+        if self._convert:
+            com, zmp, left, right, joint_angles, wl, wr, attitude, rate, encoders = _vectors(
+                com, zmp, left, right, joint_angles, wl, wr, attitude, rate, encoders)
         try:
             status = self._tick(self._params, self._chain, self._state, self._log, self._work, self._targets, support,
-                                position_com_in_world, yaw_pelvis_in_world, zmp_in_world, ankles_in_world[0],
-                                ankles_in_world[1], foot_yaws[0], foot_yaws[1], joint_angles, m.wrench_left,
-                                m.wrench_right, m.attitude, m.rate, m.joint_angles, measured_yaw)
-        except TypeError:  # not all inputs are C-contiguous float64 vectors and numbers: convert them
+                                com, yaw_pelvis_in_world, zmp, left, right, foot_yaws[0], foot_yaws[1], joint_angles,
+                                wl, wr, attitude, rate, encoders, measured_yaw)
+        except TypeError:
+            # Not every input is a float64 vector or a number (numba's dispatch checks them in C, at no cost):
+            # convert them, at this tick and every later one (the failed dispatch costs a few hundred µs).
+            self._convert = True
+            com, zmp, left, right, joint_angles, wl, wr, attitude, rate, encoders = _vectors(
+                com, zmp, left, right, joint_angles, wl, wr, attitude, rate, encoders)
             status = self._tick(self._params, self._chain, self._state, self._log, self._work, self._targets,
-                                _integer("support", support), *_inputs(
-                                    position_com_in_world, yaw_pelvis_in_world, zmp_in_world, ankles_in_world,
-                                    foot_yaws, joint_angles, m, measured_yaw))
+                                _integer("support", support), com, _number("yaw_pelvis_in_world", yaw_pelvis_in_world),
+                                zmp, left, right, _number("foot_yaws[0]", foot_yaws[0]),
+                                _number("foot_yaws[1]", foot_yaws[1]), joint_angles, wl, wr, attitude, rate, encoders,
+                                _number("measurement.yaw", measured_yaw))
         if status:
             self._raise(status, position_com_in_world, zmp_in_world, ankles_in_world, joint_angles, m, support)
         self.state.height_difference = float(self._log[self._kernel.L_HEIGHT_DIFFERENCE])
@@ -330,12 +340,23 @@ class Stabilizer:
     def _raise(self, status: int, com: Array, zmp: Array, ankles: tuple[Array, Array], angles: Array,
                m: BalanceMeasurement, support: int) -> None:
         kernel = self._kernel
-        if status > len(kernel.BAD_INPUTS):
+        if status == kernel.BAD_SUPPORT:
             raise InvalidParameterError("support", support, "0 (double), 1 (left) or 2 (right)")
         given = (com, zmp, ankles[0], ankles[1], angles, m.wrench_left, m.wrench_right, m.attitude, m.rate,
                  m.joint_angles)[status - 1]
-        raise InvalidParameterError(kernel.BAD_INPUTS[status - 1], f"{np.size(given)} values",
-                                    f"{kernel.INPUT_SIZES[status - 1]} values")
+        raise InvalidParameterError(INPUT_NAMES[status - 1], f"{np.size(given)} values",
+                                    f"{INPUT_SIZES[status - 1]} values")
+
+
+INPUT_NAMES = ("position_com_in_world", "zmp_in_world", "ankles_in_world[0]", "ankles_in_world[1]", "joint_angles",
+               "measurement.wrench_left", "measurement.wrench_right", "measurement.attitude", "measurement.rate",
+               "measurement.joint_angles")  # the update's vector inputs, in the kernel's order
+INPUT_SIZES = (3, 2, 3, 3, 12, 6, 6, 2, 3, 12)
+
+
+def _vectors(*values: object) -> tuple[Array, ...]:
+    """The update's vector inputs (in the order of :data:`INPUT_NAMES`) as float64 vectors."""
+    return tuple(_vector(name, value) for name, value in zip(INPUT_NAMES, values, strict=True))
 
 
 def _integer(name: str, value: object) -> int:
@@ -356,18 +377,6 @@ def _number(name: str, value: object) -> float:
         return float(value)  # type: ignore[arg-type]
     except (TypeError, ValueError):
         raise InvalidParameterError(name, value, "a number") from None
-
-
-def _inputs(com: object, yaw: object, zmp: object, ankles: tuple[object, object], foot_yaws: tuple[object, object],
-            angles: object, m: BalanceMeasurement, measured_yaw: object) -> tuple[Any, ...]:
-    """The kernel's arguments after ``support`` as C-contiguous float64 vectors and floats."""
-    return (_vector("position_com_in_world", com), _number("yaw_pelvis_in_world", yaw), _vector("zmp_in_world", zmp),
-            _vector("ankles_in_world[0]", ankles[0]), _vector("ankles_in_world[1]", ankles[1]),
-            _number("foot_yaws[0]", foot_yaws[0]), _number("foot_yaws[1]", foot_yaws[1]),
-            _vector("joint_angles", angles), _vector("measurement.wrench_left", m.wrench_left),
-            _vector("measurement.wrench_right", m.wrench_right), _vector("measurement.attitude", m.attitude),
-            _vector("measurement.rate", m.rate), _vector("measurement.joint_angles", m.joint_angles),
-            _number("measurement.yaw", measured_yaw))
 
 
 def servo_stiffness(robot: RobotModel) -> Array | None:

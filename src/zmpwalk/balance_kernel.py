@@ -103,11 +103,10 @@ L_PELVIS_TURN = 13  # (2)
 L_SLOPE_OFFSET = 15  # (2)
 LOG_SIZE = 17
 
-# --- what tick() returns besides 0: which input has too few values
-BAD_INPUTS = ("position_com_in_world", "zmp_in_world", "ankles_in_world[0]", "ankles_in_world[1]", "joint_angles",
-              "measurement.wrench_left", "measurement.wrench_right", "measurement.attitude", "measurement.rate",
-              "measurement.joint_angles")
-INPUT_SIZES = (3, 2, 3, 3, 12, 6, 6, 2, 3, 12)
+# --- what tick() returns besides 0: 1 + the index of a vector input with too few values (in the order of the
+# arguments: com, zmp, ankle_left, ankle_right, reference, wrench_left, wrench_right, attitude, rate, encoders),
+# or BAD_SUPPORT
+BAD_SUPPORT = 11
 
 
 def initial_state(state: np.ndarray, log: np.ndarray) -> None:
@@ -309,7 +308,7 @@ def _clip(value: float, limit: float) -> float:
     return min(max(value, -limit), limit)
 
 
-_VECTOR = "float64[::1]"
+_VECTOR = "float64[:]"  # any stride (a row of a Fortran-ordered table)
 TICK_SIGNATURE = (f"int64({_VECTOR}, float64[:, :, ::1], {_VECTOR}, {_VECTOR}, float64[:, :, ::1], {_VECTOR}, int64, "
                   f"{_VECTOR}, float64, {_VECTOR}, {_VECTOR}, {_VECTOR}, float64, float64, {_VECTOR}, {_VECTOR}, "
                   f"{_VECTOR}, {_VECTOR}, {_VECTOR}, {_VECTOR}, float64)")
@@ -321,9 +320,10 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
          ankle_right: np.ndarray, yaw_left: float, yaw_right: float, reference: np.ndarray,
          wrench_left: np.ndarray, wrench_right: np.ndarray, attitude: np.ndarray, rate: np.ndarray,
          encoders: np.ndarray, measured_yaw: float) -> int:
-    """One tick of the stabilizer: ``targets`` (12) <- the corrected joint targets [rad]; returns 0, or 1 + the
-    index in :data:`BAD_INPUTS` of an input with too few values, or ``len(BAD_INPUTS) + 1`` for a support that is
-    not 0, 1 or 2 (then nothing is changed). Compiled for C-contiguous float64 vectors only (the signature
+    """One tick of the stabilizer: ``targets`` (12) <- the corrected joint targets [rad].
+
+    Returns 0; or, changing nothing, 1 + the index of a vector input with too few values, or
+    :data:`BAD_SUPPORT` for a support that is not 0, 1 or 2. Compiled for float64 vectors only (the signature
     :data:`TICK_SIGNATURE`): other inputs raise TypeError.
 
     Inputs in world unless said otherwise: the pattern's support (0 double, 1 left, 2 right), CoM point (3) [m],
@@ -333,7 +333,7 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
     pattern's).
     """
     if support < 0 or support > 2:
-        return len(BAD_INPUTS) + 1
+        return BAD_SUPPORT
     if com.shape[0] < 3:
         return 1
     if zmp.shape[0] < 2:
