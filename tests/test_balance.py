@@ -212,6 +212,25 @@ def test_a_large_dcm_error_moves_the_swinging_foot_towards_the_fall() -> None:
     assert landing(0.02, gains) == pytest.approx(landing(0.02, without), abs=1e-12)  # inside the deadband
 
 
+def test_a_step_towards_a_fall_never_crosses_the_stance_foot() -> None:
+    """Standing on the left foot with the body 10 cm left of its plan (a fall towards the stance side): the right
+    foot's aim moves left only until the soles' inner edges are feet_clearance apart."""
+    stabilizer, inputs, _ = standing()
+    robot = stabilizer.robot
+    gains = StabilizerGains(landing_limit=0.2)
+    stabilizer = Stabilizer(robot, 1000.0, gains)
+    com = np.asarray(inputs["position_com_in_world"]).copy()
+    com[1] -= 0.10  # the plan is right of the body: a DCM error of +10 cm in y
+    inputs = {**inputs, "position_com_in_world": com, "support": 1}
+    run(stabilizer, inputs, 1500, loads=(2.0, 0.0))
+    left, right = (np.asarray(a) for a in inputs["ankles_in_world"])  # type: ignore[attr-defined]
+    right_y = right[1] + float(stabilizer._landing[1][1])  # where the right ankle lands (upright, heading 0)
+    inner = robot.sole_center_y - robot.foot_width / 2  # the inner edge of the left sole from its ankle [m]
+    gap = (left[1] + inner) - (right_y - inner)
+    assert float(stabilizer._landing[1][1]) > 0.0  # it does step towards the fall
+    assert gap == pytest.approx(gains.feet_clearance, abs=1e-3)  # [m] but no closer (the legs' pose: 1 mm)
+
+
 @pytest.mark.parametrize("field", ["dcm", "ankle_gain", "com_limit"])
 def test_bad_gains_are_rejected(field: str) -> None:
     with pytest.raises(InvalidParameterError, match=f"gains.{field}"):

@@ -33,8 +33,10 @@ separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega 
 6. **Landing and stepping**: the swinging foot aims at its planned place in world from the odometry's
    base, seen through the measured pelvis attitude, moved by :attr:`StabilizerGains.step_gain` times the
    DCM error, towards where the body falls (the capture point of Pratt et al. 2006), and turns by the
-   torso's measured yaw error so that it lands at its planned heading in world; the corrections are
-   released once the foot carries load.
+   torso's measured yaw error so that it lands at its planned heading in world; it never steps across the
+   stance foot (the soles' inner edges keep :attr:`StabilizerGains.feet_clearance` between them: a fall
+   towards the stance side is caught by the next step, of the other foot); the corrections are released
+   once the foot carries load.
 7. **Floor slope**: in double support both soles lie on the floor, so their attitude (IMU and measured leg
    kinematics) is the floor's; with unit normal ``n`` the CoM must stand ``l (n_x, n_y) / n_z`` uphill of
    its plan for the ZMP to stay where planned, and the CoM admittance is pulled to that offset instead of
@@ -105,6 +107,9 @@ class StabilizerGains:
             torso's measured yaw error, which a sole slipping in yaw leaves; 0 turns it off).
         servo_stiffness: ``kappa``: each leg servo softer than ``kappa m g l`` per radian (m the robot's mass,
             l its pendulum length) is stiffened to it by an outer loop on its encoder [-]; 0 turns it off.
+        feet_clearance: The least gap between the soles' inner edges that a landing correction leaves, across
+            the pelvis [m] (a step towards a fall on the stance side would cross the stance foot: without this
+            limit, HUBO pushed backward with 32 N s stepped its left foot into its right one).
     """
 
     dcm: float = 3.0  # [1/s]
@@ -131,6 +136,7 @@ class StabilizerGains:
     step_deadband: float = 0.03  # [m]
     landing_yaw_limit: float = 0.1  # [rad]
     servo_stiffness: float = 1.7  # [-] of m g l per rad
+    feet_clearance: float = 0.02  # [m]
 
     def __post_init__(self) -> None:
         for name, value in vars(self).items():
@@ -235,6 +241,7 @@ class Stabilizer:
         params[kernel.P_ANKLE_OFFSET:kernel.P_ANKLE_OFFSET + 6] = np.concatenate([c.ankle for c in self.chains])
         params[kernel.P_SERVO_GAIN:kernel.P_SERVO_GAIN + 12] = self.servo_gain
         params[kernel.P_STIFFEN] = float(self.servo_gain.any())
+        params[kernel.P_FEET_CLEARANCE] = self.gains.feet_clearance
         self._params = params
         chain = np.empty((2, 6, 11))
         for leg, leg_chain in enumerate(self.chains):

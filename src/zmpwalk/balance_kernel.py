@@ -68,7 +68,8 @@ P_LOAD_THRESHOLD = 35  # [N] a sole carries load above this normal force
 P_ANKLE_OFFSET = 36  # (2, 3) the ankle point in the last frame of each leg [m]
 P_SERVO_GAIN = 42  # (12) outer-loop gain per joint column [-]
 P_STIFFEN = 54  # 1 when any servo gets the outer loop
-PARAMETERS = 55
+P_FEET_CLEARANCE = 55  # [m] the gain feet_clearance
+PARAMETERS = 56
 GAIN_NAMES = ("dcm", "com_admittance", "com_stiffness", "com_damping", "com_limit", "ankle_gain",
               "ankle_time_constant", "ankle_limit", "force_gain", "force_time_constant", "force_limit",
               "attitude_gain", "attitude_damping", "attitude_limit", "zmp_margin", "velocity_filter",
@@ -565,6 +566,17 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
             state[o + 1] -= release_rate * state[o + 1]
         state[o] = _clip(state[o], landing_limit)
         state[o + 1] = _clip(state[o + 1], landing_limit)
+        if swinging:
+            # No step across the stance foot: the soles' inner edges keep feet_clearance between them (the
+            # correction's part across the pelvis; the planned feet relative to the pelvis from the reference).
+            swing, stance_ankle = (p0, p1) if foot == 0 else (p1, p0)
+            side = 1.0 if foot == 0 else -1.0
+            least = params[P_HALF_WIDTH] * 2.0 - 2.0 * params[P_SOLE_CENTER_Y] + params[P_FEET_CLEARANCE]
+            along, across = rotate2(state[o], state[o + 1], -yaw)
+            planned_gap = side * (swing[1] - stance_ankle[1])
+            if planned_gap + side * across < least:
+                across = side * (least - planned_gap)
+                state[o], state[o + 1] = rotate2(along, across, yaw)
     # --- corrections of the feet relative to the pelvis, onto the joints through the Jacobians
     shift = rotate2(offset_x, offset_y, -yaw)
     jacobian = work[4, 0:6, 0:6]
