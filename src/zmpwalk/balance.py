@@ -360,13 +360,12 @@ class Stabilizer:
         given = (com, zmp, ankles[0], ankles[1], angles, m.wrench_left, m.wrench_right, m.attitude, m.rate,
                  m.joint_angles)[status - 1]
         raise InvalidParameterError(INPUT_NAMES[status - 1], f"{np.size(given)} values",
-                                    f"{INPUT_SIZES[status - 1]} values")
+                                    f"{kernel.INPUT_SIZES[status - 1]} values")
 
 
 INPUT_NAMES = ("position_com_in_world", "zmp_in_world", "ankles_in_world[0]", "ankles_in_world[1]", "joint_angles",
                "measurement.wrench_left", "measurement.wrench_right", "measurement.attitude", "measurement.rate",
                "measurement.joint_angles")  # the update's vector inputs, in the kernel's order
-INPUT_SIZES = (3, 2, 3, 3, 12, 6, 6, 2, 3, 12)
 
 
 def _vectors(*values: object) -> tuple[Array, ...]:

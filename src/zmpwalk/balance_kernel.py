@@ -107,6 +107,7 @@ LOG_SIZE = 17
 # --- what tick() returns besides 0: 1 + the index of a vector input with too few values (in the order of the
 # arguments: com, zmp, ankle_left, ankle_right, reference, wrench_left, wrench_right, attitude, rate, encoders),
 # or BAD_SUPPORT
+INPUT_SIZES = (3, 2, 3, 3, 12, 6, 6, 2, 3, 12)  # the vector inputs' lengths, in that order
 BAD_SUPPORT = 11
 
 
@@ -335,26 +336,11 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
     """
     if support < 0 or support > 2:
         return BAD_SUPPORT
-    if com.shape[0] < 3:
-        return 1
-    if zmp.shape[0] < 2:
-        return 2
-    if ankle_left.shape[0] < 3:
-        return 3
-    if ankle_right.shape[0] < 3:
-        return 4
-    if reference.shape[0] < 12:
-        return 5
-    if wrench_left.shape[0] < 6:
-        return 6
-    if wrench_right.shape[0] < 6:
-        return 7
-    if attitude.shape[0] < 2:
-        return 8
-    if rate.shape[0] < 3:
-        return 9
-    if encoders.shape[0] < 12:
-        return 10
+    given = (com.shape[0], zmp.shape[0], ankle_left.shape[0], ankle_right.shape[0], reference.shape[0],
+             wrench_left.shape[0], wrench_right.shape[0], attitude.shape[0], rate.shape[0], encoders.shape[0])
+    for i in range(len(INPUT_SIZES)):
+        if given[i] < INPUT_SIZES[i]:
+            return i + 1
     p = params
     dt, omega, h = p[P_DT], p[P_OMEGA], p[P_ANKLE_HEIGHT]
     started = state[S_STARTED] > 0.0
