@@ -235,6 +235,9 @@ def test_a_step_towards_a_fall_never_crosses_the_stance_foot() -> None:
 def test_bad_gains_are_rejected(field: str) -> None:
     with pytest.raises(InvalidParameterError, match=f"gains.{field}"):
         StabilizerGains(**{field: -1.0})
+    with pytest.raises(InvalidParameterError, match=r"gains.landing_release.*> 0 s"):
+        StabilizerGains(landing_release=0.0)
+    assert StabilizerGains(slope_time_constant=0.0).slope_time_constant == 0.0  # 0 turns the slope loop off
     with pytest.raises(InvalidParameterError, match="rate"):
         Stabilizer(load_robot("hubo"), 5.0)
 

@@ -69,6 +69,7 @@ from zmpwalk.robots.model import RobotModel
 
 Array = NDArray[np.float64]
 
+TIME_CONSTANTS = ("ankle_time_constant", "force_time_constant", "landing_time_constant", "landing_release")
 LOAD_FRACTION = 0.05  # [-] of the robot's weight: a sole carries load above this normal force
 
 
@@ -143,6 +144,8 @@ class StabilizerGains:
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not (math.isfinite(value)
                                                                                        and value >= 0):
                 raise InvalidParameterError(f"gains.{name}", value, "a finite number >= 0")
+            if name in TIME_CONSTANTS and value <= 0:  # each tick divides by them
+                raise InvalidParameterError(f"gains.{name}", value, "a time > 0 s")
 
 
 @dataclass
