@@ -84,7 +84,8 @@ class StabilizerGains:
         com_damping: ``K_v`` [1/s].
         com_limit: Largest CoM offset [m].
         ankle_gain: Foot turn rate per metre of CoP error [rad/(s m)] (``F / D`` of Kajita's damping control).
-        ankle_time_constant: ``T`` of the ankle offsets' return to zero [s].
+        ankle_time_constant: ``T`` of the ankle offsets' return to zero [s] (> 0, as are the force and
+            landing time constants and the landing release; every other gain is >= 0).
         ankle_limit: Largest foot turn [rad].
         force_gain: Foot height rate per newton of force-difference error per newton of weight [m/s].
         force_time_constant: Return of the height difference to zero [s].
