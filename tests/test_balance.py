@@ -350,7 +350,7 @@ def test_servos_softer_than_kappa_m_g_l_get_an_encoder_loop_of_that_stiffness() 
     assert robot.servos is not None
     soft = dataclasses.replace(robot, servos=dataclasses.replace(robot.servos, kp=100.0))
     stiffened = Stabilizer(soft, 1000.0)
-    plain = Stabilizer(soft, 1000.0, StabilizerGains(servo_stiffness=0.0))
+    plain = Stabilizer(soft, 1000.0, dataclasses.replace(stiffened.gains, servo_stiffness=0.0))
     weight_moment = robot.mass * robot.gravity * robot.pendulum_length  # the box legs' links sum to the mass
     kappa = StabilizerGains().servo_stiffness
     assert stiffened.servo_gain == pytest.approx(np.full(12, kappa * weight_moment / 100.0 - 1.0), rel=1e-9)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from importlib import resources
 
 import pytest
 
@@ -117,6 +118,27 @@ def test_malformed_robot_file(tmp_path):
     path.write_text('name = "bot"\ndescription = "x"\nmass = 1.0\nheight = 0.5\n[legs]\nhip_spacing = -0.1\n')
     with pytest.raises(FileFormatError, match=r"bot\.toml"):
         load_robot(path)
+
+
+@pytest.mark.parametrize("table, message", [
+    ("[stabilizer]\ncom_stifness = 3.0\n", r"\[stabilizer\] unknown gain 'com_stifness'; known: dcm, "),
+    ("[stabilizer]\ncom_stiffness = -3.0\n", r"\[stabilizer\] gains.com_stiffness = -3"),
+    ("[stabilizer]\nlanding_release = 0.0\n", r"\[stabilizer\] gains.landing_release = 0 .*> 0 s"),
+])
+def test_a_robot_files_stabilizer_gains_are_checked(tmp_path, table, message):
+    """A robot file's [stabilizer] table names gains of StabilizerGains, checked as the gains check them; the
+    built-in HUBO file's own gain reaches the stabilizer."""
+    from zmpwalk.balance import Stabilizer
+
+    text = (resources.files("zmpwalk") / "robots" / "data" / "hubo.toml").read_text()
+    path = tmp_path / "bot.toml"
+    path.write_text(text.replace("[stabilizer]\ncom_stiffness = 3.0", table.rstrip("\n")))
+    with pytest.raises(FileFormatError, match=message):
+        load_robot(path)
+    hubo = load_robot("hubo")
+    assert dict(hubo.stabilizer_gains) == {"com_stiffness": 3.0}
+    assert Stabilizer(hubo, 1000.0).gains.com_stiffness == 3.0
+    assert Stabilizer(load_robot("mju-biped"), 1000.0).gains.com_stiffness == 10.0  # the default
 
 
 def test_unknown_generator_lists_the_known_ones():

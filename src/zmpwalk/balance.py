@@ -203,7 +203,9 @@ class Stabilizer:
     Args:
         robot: The robot (legs, masses, soles).
         rate: Control rate [Hz].
-        gains: The gains (defaults suit HUBO, TALOS and Booster T1 in the simulation; docs/balance.md).
+        gains: The gains (default: :class:`StabilizerGains` with the robot file's ``[stabilizer]`` gains, which
+            HUBO's box model has; the defaults suit TALOS, Booster T1 and the small biped in the simulation;
+            docs/balance.md).
 
     The first :meth:`update` initialises the filters; :meth:`reset` forgets the state. The tick itself is
     :func:`zmpwalk.balance_kernel.tick`, compiled on first use (cached on disk afterwards).
@@ -218,7 +220,7 @@ class Stabilizer:
         self._tick = kernel.tick
         self._convert = False  # convert the inputs before each tick (set once some were not float64 vectors)
         self.robot = robot
-        self.gains = gains or StabilizerGains()
+        self.gains = gains or StabilizerGains(**dict(robot.stabilizer_gains))
         self.dt = 1.0 / float(rate)
         self.omega = math.sqrt(robot.gravity / robot.pendulum_length)
         self.chains = leg_chains(robot)

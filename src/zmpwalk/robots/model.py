@@ -19,7 +19,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from zmpwalk.errors import FileFormatError
+from zmpwalk.errors import FileFormatError, InvalidParameterError
 
 if TYPE_CHECKING:
     from zmpwalk.leg_chain import LegChain
@@ -164,6 +164,7 @@ class RobotModel:
     schedule_scale: tuple[float, float, float] = (1.0, 1.0, 1.0)  # [-] time, stride, lateral
     foot_speed_limit: float | None = None  # [m/s]
     foot_acceleration_limit: float | None = None  # [m/s^2]
+    stabilizer_gains: tuple[tuple[str, float], ...] = ()  # the robot's own [stabilizer] gains (name, value)
 
     def hip_in_pelvis(self, side: int) -> tuple[float, float, float]:
         """Hip joint centre of the left (``side = +1``) or right (-1) leg relative to the pattern's pelvis
@@ -236,7 +237,7 @@ _POSITIVE = {"mass", "height", "hip_spacing", "thigh_length", "shank_length", "a
              "foot_length", "foot_width", "pelvis_height", "pendulum_length", "gravity",
              "dsp_time", "lateral_velocity", "foot_speed_limit", "foot_acceleration_limit"}
 # Sections a later part of zmpwalk reads (bodies, servos); kept as raw tables.
-_EXTRA_SECTIONS = {"limits", "bodies", "servos", "contact"}  # read by their own parsers
+_EXTRA_SECTIONS = {"limits", "bodies", "servos", "contact", "stabilizer"}  # read by their own parsers
 
 
 def schedule_scale(pendulum_length: float, leg_length: float, hip_spacing: float) -> tuple[float, float, float]:
@@ -331,6 +332,26 @@ def _table(kind: type[Any], table: object, name: str, source: str) -> Any:
     return kind(**values)
 
 
+def _stabilizer_gains(table: object, source: str) -> tuple[tuple[str, float], ...]:
+    """The [stabilizer] table: gains of :class:`zmpwalk.balance.StabilizerGains` tuned for this robot (the others
+    keep their defaults), checked as the gains check them."""
+    if table is None:
+        return ()
+    from zmpwalk.balance import StabilizerGains  # balance reads this module: import here, when a file has one
+
+    known = [f.name for f in fields(StabilizerGains)]
+    if not isinstance(table, dict):
+        raise FileFormatError(source, "[stabilizer] must be a table of gains")
+    for key in table:
+        if key not in known:
+            raise FileFormatError(source, f"[stabilizer] unknown gain {key!r}; known: {', '.join(known)}")
+    try:
+        StabilizerGains(**table)
+    except (InvalidParameterError, TypeError) as error:
+        raise FileFormatError(source, f"[stabilizer] {error}") from None
+    return tuple((key, float(value)) for key, value in table.items())
+
+
 def _links(table: object, values: dict[str, Any], source: str) -> dict[str, Link]:
     """The [bodies] table: mass and box per link; leg centres of mass default to the segment middles."""
     if table is None:
@@ -408,6 +429,7 @@ def robot_from_dict(data: dict[str, Any], source: str = "<robot>") -> RobotModel
     values["links"] = _links(data.get("bodies"), values, source)
     values["servos"] = _table(Servos, data.get("servos"), "servos", source)
     values["contact"] = _table(Contact, data.get("contact"), "contact", source)
+    values["stabilizer_gains"] = _stabilizer_gains(data.get("stabilizer"), source)
     if values.pop("scale_schedule", True):
         values["schedule_scale"] = schedule_scale(values["pendulum_length"], values["thigh_length"]
                                                   + values["shank_length"], values["hip_spacing"])
