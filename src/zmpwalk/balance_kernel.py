@@ -234,7 +234,7 @@ def solve6(a: np.ndarray, b: np.ndarray) -> None:
 
 
 @njit(cache=True, nogil=True)
-def _sole_centre(params: np.ndarray, foot: int, fx: float, fy: float, yaw: float) -> tuple[float, float]:
+def sole_centre(params: np.ndarray, foot: int, fx: float, fy: float, yaw: float) -> tuple[float, float]:
     """The centre of the sole of ``foot`` (0 left, 1 right) whose ankle is at ``(fx, fy)`` with ``yaw``."""
     side = 1.0 if foot == 0 else -1.0
     ox, oy = rotate2(params[P_SOLE_CENTER_X], side * params[P_SOLE_CENTER_Y], yaw)
@@ -242,15 +242,13 @@ def _sole_centre(params: np.ndarray, foot: int, fx: float, fy: float, yaw: float
 
 
 @njit(cache=True, nogil=True)
-def clamp_zmp(params: np.ndarray, zx: float, zy: float, support: int, left_x: float, left_y: float,
-              right_x: float, right_y: float, yaw_left: float, yaw_right: float) -> tuple[float, float]:
+def clamp_zmp(params: np.ndarray, zx: float, zy: float, support: int, c0x: float, c0y: float, c1x: float,
+              c1y: float, yaw_left: float, yaw_right: float) -> tuple[float, float]:
     """The ZMP moved into the support polygon shrunk by the margin (single support: the sole; double: the segment
-    between the soles' centres widened by the soles' half widths, a conservative hull). The feet are given by their
-    ankles in world [m] and yaws [rad]."""
+    between the soles' centres widened by the soles' half widths, a conservative hull). The soles are given by
+    their centres in world [m] (:func:`sole_centre`) and yaws [rad]."""
     margin = params[P_ZMP_MARGIN]
     lx, ly = max(params[P_HALF_LENGTH] - margin, 0.0), max(params[P_HALF_WIDTH] - margin, 0.0)
-    c0x, c0y = _sole_centre(params, 0, left_x, left_y, yaw_left)
-    c1x, c1y = _sole_centre(params, 1, right_x, right_y, yaw_right)
     if support == 1 or support == 2:
         cx, cy, yaw = (c0x, c0y, yaw_left) if support == 1 else (c1x, c1y, yaw_right)
         local_x, local_y = rotate2(zx - cx, zy - cy, -yaw)
@@ -268,13 +266,10 @@ def clamp_zmp(params: np.ndarray, zx: float, zy: float, support: int, left_x: fl
 
 
 @njit(cache=True, nogil=True)
-def distribute(params: np.ndarray, zx: float, zy: float, support: int, left_x: float, left_y: float,
-               right_x: float, right_y: float, yaw_left: float,
-               yaw_right: float) -> tuple[float, float, float, float, float, float]:
-    """Load shares of the feet and each sole's CoP target [m] for a desired ZMP: (share left, share right,
-    target left x, y, target right x, y)."""
-    c0x, c0y = _sole_centre(params, 0, left_x, left_y, yaw_left)
-    c1x, c1y = _sole_centre(params, 1, right_x, right_y, yaw_right)
+def distribute(zx: float, zy: float, support: int, c0x: float, c0y: float, c1x: float,
+               c1y: float) -> tuple[float, float, float, float, float, float]:
+    """Load shares of the feet and each sole's CoP target [m] for a desired ZMP, given the soles' centres in world
+    [m]: (share left, share right, target left x, y, target right x, y)."""
     if support == 1:
         return 1.0, 0.0, zx, zy, c1x, c1y
     if support == 2:
@@ -283,6 +278,16 @@ def distribute(params: np.ndarray, zx: float, zy: float, support: int, left_x: f
     ratio = min(max(((zx - c0x) * sx + (zy - c0y) * sy) / max(sx * sx + sy * sy, 1e-12), 0.0), 1.0)
     dx, dy = zx - (c0x + ratio * sx), zy - (c0y + ratio * sy)
     return 1.0 - ratio, ratio, c0x + dx, c0y + dy, c1x + dx, c1y + dy
+
+
+@njit(cache=True, nogil=True)
+def sole_cop(wrench: np.ndarray, ankle_height: float, x: float, y: float, yaw: float) -> tuple[float, float]:
+    """The centre of pressure in world [m] of a loaded sole whose ankle is at ``(x, y)`` with ``yaw``, from the
+    ground's wrench on the foot about the ankle, in the foot frame (force [N], torque [N m]): the point on the
+    sole (``ankle_height`` below the ankle) where the torque's horizontal part vanishes."""
+    lx, ly = rotate2(-(wrench[4] + ankle_height * wrench[0]) / wrench[2],
+                     (wrench[3] - ankle_height * wrench[1]) / wrench[2], yaw)
+    return x + lx, y + ly
 
 
 @njit(cache=True, nogil=True)
@@ -440,15 +445,13 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
         left_x, left_y, right_x, right_y = anchor_x, anchor_y, anchor_x + other[0], anchor_y + other[1]
     else:
         left_x, left_y, right_x, right_y = anchor_x + other[0], anchor_y + other[1], anchor_x, anchor_y
+    c0x, c0y = sole_centre(p, 0, left_x, left_y, yaw_left)
+    c1x, c1y = sole_centre(p, 1, right_x, right_y, yaw_right)
     cop0x = cop0y = cop1x = cop1y = 0.0
     if loaded0:
-        lx, ly = rotate2(-(wrench_left[4] + h * wrench_left[0]) / wrench_left[2],
-                         (wrench_left[3] - h * wrench_left[1]) / wrench_left[2], yaw_left)
-        cop0x, cop0y = left_x + lx, left_y + ly
+        cop0x, cop0y = sole_cop(wrench_left, h, left_x, left_y, yaw_left)
     if loaded1:
-        lx, ly = rotate2(-(wrench_right[4] + h * wrench_right[0]) / wrench_right[2],
-                         (wrench_right[3] - h * wrench_right[1]) / wrench_right[2], yaw_right)
-        cop1x, cop1y = right_x + lx, right_y + ly
+        cop1x, cop1y = sole_cop(wrench_right, h, right_x, right_y, yaw_right)
     zmx = zmy = math.nan
     if loaded0 or loaded1:
         w0 = f0 if loaded0 else 0.0
@@ -470,8 +473,8 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
     ex = (cx + state[S_COM_VELOCITY] / omega) - (rx + vrx / omega)
     ey = (cy + state[S_COM_VELOCITY + 1] / omega) - (ry + vry / omega)
     gain = 1.0 + p[P_DCM] / omega
-    pdx, pdy = clamp_zmp(p, zmp[0] + gain * ex, zmp[1] + gain * ey, support, left_x, left_y, right_x, right_y,
-                         yaw_left, yaw_right)
+    pdx, pdy = clamp_zmp(p, zmp[0] + gain * ex, zmp[1] + gain * ey, support, c0x, c0y, c1x, c1y, yaw_left,
+                         yaw_right)
     # --- 2. CoM admittance
     if loaded0 or loaded1:
         ax, ay = p[P_COM_ADMITTANCE] * (zmx - pdx), p[P_COM_ADMITTANCE] * (zmy - pdy)
@@ -490,8 +493,7 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
         state[S_OFFSET_RATE] = state[S_OFFSET_RATE + 1] = 0.0
     offset_x, offset_y = state[S_OFFSET], state[S_OFFSET + 1]
     # --- 3. ankle damping: each loaded sole's CoP follows its share of p_d
-    share0, share1, t0x, t0y, t1x, t1y = distribute(p, pdx, pdy, support, left_x, left_y, right_x, right_y,
-                         yaw_left, yaw_right)
+    share0, share1, t0x, t0y, t1x, t1y = distribute(pdx, pdy, support, c0x, c0y, c1x, c1y)
     decay = dt / p[P_ANKLE_TIME_CONSTANT]
     ankle_limit, ankle_gain = p[P_ANKLE_LIMIT], p[P_ANKLE_GAIN]
     for foot in range(2):
