@@ -264,9 +264,37 @@ def batch_hull_margin(points: Array, vertices: Array) -> Array:
 
     Args:
         points: (n, 2) [m].
-        vertices: (n, m, 2) [m], any order, at least three not collinear.
+        vertices: (n, m, 2) [m], any order, repeated points allowed, at least three not collinear.
 
     Returns:
         (n,) signed distances [m], > 0 inside.
+
+    No hull is built. With the hull's support function ``h(u) = max_k u . v_k``, a point ``x`` inside lies
+    ``min_u h(u) - u . x`` from the boundary, the minimum taken at an edge's outward normal; every hull
+    edge joins two of the vertices, so the normals of all vertex pairs, both ways, hold the minimiser, and
+    any other direction gives a larger value. The point is outside when that minimum is negative, and its
+    distance is then the least distance to a segment between two vertices (each lies in the hull, and
+    the hull's edges are among them).
+
+    .. math:: d(x) = \\min_{(i, j)} \\min_{\\pm} \\left( h(\\pm u_{ij}) \\mp u_{ij} \\cdot x \\right)
     """
-    return edge_margin(points, *hull_edges(vertices))
+    m = vertices.shape[1]
+    i, j = np.triu_indices(m, 1)
+    start = vertices[:, i]  # (n, pairs, 2)
+    edge = vertices[:, j] - start
+    length = np.hypot(edge[..., 0], edge[..., 1])
+    distinct = length > 1e-12
+    scale = np.where(distinct, length, 1.0)
+    ux, uy = edge[..., 1] / scale, -edge[..., 0] / scale  # one unit normal of each pair's line
+    projection = ux[..., None] * vertices[:, None, :, 0] + uy[..., None] * vertices[:, None, :, 1]
+    point = ux * points[:, 0:1] + uy * points[:, 1:2]
+    inner = np.minimum(projection.max(axis=2) - point, point - projection.min(axis=2))
+    inner = np.min(inner, axis=1, where=distinct, initial=np.inf)
+    margin = np.asarray(inner, dtype=np.float64)
+    out = inner < 0.0
+    if out.any():
+        start, edge, scale = start[out], edge[out], scale[out]
+        rx, ry = points[out, 0:1] - start[..., 0], points[out, 1:2] - start[..., 1]
+        along = np.clip((rx * edge[..., 0] + ry * edge[..., 1]) / scale**2, 0.0, 1.0)
+        margin[out] = -np.min(np.hypot(rx - along * edge[..., 0], ry - along * edge[..., 1]), axis=1)
+    return margin
