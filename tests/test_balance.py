@@ -159,6 +159,22 @@ def test_left_foot_under_loaded_in_double_support_is_lowered() -> None:
     assert stabilizer.state.height_difference > 0.0  # left foot lowered by half of it [m]
 
 
+def test_a_sole_the_plan_has_down_that_carries_no_load_is_lowered_in_double_support_only() -> None:
+    """Landing timing: in double support a sole without load reads the whole weight as the force difference
+    and is lowered at the touchdown speed, h' = touchdown_speed * (wanted - (f_l - f_r)) / W - h / T; with the
+    left sole bare and the desired ZMP between the soles (wanted ~ 0) that is h(t) = v T (1 - exp(-t / T)).
+    In single support the same sole is the swinging one and nothing moves."""
+    stabilizer, inputs, _ = standing()
+    gains = stabilizer.gains
+    run(stabilizer, inputs, 100, loads=(0.0, 2.0))
+    rate, time_constant = gains.touchdown_speed, gains.force_time_constant
+    expected = rate * time_constant * (1 - math.exp(-0.1 / time_constant))
+    assert stabilizer.state.height_difference == pytest.approx(expected, rel=0.01)  # [m] left lowered by half
+    swinging = Stabilizer(stabilizer.robot, 1000.0)
+    run(swinging, {**inputs, "support": 2}, 100, loads=(0.0, 2.0))  # right stance: the left foot swings
+    assert swinging.state.height_difference == 0.0
+
+
 def test_a_floor_rising_ahead_moves_the_com_uphill_by_l_tan_slope() -> None:
     """Standing on a floor that rises 2 degrees ahead, the torso square to it (pitched back by the slope), the
     soles' normal is the floor's; the CoM offset's target is l tan(slope) uphill (forward)."""

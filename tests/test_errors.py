@@ -127,7 +127,7 @@ def test_malformed_robot_file(tmp_path):
 ])
 def test_a_robot_files_stabilizer_gains_are_checked(tmp_path, table, message):
     """A robot file's [stabilizer] table names gains of StabilizerGains, checked as the gains check them; the
-    built-in HUBO file's own gain reaches the stabilizer."""
+    built-in HUBO file's own gains reach the stabilizer."""
     from zmpwalk.balance import Stabilizer
 
     text = (resources.files("zmpwalk") / "robots" / "data" / "hubo.toml").read_text()
@@ -136,8 +136,9 @@ def test_a_robot_files_stabilizer_gains_are_checked(tmp_path, table, message):
     with pytest.raises(FileFormatError, match=message):
         load_robot(path)
     hubo = load_robot("hubo")
-    assert dict(hubo.stabilizer_gains) == {"com_stiffness": 3.0}
-    assert Stabilizer(hubo, 1000.0).gains.com_stiffness == 3.0
+    assert dict(hubo.stabilizer_gains) == {"com_stiffness": 3.0, "touchdown_speed": 0.2}
+    gains = Stabilizer(hubo, 1000.0).gains
+    assert (gains.com_stiffness, gains.touchdown_speed) == (3.0, 0.2)
     assert Stabilizer(load_robot("mju-biped"), 1000.0).gains.com_stiffness == 10.0  # the default
 
 

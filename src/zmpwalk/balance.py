@@ -28,7 +28,10 @@ separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega 
    pressure follows its share of ``p_d`` by turning the foot, ``delta' = -(tau_d - tau) / D - delta / T``,
    written per metre of CoP error.
 4. **Foot force difference control** (Kajita et al. 2010): in double support the feet's heights move apart
-   until the measured force difference is the desired one.
+   until the measured force difference is the desired one. It runs as soon as one sole carries load: a sole
+   that the plan has down but that carries none (it lands late, or the body rolled it off the floor) reads
+   the whole weight as the difference and is lowered, at :attr:`StabilizerGains.touchdown_speed`, until it
+   takes its share (landing timing).
 5. **Torso attitude**: the pelvis is turned against the measured roll and pitch (and their rates).
 6. **Landing and stepping**: the swinging foot aims at its planned place in world from the odometry's
    base, seen through the measured pelvis attitude, moved by :attr:`StabilizerGains.step_gain` times the
@@ -112,6 +115,11 @@ class StabilizerGains:
         feet_clearance: The least gap between the soles' inner edges that a landing correction leaves, across
             the pelvis [m] (a step towards a fall on the stance side would cross the stance foot: without this
             limit, HUBO pushed backward with 32 N s stepped its left foot into its right one).
+        touchdown_speed: ``force_gain`` while only one sole carries load in double support: how fast a sole
+            the plan has down but that carries none (a late touchdown) is lowered, per newton of
+            force-difference error per newton of weight [m/s]. Apart from ``force_gain`` because the two-sole
+            loop must stay slow under sensor latency (HUBO with 10 ms falls at ``force_gain`` 0.3) while a
+            bare sole may be lowered fast.
     """
 
     dcm: float = 3.0  # [1/s]
@@ -139,6 +147,7 @@ class StabilizerGains:
     landing_yaw_limit: float = 0.1  # [rad]
     servo_stiffness: float = 1.7  # [-] of m g l per rad
     feet_clearance: float = 0.02  # [m]
+    touchdown_speed: float = 0.05  # [m/s]
 
     def __post_init__(self) -> None:
         for name, value in vars(self).items():
@@ -248,6 +257,7 @@ class Stabilizer:
         params[kernel.P_SERVO_GAIN:kernel.P_SERVO_GAIN + 12] = self.servo_gain
         params[kernel.P_STIFFEN] = float(self.servo_gain.any())
         params[kernel.P_FEET_CLEARANCE] = self.gains.feet_clearance
+        params[kernel.P_TOUCHDOWN_SPEED] = self.gains.touchdown_speed
         self._params = params
         chain = np.empty((2, 6, 11))
         for leg, leg_chain in enumerate(self.chains):

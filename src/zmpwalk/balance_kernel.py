@@ -69,7 +69,8 @@ P_ANKLE_OFFSET = 36  # (2, 3) the ankle point in the last frame of each leg [m]
 P_SERVO_GAIN = 42  # (12) outer-loop gain per joint column [-]
 P_STIFFEN = 54  # 1 when any servo gets the outer loop
 P_FEET_CLEARANCE = 55  # [m] the gain feet_clearance
-PARAMETERS = 56
+P_TOUCHDOWN_SPEED = 56  # [m/s] the gain touchdown_speed
+PARAMETERS = 57
 GAIN_NAMES = ("dcm", "com_admittance", "com_stiffness", "com_damping", "com_limit", "ankle_gain",
               "ankle_time_constant", "ankle_limit", "force_gain", "force_time_constant", "force_limit",
               "attitude_gain", "attitude_damping", "attitude_limit", "zmp_margin", "velocity_filter",
@@ -509,11 +510,13 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
             state[o + 1] += dt * (ankle_gain * error[0])
         state[o] = _clip(state[o] - decay * state[o], ankle_limit)
         state[o + 1] = _clip(state[o + 1] - decay * state[o + 1], ankle_limit)
-    # --- 4. foot force difference (double support)
+    # --- 4. foot force difference (double support); a sole the plan has down that carries no load (a late
+    # touchdown, an early lift) reads the whole weight as the difference and is lowered at the touchdown speed
     weight = f0 + f1
-    if support == 0 and loaded0 and loaded1 and weight > 0:
+    if support == 0 and (loaded0 or loaded1) and weight > 0:
         wanted = (share0 - share1) * weight
-        state[S_HEIGHT] += dt * p[P_FORCE_GAIN] * (wanted - (f0 - f1)) / weight
+        rate_gain = p[P_FORCE_GAIN] if loaded0 and loaded1 else p[P_TOUCHDOWN_SPEED]
+        state[S_HEIGHT] += dt * rate_gain * (wanted - (f0 - f1)) / weight
     state[S_HEIGHT] -= dt / p[P_FORCE_TIME_CONSTANT] * state[S_HEIGHT]
     state[S_HEIGHT] = _clip(state[S_HEIGHT], p[P_FORCE_LIMIT])
     height = state[S_HEIGHT]
