@@ -23,9 +23,11 @@ def test_a_too_long_stride_at_0_4_s_on_hubo_fails_and_exits_non_zero(tmp_path: P
 
 
 def test_the_small_biped_on_hubo_tables_fails_in_the_report(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Open loop the small biped falls on HUBO's fig30 tables (its pattern leaves the soles by 18 mm); the
+    report shows it red and exits 3. (With the stabilizer it now walks them: docs/simulation.md.)"""
     out = tmp_path / "r"
-    assert main(["report", "--robot", "mju-biped", "--scenario", "fig30", "--no-animation", "--out", str(out)]) \
-        == EXIT_FAILED
+    assert main(["report", "--robot", "mju-biped", "--scenario", "fig30", "--no-animation", "--balance", "off",
+                 "--out", str(out)]) == EXIT_FAILED
     printed = capsys.readouterr().out
     assert "FAIL" in printed and "no fall" in printed
     page = (out / "index.html").read_text(encoding="utf-8")
