@@ -175,6 +175,54 @@ def test_a_sole_the_plan_has_down_that_carries_no_load_is_lowered_in_double_supp
     assert swinging.state.height_difference == 0.0
 
 
+def test_a_swinging_sole_that_touches_down_early_is_raised() -> None:
+    """Early touchdown: in single support the swinging sole's desired share of the load is none. With the left
+    foot swinging (right stance) and carrying 30 % of the weight, the error of the force difference is
+    -0.6 of the weight, and h(t) = -0.6 v T (1 - exp(-t / T)) (negative: the left foot raised)."""
+    stabilizer, inputs, _ = standing()
+    gains = stabilizer.gains
+    run(stabilizer, {**inputs, "support": 2}, 100, loads=(0.6, 1.4))
+    rate, time_constant = gains.touchdown_speed, gains.force_time_constant
+    expected = -0.6 * rate * time_constant * (1 - math.exp(-0.1 / time_constant))
+    assert stabilizer.state.height_difference == pytest.approx(expected, rel=0.01)  # [m]
+
+
+def left_ankle_height_change(stabilizer: Stabilizer, inputs: dict[str, object], targets: np.ndarray) -> float:
+    """The height change of the left ankle in the base frame that the targets ask for [m]: the Jacobian at the
+    pattern's angles times the change of the joints (the stabilizer maps its foot changes onto the joints
+    through the inverse of that Jacobian)."""
+    chain = leg_chains(stabilizer.robot)[0]
+    order = np.argsort(chain.role_order)  # role-ordered columns -> chain order
+    reference = np.asarray(inputs["joint_angles"])[:6][order]
+    change = (np.asarray(targets)[:6] - np.asarray(inputs["joint_angles"])[:6])[order]
+    return float((chain.jacobian(reference[None])[0] @ change)[2])
+
+
+@pytest.mark.parametrize("roll", [0.0, -0.02])
+def test_the_swinging_foot_aims_at_its_planned_height_above_the_floor(roll: float) -> None:
+    """With landing_height_limit the swinging left foot (planned on the floor, level with the stance foot)
+    is moved up in the base frame by what the measured attitude and the stance sole's compression take from
+    its height above the floor: the stance sole sinks (W / k)^(1/e) under the whole weight W, and a torso
+    rolled by phi lowers the left foot relative to the right one, in the base frame, by sin(phi) dy:
+
+    .. math:: \\Delta z = -\\sin\\phi\\, \\Delta y + \\cos\\phi\\, (W / k)^{1/e}
+    """
+    stabilizer, inputs, half = standing()
+    robot = stabilizer.robot
+    gains = dataclasses.replace(stabilizer.gains, landing_height_limit=0.02)
+    stabilizer = Stabilizer(robot, 1000.0, gains)
+    swing = {**inputs, "support": 2}  # right stance: the left foot swings
+    targets = run(stabilizer, swing, 5000, loads=(0.0, 2.0), attitude=np.array([roll, 0.0]))  # 25 time constants
+    assert robot.contact is not None
+    compression = (2 * half / robot.contact.stiffness) ** (1 / robot.contact.exponent)  # [m]
+    left, right = (np.asarray(a) for a in inputs["ankles_in_world"])  # type: ignore[attr-defined]
+    expected = -math.sin(roll) * (left[1] - right[1]) + math.cos(roll) * compression
+    assert left_ankle_height_change(stabilizer, swing, targets) == pytest.approx(expected, abs=1e-9)  # [m]
+    off = Stabilizer(robot, 1000.0, dataclasses.replace(gains, landing_height_limit=0.0))  # the pattern's height
+    targets = run(off, swing, 100, loads=(0.0, 2.0))
+    assert abs(left_ankle_height_change(off, swing, targets)) < 1e-9  # [m]
+
+
 def test_a_floor_rising_ahead_moves_the_com_uphill_by_l_tan_slope() -> None:
     """Standing on a floor that rises 2 degrees ahead, the torso square to it (pitched back by the slope), the
     soles' normal is the floor's; the CoM offset's target is l tan(slope) uphill (forward)."""

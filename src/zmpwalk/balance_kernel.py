@@ -70,7 +70,10 @@ P_SERVO_GAIN = 42  # (12) outer-loop gain per joint column [-]
 P_STIFFEN = 54  # 1 when any servo gets the outer loop
 P_FEET_CLEARANCE = 55  # [m] the gain feet_clearance
 P_TOUCHDOWN_SPEED = 56  # [m/s] the gain touchdown_speed
-PARAMETERS = 57
+P_LANDING_HEIGHT_LIMIT = 57  # [m] the gain landing_height_limit
+P_SOLE_STIFFNESS = 58  # [N/m^e] k of the sole's contact law f = k x^e (0: a rigid sole)
+P_SOLE_EXPONENT = 59  # [-] e
+PARAMETERS = 60
 GAIN_NAMES = ("dcm", "com_admittance", "com_stiffness", "com_damping", "com_limit", "ankle_gain",
               "ankle_time_constant", "ankle_limit", "force_gain", "force_time_constant", "force_limit",
               "attitude_gain", "attitude_damping", "attitude_limit", "zmp_margin", "velocity_filter",
@@ -92,7 +95,8 @@ S_LANDING_YAW = 28  # (2) [rad]
 S_ANCHOR = 30  # the reference sole of the odometry (0 left, 1 right)
 S_FLOOR_NORMAL = 31  # (3) filtered, in world
 S_SOLE_NORMALS = 34  # (2, 2) horizontal parts of each sole's normal in world, last tick
-STATE_SIZE = 38
+S_LANDING_HEIGHT = 38  # (2) height corrections of the swinging feet [m]
+STATE_SIZE = 40
 
 # --- log (zmpwalk.balance.BalanceState)
 L_ZMP_DESIRED = 0  # (2)
@@ -511,11 +515,13 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
         state[o] = _clip(state[o] - decay * state[o], ankle_limit)
         state[o + 1] = _clip(state[o + 1] - decay * state[o + 1], ankle_limit)
     # --- 4. foot force difference (double support); a sole the plan has down that carries no load (a late
-    # touchdown, an early lift) reads the whole weight as the difference and is lowered at the touchdown speed
+    # touchdown, an early lift) reads the whole weight as the difference and is lowered at the touchdown speed;
+    # in single support a swinging sole that carries load (an early touchdown) is raised at that speed
     weight = f0 + f1
-    if support == 0 and (loaded0 or loaded1) and weight > 0:
+    early = (support == 1 and loaded1) or (support == 2 and loaded0)  # the swinging sole touches down early
+    if (early or (support == 0 and (loaded0 or loaded1))) and weight > 0:
         wanted = (share0 - share1) * weight
-        rate_gain = p[P_FORCE_GAIN] if loaded0 and loaded1 else p[P_TOUCHDOWN_SPEED]
+        rate_gain = p[P_FORCE_GAIN] if loaded0 and loaded1 and not early else p[P_TOUCHDOWN_SPEED]
         state[S_HEIGHT] += dt * rate_gain * (wanted - (f0 - f1)) / weight
     state[S_HEIGHT] -= dt / p[P_FORCE_TIME_CONSTANT] * state[S_HEIGHT]
     state[S_HEIGHT] = _clip(state[S_HEIGHT], p[P_FORCE_LIMIT])
@@ -526,6 +532,8 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
     # --- 6. landing and stepping (see zmpwalk.balance)
     stance = _rotate3(rot, ra[0], ra[1], ra[2])
     base_ex, base_ey = anchor_x - stance[0], anchor_y - stance[1]
+    planned_anchor = ankle_left if anchor == 0 else ankle_right
+    height_limit = p[P_LANDING_HEIGHT_LIMIT]
     error_norm = math.hypot(ex, ey)
     step = (p[P_STEP_GAIN] * max(error_norm - p[P_STEP_DEADBAND], 0.0) / error_norm if error_norm > 0.0
             else 0.0)
@@ -552,9 +560,22 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
                           seen[1] - planned[1] - turn_roll * planned[2], yaw)
             state[o] += landing_rate * (aim[0] + offset_x + step_x - state[o])
             state[o + 1] += landing_rate * (aim[1] + offset_y + step_y - state[o + 1])
+            if height_limit > 0.0:
+                # the planned height above the stance sole, on the floor's estimated plane, from the measured
+                # base; less the pelvis turn's share, which every foot gets (see below)
+                rise = -(nx * (world[0] - anchor_x) + ny * (world[1] - anchor_y)) / nz
+                above = world[2] - planned_anchor[2] + rise + stance[2]
+                stance_force = f0 if anchor == 0 else f1
+                if p[P_SOLE_STIFFNESS] > 0.0 and stance_force > 0.0:  # the stance sole is pressed into the floor
+                    above += (stance_force / p[P_SOLE_STIFFNESS]) ** (1.0 / p[P_SOLE_EXPONENT])
+                seen_z = rot[2] * (world[0] - base_ex) + rot[5] * (world[1] - base_ey) + rot[8] * above
+                aim_z = seen_z - planned[2] + turn_roll * planned[1] - turn_pitch * planned[0]
+                state[S_LANDING_HEIGHT + foot] += landing_rate * (aim_z - state[S_LANDING_HEIGHT + foot])
+                state[S_LANDING_HEIGHT + foot] = _clip(state[S_LANDING_HEIGHT + foot], height_limit)
         else:
             state[o] -= release_rate * state[o]
             state[o + 1] -= release_rate * state[o + 1]
+            state[S_LANDING_HEIGHT + foot] -= release_rate * state[S_LANDING_HEIGHT + foot]
         state[o] = _clip(state[o], landing_limit)
         state[o + 1] = _clip(state[o + 1], landing_limit)
         if swinging:
@@ -582,7 +603,8 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
         foot_turn = rotate2(state[S_ANKLE + 2 * leg], state[S_ANKLE + 2 * leg + 1], foot_yaw - yaw)
         changes[0] = landing[0] - shift[0] - turn_pitch * pz
         changes[1] = landing[1] - shift[1] + turn_roll * pz
-        changes[2] = (-height / 2 if leg == 0 else height / 2) - (turn_roll * py - turn_pitch * px)
+        changes[2] = ((-height / 2 if leg == 0 else height / 2) - (turn_roll * py - turn_pitch * px)
+                      + state[S_LANDING_HEIGHT + leg])
         changes[3] = foot_turn[0] - turn_roll
         changes[4] = foot_turn[1] - turn_pitch
         changes[5] = state[S_LANDING_YAW + leg]
