@@ -177,11 +177,16 @@ def test_a_sole_the_plan_has_down_that_carries_no_load_is_lowered_in_double_supp
 
 def test_a_swinging_sole_that_touches_down_early_is_raised() -> None:
     """Early touchdown: in single support the swinging sole's desired share of the load is none. With the left
-    foot swinging (right stance) and carrying 30 % of the weight, the error of the force difference is
-    -0.6 of the weight, and h(t) = -0.6 v T (1 - exp(-t / T)) (negative: the left foot raised)."""
+    foot swinging (right stance), lifted, and then carrying 30 % of the weight, the error of the force
+    difference is -0.6 of the weight, and h(t) = -0.6 v T (1 - exp(-t / T)) (negative: the left foot raised).
+    A sole that still carries load as it lifts (the load passes to the stance sole) is left to the plan."""
     stabilizer, inputs, _ = standing()
     gains = stabilizer.gains
-    run(stabilizer, {**inputs, "support": 2}, 100, loads=(0.6, 1.4))
+    swing = {**inputs, "support": 2}
+    run(stabilizer, swing, 100, loads=(0.6, 1.4))  # not lifted yet
+    assert stabilizer.state.height_difference == 0.0
+    run(stabilizer, swing, 1, loads=(0.0, 2.0))  # lifted
+    run(stabilizer, swing, 100, loads=(0.6, 1.4))  # down again
     rate, time_constant = gains.touchdown_speed, gains.force_time_constant
     expected = -0.6 * rate * time_constant * (1 - math.exp(-0.1 / time_constant))
     assert stabilizer.state.height_difference == pytest.approx(expected, rel=0.01)  # [m]

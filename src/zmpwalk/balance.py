@@ -32,7 +32,8 @@ separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega 
    that the plan has down but that carries none (it lands late, or the body rolled it off the floor) reads
    the whole weight as the difference and is lowered, at :attr:`StabilizerGains.touchdown_speed`, until it
    takes its share (landing timing). In single support the swinging sole's desired share is none: one that
-   touches down early carries load that the plan gives the stance sole, and it is raised at the same speed.
+   touches down early (it carries load again after it has lifted) carries load that the plan gives the
+   stance sole, and it is raised at the same speed.
 5. **Torso attitude**: the pelvis is turned against the measured roll and pitch (and their rates).
 6. **Landing and stepping**: the swinging foot aims at its planned place in world from the odometry's
    base, seen through the measured pelvis attitude, moved by :attr:`StabilizerGains.step_gain` times the
@@ -129,7 +130,7 @@ class StabilizerGains:
             that carries load in single support (an early touchdown).
         landing_height_limit: Largest height correction of a swinging foot that aims at its planned height
             above the floor [m]; 0 (the default) leaves the swing height to the pattern. The small biped's
-            file sets it: its CoP - ZMP RMS 12.1 -> 9.4 mm; HUBO's gets worse with it (docs/balance.md).
+            file sets it: its CoP - ZMP RMS 12.0 -> 9.5 mm; HUBO's gets worse with it (docs/balance.md).
     """
 
     dcm: float = 3.0  # [1/s]

@@ -96,7 +96,8 @@ S_ANCHOR = 30  # the reference sole of the odometry (0 left, 1 right)
 S_FLOOR_NORMAL = 31  # (3) filtered, in world
 S_SOLE_NORMALS = 34  # (2, 2) horizontal parts of each sole's normal in world, last tick
 S_LANDING_HEIGHT = 38  # (2) height corrections of the swinging feet [m]
-STATE_SIZE = 40
+S_LIFTED = 40  # (2) 1 once the swinging sole has carried no load in this single support
+STATE_SIZE = 42
 
 # --- log (zmpwalk.balance.BalanceState)
 L_ZMP_DESIRED = 0  # (2)
@@ -518,7 +519,15 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
     # touchdown, an early lift) reads the whole weight as the difference and is lowered at the touchdown speed;
     # in single support a swinging sole that carries load (an early touchdown) is raised at that speed
     weight = f0 + f1
-    early = (support == 1 and loaded1) or (support == 2 and loaded0)  # the swinging sole touches down early
+    if support == 0:
+        state[S_LIFTED] = state[S_LIFTED + 1] = 0.0
+    elif support == 1 and not loaded1:
+        state[S_LIFTED + 1] = 1.0
+    elif support == 2 and not loaded0:
+        state[S_LIFTED] = 1.0
+    # the swinging sole touches down early: it carries load after it has lifted (not while it lifts)
+    early = (support == 1 and loaded1 and state[S_LIFTED + 1] > 0.0) or (support == 2 and loaded0
+                                                                          and state[S_LIFTED] > 0.0)
     if (early or (support == 0 and (loaded0 or loaded1))) and weight > 0:
         wanted = (share0 - share1) * weight
         rate_gain = p[P_FORCE_GAIN] if loaded0 and loaded1 and not early else p[P_TOUCHDOWN_SPEED]
