@@ -569,9 +569,10 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
                           seen[1] - planned[1] - turn_roll * planned[2], yaw)
             state[o] += landing_rate * (aim[0] + offset_x + step_x - state[o])
             state[o + 1] += landing_rate * (aim[1] + offset_y + step_y - state[o + 1])
-            if height_limit > 0.0:
-                # the planned height above the stance sole, on the floor's estimated plane, from the measured
-                # base; less the pelvis turn's share, which every foot gets (see below)
+            if height_limit > 0.0 and anchor != foot:
+                # the planned height above the stance sole (the odometry's reference once the swinging sole has
+                # handed its load over), on the floor's estimated plane, from the measured base; less the
+                # pelvis turn's share, which every foot gets (see below)
                 rise = -(nx * (world[0] - anchor_x) + ny * (world[1] - anchor_y)) / nz
                 above = world[2] - planned_anchor[2] + rise + stance[2]
                 stance_force = f0 if anchor == 0 else f1
