@@ -337,6 +337,25 @@ def test_inputs_as_lists_give_the_same_targets_and_bad_inputs_are_rejected_leavi
     assert np.array_equal(stabilizer._state, state)
 
 
+def test_a_straight_leg_in_the_pattern_is_rejected_leaving_the_state() -> None:
+    """A straight knee makes the leg's Jacobian singular: no foot correction maps onto the joints there. The
+    tick raises an InvalidParameterError naming the leg's angles (it divided by a zero pivot before) and the
+    state is as it was; a knee bent by 0.05 rad is accepted."""
+    stabilizer, inputs, _ = standing()
+    run(stabilizer, inputs, 20, cop_shift=(0.01, -0.005))
+    state, log = stabilizer._state.copy(), stabilizer._log.copy()
+    straight = np.asarray(inputs["joint_angles"]).copy()
+    straight[6:12] = 0.0  # the right leg hangs straight below the hip
+    measurement = measured(stabilizer, inputs)
+    with pytest.raises(InvalidParameterError, match=r"joint_angles\[6:12\] \(right leg\).*knee that is not straight"):
+        stabilizer.update(**{**inputs, "joint_angles": straight}, measurement=measurement)  # type: ignore[arg-type]
+    assert np.array_equal(stabilizer._state, state) and np.array_equal(stabilizer._log, log)
+    bent = straight.copy()
+    bent[6 + JOINT_NAMES.index("knee")] = 0.05  # [rad] the columns are in JOINT_NAMES' order for each leg
+    targets = stabilizer.update(**{**inputs, "joint_angles": bent}, measurement=measurement)  # type: ignore[arg-type]
+    assert np.all(np.isfinite(targets))
+
+
 def test_stabilizer_carries_hubo_on_soft_servos() -> None:
     from zmpwalk.scenarios import load_scenario
     from zmpwalk.sim import simulate

@@ -389,6 +389,12 @@ class Stabilizer:
         kernel = self._kernel
         if status == kernel.BAD_SUPPORT:
             raise InvalidParameterError("support", support, "0 (double), 1 (left) or 2 (right)")
+        if status in (kernel.SINGULAR_LEG, kernel.SINGULAR_LEG + 1):
+            leg = status - kernel.SINGULAR_LEG
+            values = np.round(np.asarray(angles, dtype=float)[6 * leg:6 * leg + 6], 4).tolist()
+            raise InvalidParameterError(f"joint_angles[{6 * leg}:{6 * leg + 6}] ({('left', 'right')[leg]} leg)",
+                                        values, "a posture where the leg's Jacobian is invertible (a knee that is "
+                                        "not straight): no foot correction maps onto the joints at a singular one")
         given = (com, zmp, ankles[0], ankles[1], angles, m.wrench_left, m.wrench_right, m.attitude, m.rate,
                  m.joint_angles)[status - 1]
         raise InvalidParameterError(INPUT_NAMES[status - 1], f"{np.size(given)} values",

@@ -112,9 +112,11 @@ LOG_SIZE = 17
 
 # --- what tick() returns besides 0: 1 + the index of a vector input with too few values (in the order of the
 # arguments: com, zmp, ankle_left, ankle_right, reference, wrench_left, wrench_right, attitude, rate, encoders),
-# or BAD_SUPPORT
+# or BAD_SUPPORT, or SINGULAR_LEG + leg (0 left, 1 right)
 INPUT_SIZES = (3, 2, 3, 3, 12, 6, 6, 2, 3, 12)  # the vector inputs' lengths, in that order
 BAD_SUPPORT = 11
+SINGULAR_LEG = 12
+SINGULAR_PIVOT = 1e-6  # [m] or [-]: a smaller pivot of a leg's Jacobian (a straight knee) is a singular posture
 
 
 def initial_state(state: np.ndarray, log: np.ndarray) -> None:
@@ -216,8 +218,10 @@ def leg_jacobian(chain: np.ndarray, leg: int, frames: np.ndarray, ankle: tuple[f
 
 
 @njit(cache=True, nogil=True)
-def solve6(a: np.ndarray, b: np.ndarray) -> None:
-    """``b <- a^{-1} b`` for a (6, 6) ``a`` (overwritten) by Gaussian elimination with partial pivoting."""
+def solve6(a: np.ndarray, b: np.ndarray) -> float:
+    """``b <- a^{-1} b`` for a (6, 6) ``a`` (overwritten) by Gaussian elimination with partial pivoting; returns
+    the smallest pivot's magnitude (0 for a singular ``a``, and then ``b`` is left partly eliminated)."""
+    least = math.inf
     for col in range(6):
         pivot = col
         for row in range(col + 1, 6):
@@ -227,6 +231,9 @@ def solve6(a: np.ndarray, b: np.ndarray) -> None:
             for m in range(6):
                 a[col, m], a[pivot, m] = a[pivot, m], a[col, m]
             b[col], b[pivot] = b[pivot], b[col]
+        least = min(least, abs(a[col, col]))
+        if least == 0.0:
+            return 0.0
         for row in range(col + 1, 6):
             factor = a[row, col] / a[col, col]
             for m in range(col, 6):
@@ -237,6 +244,7 @@ def solve6(a: np.ndarray, b: np.ndarray) -> None:
         for m in range(row + 1, 6):
             total -= a[row, m] * b[m]
         b[row] = total / a[row, row]
+    return least
 
 
 @njit(cache=True, nogil=True)
@@ -336,8 +344,9 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
     """One tick of the stabilizer: ``targets`` (12) <- the corrected joint targets [rad].
 
     Returns 0; or, changing nothing, 1 + the index of a vector input with too few values, or
-    :data:`BAD_SUPPORT` for a support that is not 0, 1 or 2. Compiled for float64 vectors only (the signature
-    :data:`TICK_SIGNATURE`): other inputs raise TypeError.
+    :data:`BAD_SUPPORT` for a support that is not 0, 1 or 2, or :data:`SINGULAR_LEG` + the leg for pattern
+    angles where a leg's Jacobian is singular (a straight knee: no foot correction maps onto the joints).
+    Compiled for float64 vectors only (the signature :data:`TICK_SIGNATURE`): other inputs raise TypeError.
 
     Inputs in world unless said otherwise: the pattern's support (0 double, 1 left, 2 right), CoM point (3) [m],
     pelvis yaw [rad], ZMP (2) [m], planned ankles (3 each) [m], foot yaws [rad] and joint angles (12) [rad]; the
@@ -353,6 +362,19 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
         if given[i] < INPUT_SIZES[i]:
             return i + 1
     p = params
+    # the pattern's legs, and whether the foot corrections can be mapped onto their joints: checked before
+    # anything is written
+    leg_kinematics(chain, 0, reference, work[1])
+    leg_kinematics(chain, 1, reference, work[3])
+    p0 = ankle_in_base(p, 0, work[1])
+    p1 = ankle_in_base(p, 1, work[3])
+    jacobian = work[4, 0:6, 0:6]
+    changes = work[4, 0, 6:12]
+    for leg in range(2):
+        leg_jacobian(chain, leg, work[2 * leg + 1], p0 if leg == 0 else p1, jacobian)
+        changes[:] = 0.0
+        if solve6(jacobian, changes) < SINGULAR_PIVOT:
+            return SINGULAR_LEG + leg
     dt, omega, h = p[P_DT], p[P_OMEGA], p[P_ANKLE_HEIGHT]
     started = state[S_STARTED] > 0.0
     rx, ry = com[0], com[1]
@@ -369,16 +391,12 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
     roll, pitch = attitude[0], attitude[1]
     heading = yaw if math.isnan(measured_yaw) else measured_yaw
     leg_kinematics(chain, 0, encoders, work[0])
-    leg_kinematics(chain, 0, reference, work[1])
     leg_kinematics(chain, 1, encoders, work[2])
-    leg_kinematics(chain, 1, reference, work[3])
     rot = work[4, 6, 0:9]
     _rotation_zyx(heading, pitch, roll, rot)
     # measured ankles (base), reference ankles (base)
     a0 = ankle_in_base(p, 0, work[0])
-    p0 = ankle_in_base(p, 0, work[1])
     a1 = ankle_in_base(p, 1, work[2])
-    p1 = ankle_in_base(p, 1, work[3])
     # CoM in the base from the measured legs
     mx, my, mz = p[P_REST_MOMENT], p[P_REST_MOMENT + 1], p[P_REST_MOMENT + 2]
     for leg in range(2):
@@ -601,8 +619,6 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
                 state[o], state[o + 1] = rotate2(along, across, yaw)
     # --- corrections of the feet relative to the pelvis, onto the joints through the Jacobians
     shift = rotate2(offset_x, offset_y, -yaw)
-    jacobian = work[4, 0:6, 0:6]
-    changes = work[4, 0, 6:12]
     for i in range(12):
         targets[i] = reference[i]
     for leg in range(2):
