@@ -107,14 +107,20 @@ def test_the_ticks_compiled_kinematics_are_each_legs_own(name: str) -> None:
             assert np.abs(jacobian - chain.jacobian(pose)[0]).max() < KINEMATICS_TOL
 
 
-def test_the_compiled_solve_inverts_a_random_matrix() -> None:
+def test_the_compiled_solve_inverts_a_random_matrix_and_finds_a_singular_one() -> None:
     rng = np.random.default_rng(3)
+    swaps = np.zeros(6)
     for _ in range(50):
         a = rng.normal(size=(6, 6))
         x = rng.normal(size=6)
         b = a @ x
-        kernel.solve6(a.copy(), b)
+        factors = a.copy()
+        assert kernel.lu6(factors, swaps) > 0.0
+        kernel.lu_solve6(factors, swaps, b)
         assert np.abs(b - x).max() < 1e-9 * max(1.0, np.linalg.cond(a) / 1e3)
+    singular = rng.normal(size=(6, 6))
+    singular[4] = 2.0 * singular[1] - singular[2]  # rank 5
+    assert kernel.lu6(singular, swaps) < 1e-12
 
 
 def test_a_perfect_measurement_changes_nothing() -> None:

@@ -285,7 +285,7 @@ class Stabilizer:
         self._chain = chain
         self._state = np.zeros(kernel.STATE_SIZE)
         self._log = np.zeros(kernel.LOG_SIZE)
-        self._work = np.zeros((5, 7, 12))
+        self._work = np.zeros((6, 7, 12))
         self._targets = np.zeros(12)
         log = self._log
         self.state = BalanceState(  # views into the kernel's log: every update overwrites them in place

@@ -12,10 +12,11 @@ Arrays (all float64):
   among the leg's 6 role-ordered columns (10) (:data:`zmpwalk.kinematics.JOINT_COLUMNS`).
 - ``state`` (:data:`STATE_SIZE`): the filters and offsets that carry from tick to tick (layout below).
 - ``log`` (:data:`LOG_SIZE`): what :class:`zmpwalk.balance.BalanceState` shows (views into it).
-- ``work`` (5, 7, 12): scratch. ``work[pose]`` for the four poses (left measured, left reference, right
+- ``work`` (6, 7, 12): scratch. ``work[pose]`` for the four poses (left measured, left reference, right
   measured, right reference) holds the product of exponentials: each of the leg's 7 frames' rotation (row-major,
-  0:9) and translation (9:12) in the base frame. ``work[4]`` holds a leg's Jacobian (rows 0:6, columns 0:6),
-  the foot correction it solves for (row 0, 6:12) and the torso's rotation in world (row 6, 0:9).
+  0:9) and translation (9:12) in the base frame. ``work[4]`` holds the LU factors of the left and right leg's
+  Jacobians at the reference (rows 0:6, columns 0:6 and 6:12) and the torso's rotation in world (row 6, 0:9);
+  ``work[5]`` the factors' row swaps (row 0, 0:6 and 6:12) and a leg's foot correction (row 1, 0:6).
 
 The frames: *base* is the torso (pelvis) frame, x forward, y left, z up; *world* is the walk's frame, z up against
 gravity. Every position is in metres, every angle in radians.
@@ -218,33 +219,46 @@ def leg_jacobian(chain: np.ndarray, leg: int, frames: np.ndarray, ankle: tuple[f
 
 
 @njit(cache=True, nogil=True)
-def solve6(a: np.ndarray, b: np.ndarray) -> float:
-    """``b <- a^{-1} b`` for a (6, 6) ``a`` (overwritten) by Gaussian elimination with partial pivoting; returns
-    the smallest pivot's magnitude (0 for a singular ``a``, and then ``b`` is left partly eliminated)."""
+def lu6(a: np.ndarray, swaps: np.ndarray) -> float:
+    """``a`` (6, 6) <- its LU factors by Gaussian elimination with partial pivoting (``P a = L U``, the unit
+    ``L``'s multipliers below the diagonal), the row swapped into place at each column in ``swaps`` (6);
+    returns the smallest pivot's magnitude (0 for a singular ``a``, and the factoring stops there)."""
     least = math.inf
     for col in range(6):
         pivot = col
         for row in range(col + 1, 6):
             if abs(a[row, col]) > abs(a[pivot, col]):
                 pivot = row
+        swaps[col] = pivot
         if pivot != col:
             for m in range(6):
                 a[col, m], a[pivot, m] = a[pivot, m], a[col, m]
-            b[col], b[pivot] = b[pivot], b[col]
         least = min(least, abs(a[col, col]))
         if least == 0.0:
             return 0.0
         for row in range(col + 1, 6):
             factor = a[row, col] / a[col, col]
-            for m in range(col, 6):
+            a[row, col] = factor
+            for m in range(col + 1, 6):
                 a[row, m] -= factor * a[col, m]
-            b[row] -= factor * b[col]
+    return least
+
+
+@njit(cache=True, nogil=True)
+def lu_solve6(a: np.ndarray, swaps: np.ndarray, b: np.ndarray) -> None:
+    """``b <- A^{-1} b`` from the factors of :func:`lu6` (a non-singular ``A``)."""
+    for col in range(6):
+        pivot = int(swaps[col])
+        if pivot != col:
+            b[col], b[pivot] = b[pivot], b[col]
+    for row in range(6):
+        for m in range(row):
+            b[row] -= a[row, m] * b[m]
     for row in range(5, -1, -1):
         total = b[row]
         for m in range(row + 1, 6):
             total -= a[row, m] * b[m]
         b[row] = total / a[row, row]
-    return least
 
 
 @njit(cache=True, nogil=True)
@@ -362,18 +376,16 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
         if given[i] < INPUT_SIZES[i]:
             return i + 1
     p = params
-    # the pattern's legs, and whether the foot corrections can be mapped onto their joints: checked before
-    # anything is written
+    # the pattern's legs and their Jacobians' factors, which map the foot corrections onto the joints at the end;
+    # a singular one is rejected before anything is written
     leg_kinematics(chain, 0, reference, work[1])
     leg_kinematics(chain, 1, reference, work[3])
     p0 = ankle_in_base(p, 0, work[1])
     p1 = ankle_in_base(p, 1, work[3])
-    jacobian = work[4, 0:6, 0:6]
-    changes = work[4, 0, 6:12]
     for leg in range(2):
-        leg_jacobian(chain, leg, work[2 * leg + 1], p0 if leg == 0 else p1, jacobian)
-        changes[:] = 0.0
-        if solve6(jacobian, changes) < SINGULAR_PIVOT:
+        factors, swaps = work[4, 0:6, 6 * leg:6 * leg + 6], work[5, 0, 6 * leg:6 * leg + 6]
+        leg_jacobian(chain, leg, work[2 * leg + 1], p0 if leg == 0 else p1, factors)
+        if lu6(factors, swaps) < SINGULAR_PIVOT:
             return SINGULAR_LEG + leg
     dt, omega, h = p[P_DT], p[P_OMEGA], p[P_ANKLE_HEIGHT]
     started = state[S_STARTED] > 0.0
@@ -619,6 +631,7 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
                 state[o], state[o + 1] = rotate2(along, across, yaw)
     # --- corrections of the feet relative to the pelvis, onto the joints through the Jacobians
     shift = rotate2(offset_x, offset_y, -yaw)
+    changes = work[5, 1, 0:6]
     for i in range(12):
         targets[i] = reference[i]
     for leg in range(2):
@@ -634,8 +647,7 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
         changes[3] = foot_turn[0] - turn_roll
         changes[4] = foot_turn[1] - turn_pitch
         changes[5] = state[S_LANDING_YAW + leg]
-        leg_jacobian(chain, leg, work[2 * leg + 1], planned, jacobian)
-        solve6(jacobian, changes)
+        lu_solve6(work[4, 0:6, 6 * leg:6 * leg + 6], work[5, 0, 6 * leg:6 * leg + 6], changes)
         for i in range(6):
             targets[6 * leg + int(chain[leg, i, 10])] += changes[i]
     if p[P_STIFFEN] > 0.0:  # --- 8. servo stiffness: the encoder loop on the soft servos
