@@ -351,11 +351,11 @@ class Stabilizer:
             The targets, in an array that the next update overwrites (copy what you keep).
 
         Raises:
-            InvalidParameterError: ``support`` is not 0, 1 or 2, or an input has too few values (the state is
-                then as it was).
+            InvalidParameterError: ``support`` is not 0, 1 or 2, an input has too few values, or a leg's
+                Jacobian at ``joint_angles`` is singular (a straight knee); the state is then as it was.
 
-        The work is fixed: both legs' kinematics (measured and reference angles), one 6 x 6 solve per leg, and
-        scalar arithmetic, compiled; nothing is planned, iterated or allocated.
+        The work is fixed: both legs' kinematics (measured and reference angles), one 6 x 6 LU factoring and
+        solve per leg, and scalar arithmetic, compiled; nothing is planned, iterated or allocated.
         """
         m = measurement
         measured_yaw = math.nan if m.yaw is None else m.yaw
