@@ -287,6 +287,38 @@ def test_a_large_dcm_error_moves_the_swinging_foot_towards_the_fall() -> None:
     assert landing(0.02, gains) == pytest.approx(landing(0.02, without), abs=1e-12)  # inside the deadband
 
 
+def test_a_late_touchdown_keeps_its_aim_and_a_moment_without_load_is_no_late_touchdown() -> None:
+    """The right foot swings with the body 6 cm off its plan and builds a landing correction ``c``. Once
+    the plan puts it down it is released, ``c exp(-t / T_release)``, only if the sole carries load; a sole the
+    plan has down that stays bare (a late touchdown) keeps aiming. A stance sole bare for 15 ms (under
+    ``AIRBORNE_AIM``) is not a late touchdown and gets no correction; bare for 30 ms it is one."""
+    def swung() -> tuple[Stabilizer, dict[str, object]]:
+        stabilizer, inputs, _ = standing()
+        com = np.asarray(inputs["position_com_in_world"]).copy()
+        com[0] -= 0.06  # the plan is behind the body: a DCM error of +6 cm
+        inputs = {**inputs, "position_com_in_world": com}
+        run(stabilizer, {**inputs, "support": 1}, 1500, loads=(2.0, 0.0))  # left stance: the right foot swings
+        return stabilizer, inputs
+
+    stabilizer, inputs = swung()
+    aimed = float(stabilizer._landing[1][0])
+    assert abs(aimed) > 0.005  # [m]
+    run(stabilizer, {**inputs, "support": 0}, 300, loads=(1.0, 1.0))  # touched down
+    release = stabilizer.gains.landing_release
+    assert stabilizer._landing[1][0] == pytest.approx(aimed * math.exp(-0.3 / release), rel=0.01)
+    stabilizer, inputs = swung()
+    run(stabilizer, {**inputs, "support": 0}, 300, loads=(2.0, 0.0))  # the plan has it down; it is bare
+    assert stabilizer._landing[1][0] == pytest.approx(aimed, rel=0.05)
+    assert kernel.AIRBORNE_AIM == pytest.approx(0.02)  # [s] the figures below rest on it
+    for bare, aims in ((15, False), (30, True)):
+        stabilizer, inputs, _ = standing()
+        inputs = {**inputs, "position_com_in_world": np.asarray(inputs["position_com_in_world"]) - [0.06, 0, 0]}
+        run(stabilizer, inputs, 100)
+        run(stabilizer, inputs, bare, loads=(2.0, 0.0))
+        run(stabilizer, inputs, 100)
+        assert (abs(stabilizer._landing[1][0]) > 1e-4) == aims
+
+
 def test_a_step_towards_a_fall_never_crosses_the_stance_foot() -> None:
     """Standing on the left foot with the body 10 cm left of its plan (a fall towards the stance side): the right
     foot's aim moves left only until the soles' inner edges are feet_clearance apart."""

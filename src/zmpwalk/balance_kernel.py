@@ -98,7 +98,8 @@ S_FLOOR_NORMAL = 31  # (3) filtered, in world
 S_SOLE_NORMALS = 34  # (2, 2) horizontal parts of each sole's normal in world, last tick
 S_LANDING_HEIGHT = 38  # (2) height corrections of the swinging feet [m]
 S_LIFTED = 40  # (2) 1 once the swinging sole has carried no load in this single support
-STATE_SIZE = 42
+S_AIRBORNE = 42  # (2) how long each sole has carried no load, up to this tick [s]
+STATE_SIZE = 44
 
 # --- log (zmpwalk.balance.BalanceState)
 L_ZMP_DESIRED = 0  # (2)
@@ -117,6 +118,7 @@ LOG_SIZE = 17
 INPUT_SIZES = (3, 2, 3, 3, 12, 6, 6, 2, 3, 12)  # the vector inputs' lengths, in that order
 BAD_SUPPORT = 11
 SINGULAR_LEG = 12
+AIRBORNE_AIM = 0.02  # [s] a sole the plan has down that has carried no load this long keeps its landing aim
 SINGULAR_PIVOT = 1e-6  # [m] or [-]: a smaller pivot of a leg's Jacobian (a straight knee) is a singular posture
 
 
@@ -586,12 +588,16 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
     for foot in range(2):
         o = S_LANDING + 2 * foot
         swinging = (support == 1 and foot == 1) or (support == 2 and foot == 0)
+        loaded = loaded0 if foot == 0 else loaded1
+        state[S_AIRBORNE + foot] = 0.0 if loaded else state[S_AIRBORNE + foot] + dt
+        # a sole the plan has put down that has not touched down yet (a late touchdown) keeps aiming
+        aiming = swinging or state[S_AIRBORNE + foot] > AIRBORNE_AIM
         oy = S_LANDING_YAW + foot
-        if swinging:
+        if aiming:
             state[oy] += landing_rate * (yaw_aim - state[oy])
         else:
             state[oy] += -release_rate * state[oy]
-        if swinging:
+        if aiming:
             planned = p0 if foot == 0 else p1
             world = ankle_left if foot == 0 else ankle_right
             seen = _rotate3_back(rot, world[0] - base_ex, world[1] - base_ey, planned[2])
@@ -618,7 +624,7 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
             state[S_LANDING_HEIGHT + foot] -= release_rate * state[S_LANDING_HEIGHT + foot]
         state[o] = _clip(state[o], landing_limit)
         state[o + 1] = _clip(state[o + 1], landing_limit)
-        if swinging:
+        if aiming:
             # No step across the stance foot: the soles' inner edges keep feet_clearance between them (the
             # correction's part across the pelvis; the planned feet relative to the pelvis from the reference).
             swing, stance_ankle = (p0, p1) if foot == 0 else (p1, p0)
