@@ -290,8 +290,8 @@ def test_a_large_dcm_error_moves_the_swinging_foot_towards_the_fall() -> None:
 def test_a_late_touchdown_keeps_its_aim_and_a_moment_without_load_is_no_late_touchdown() -> None:
     """The right foot swings with the body 6 cm off its plan and builds a landing correction ``c``. Once
     the plan puts it down it is released, ``c exp(-t / T_release)``, only if the sole carries load; a sole the
-    plan has down that stays bare (a late touchdown) keeps aiming. A stance sole bare for 15 ms (under
-    ``AIRBORNE_AIM``) is not a late touchdown and gets no correction; bare for 30 ms it is one."""
+    plan has down that stays bare (a late touchdown) keeps aiming. A stance sole bare for 3/4 of
+    ``AIRBORNE_AIM`` (20 ms) is not a late touchdown and gets no correction; bare for 3/2 of it, it is one."""
     def swung() -> tuple[Stabilizer, dict[str, object]]:
         stabilizer, inputs, _ = standing()
         com = np.asarray(inputs["position_com_in_world"]).copy()
@@ -309,8 +309,8 @@ def test_a_late_touchdown_keeps_its_aim_and_a_moment_without_load_is_no_late_tou
     stabilizer, inputs = swung()
     run(stabilizer, {**inputs, "support": 0}, 300, loads=(2.0, 0.0))  # the plan has it down; it is bare
     assert stabilizer._landing[1][0] == pytest.approx(aimed, rel=0.05)
-    assert kernel.AIRBORNE_AIM == pytest.approx(0.02)  # [s] the figures below rest on it
-    for bare, aims in ((15, False), (30, True)):
+    ticks = round(kernel.AIRBORNE_AIM * 1000.0)  # at 1 kHz
+    for bare, aims in ((ticks * 3 // 4, False), (ticks * 3 // 2, True)):
         stabilizer, inputs, _ = standing()
         inputs = {**inputs, "position_com_in_world": np.asarray(inputs["position_com_in_world"]) - [0.06, 0, 0]}
         run(stabilizer, inputs, 100)
