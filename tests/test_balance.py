@@ -268,16 +268,23 @@ def test_odometry_follows_the_newer_foot_through_double_support() -> None:
     assert stabilizer._anchor == 1
 
 
+def off_plan(error_x: float, error_y: float = 0.0,
+             gains: StabilizerGains | None = None) -> tuple[Stabilizer, dict[str, object]]:
+    """HUBO standing (as :func:`standing`) with the plan's CoM moved so that the body is ``(error_x, error_y)``
+    [m] ahead and left of it: a DCM error of that much. Double support; the caller picks the support."""
+    stabilizer, inputs, _ = standing()
+    if gains is not None:
+        stabilizer = Stabilizer(stabilizer.robot, 1000.0, gains)
+    com = np.asarray(inputs["position_com_in_world"]) - np.array([error_x, error_y, 0.0])
+    return stabilizer, {**inputs, "position_com_in_world": com}
+
+
 def test_a_large_dcm_error_moves_the_swinging_foot_towards_the_fall() -> None:
     """Standing on the left foot with the body 6 cm ahead of its plan: the right foot's aim moves forward by
     step_gain times the DCM error beyond the deadband; within the deadband it lands where planned."""
     def landing(shift: float, gains: StabilizerGains) -> float:
-        stabilizer, inputs, _ = standing()
-        stabilizer = Stabilizer(stabilizer.robot, 1000.0, gains)
-        com = np.asarray(inputs["position_com_in_world"]).copy()
-        com[0] -= shift  # the plan is behind the body: a DCM error of +shift
-        inputs = {**inputs, "position_com_in_world": com, "support": 1}
-        run(stabilizer, inputs, 1500, loads=(2.0, 0.0))
+        stabilizer, inputs = off_plan(shift, gains=gains)
+        run(stabilizer, {**inputs, "support": 1}, 1500, loads=(2.0, 0.0))
         return float(stabilizer._landing[1][0])
 
     gains = StabilizerGains(step_gain=0.5, step_deadband=0.03)
@@ -293,10 +300,7 @@ def test_a_late_touchdown_keeps_its_aim_and_a_moment_without_load_is_no_late_tou
     plan has down that stays bare (a late touchdown) keeps aiming. A stance sole bare for 3/4 of
     ``AIRBORNE_AIM`` (20 ms) is not a late touchdown and gets no correction; bare for 3/2 of it, it is one."""
     def swung() -> tuple[Stabilizer, dict[str, object]]:
-        stabilizer, inputs, _ = standing()
-        com = np.asarray(inputs["position_com_in_world"]).copy()
-        com[0] -= 0.06  # the plan is behind the body: a DCM error of +6 cm
-        inputs = {**inputs, "position_com_in_world": com}
+        stabilizer, inputs = off_plan(0.06)
         run(stabilizer, {**inputs, "support": 1}, 1500, loads=(2.0, 0.0))  # left stance: the right foot swings
         return stabilizer, inputs
 
@@ -311,8 +315,7 @@ def test_a_late_touchdown_keeps_its_aim_and_a_moment_without_load_is_no_late_tou
     assert stabilizer._landing[1][0] == pytest.approx(aimed, rel=0.05)
     ticks = round(kernel.AIRBORNE_AIM * 1000.0)  # at 1 kHz
     for bare, aims in ((ticks * 3 // 4, False), (ticks * 3 // 2, True)):
-        stabilizer, inputs, _ = standing()
-        inputs = {**inputs, "position_com_in_world": np.asarray(inputs["position_com_in_world"]) - [0.06, 0, 0]}
+        stabilizer, inputs = off_plan(0.06)
         run(stabilizer, inputs, 100)
         run(stabilizer, inputs, bare, loads=(2.0, 0.0))
         run(stabilizer, inputs, 100)
@@ -322,14 +325,10 @@ def test_a_late_touchdown_keeps_its_aim_and_a_moment_without_load_is_no_late_tou
 def test_a_step_towards_a_fall_never_crosses_the_stance_foot() -> None:
     """Standing on the left foot with the body 10 cm left of its plan (a fall towards the stance side): the right
     foot's aim moves left only until the soles' inner edges are feet_clearance apart."""
-    stabilizer, inputs, _ = standing()
-    robot = stabilizer.robot
     gains = StabilizerGains(landing_limit=0.2)
-    stabilizer = Stabilizer(robot, 1000.0, gains)
-    com = np.asarray(inputs["position_com_in_world"]).copy()
-    com[1] -= 0.10  # the plan is right of the body: a DCM error of +10 cm in y
-    inputs = {**inputs, "position_com_in_world": com, "support": 1}
-    run(stabilizer, inputs, 1500, loads=(2.0, 0.0))
+    stabilizer, inputs = off_plan(0.0, 0.10, gains)  # the plan is right of the body
+    robot = stabilizer.robot
+    run(stabilizer, {**inputs, "support": 1}, 1500, loads=(2.0, 0.0))
     left, right = (np.asarray(a) for a in inputs["ankles_in_world"])  # type: ignore[attr-defined]
     right_y = right[1] + float(stabilizer._landing[1][1])  # where the right ankle lands (upright, heading 0)
     inner = robot.sole_center_y - robot.foot_width / 2  # the inner edge of the left sole from its ankle [m]

@@ -45,10 +45,10 @@ separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega 
    sole, on the floor's estimated plane, from the measured legs and attitude, plus the stance sole's
    compression ``(f / k)^(1/e)`` under its measured force ``f`` where the robot file gives the soles' contact
    law (a stance sole pressed into the floor lowers the whole robot, and a swinging foot whose plan comes down
-   gently reaches the floor that much early). The corrections are released once the plan puts the foot down
-   and the sole has touched down: a sole the plan has down that has carried no load for over
-   :data:`zmpwalk.balance_kernel.AIRBORNE_AIM` (a late touchdown) keeps its aim, while a stance sole that
-   unloads for a moment (sensor noise, a rocking body) is not taken for one.
+   gently reaches the floor that much early). The corrections are released once the plan puts the foot down,
+   unless its sole has carried no load for over :data:`zmpwalk.balance_kernel.AIRBORNE_AIM` (a late
+   touchdown), which keeps its aim until it carries load; a stance sole that unloads for a shorter moment
+   (sensor noise, a rocking body) is not taken for one.
 7. **Floor slope**: in double support both soles lie on the floor, so their attitude (IMU and measured leg
    kinematics) is the floor's; with unit normal ``n`` the CoM must stand ``l (n_x, n_y) / n_z`` uphill of
    its plan for the ZMP to stay where planned, and the CoM admittance is pulled to that offset instead of
@@ -108,8 +108,8 @@ class StabilizerGains:
         zmp_margin: ``p_d`` is kept this far inside the support polygon [m].
         velocity_filter: Time constant of the CoM velocity estimate's low-pass filter [s].
         landing_time_constant: How fast a swinging foot's aim moves to its planned place in world [s].
-        landing_release: How fast that correction is released once the plan puts the foot down and the sole
-            carries load [s].
+        landing_release: How fast that correction is released once the plan puts the foot down, unless its
+            sole has been bare for over ``balance_kernel.AIRBORNE_AIM`` (a late touchdown, still aiming) [s].
         landing_limit: Largest landing correction [m].
         slope_time_constant: Low-pass filter of the floor normal measured under both soles in double support
             [s]; 0 turns the slope compensation off.
