@@ -22,9 +22,12 @@ from zmpwalk.robots.model import JOINT_NAMES
 TALOS = Path(__file__).resolve().parents[2] / "shared" / "robots" / "pal_talos" / "scene_position.xml"
 
 
+WHOLE_BODY = "whole_body"  # what standing() gives as the CoM point
+
+
 def standing() -> tuple[Stabilizer, dict[str, object], float]:
-    """HUBO standing in the ready posture, the stabilizer's inputs for it (the CoM and the ZMP where its
-    kinematics put the CoM), and half its weight [N]."""
+    """HUBO standing in the ready posture, the stabilizer's inputs for it (its whole-body CoM, where its
+    kinematics put it, and the ZMP under it), and half its weight [N]."""
     robot = load_robot("hubo")
     pattern = generate(robot, [StepCommand(duration=0.8)], rate=1000.0)
     angles = pattern_joint_trajectory(pattern).angles[0]
@@ -41,7 +44,7 @@ def standing() -> tuple[Stabilizer, dict[str, object], float]:
         "ankles_in_world": (pattern.position_left_ankle_in_world[0], pattern.position_right_ankle_in_world[0]),
         "foot_yaws": (0.0, 0.0), "joint_angles": angles,
     }
-    return Stabilizer(robot, 1000.0), inputs, robot.mass * robot.gravity / 2
+    return Stabilizer(robot, 1000.0, com_reference=WHOLE_BODY), inputs, robot.mass * robot.gravity / 2
 
 
 def wrench(force: float, cop_x: float = 0.0, cop_y: float = 0.0, ankle_height: float = 0.095) -> np.ndarray:
@@ -154,7 +157,7 @@ def test_torso_leaning_forward_moves_the_desired_zmp_forward_and_turns_the_pelvi
 def test_measured_zmp_ahead_of_the_desired_accelerates_the_com_forward() -> None:
     stabilizer, inputs, _ = standing()
     gains = dataclasses.replace(stabilizer.gains, ankle_gain=0.0)
-    stabilizer = Stabilizer(stabilizer.robot, 1000.0, gains)
+    stabilizer = Stabilizer(stabilizer.robot, 1000.0, gains, com_reference=WHOLE_BODY)
     run(stabilizer, inputs, 50, cop_shift=(0.02, 0.0))
     assert stabilizer.state.com_offset[0] > 0.0  # c'' = A (p_measured - p_desired) > 0
 
@@ -176,7 +179,7 @@ def test_a_sole_the_plan_has_down_that_carries_no_load_is_lowered_in_double_supp
     rate, time_constant = gains.touchdown_speed, gains.force_time_constant
     expected = rate * time_constant * (1 - math.exp(-0.1 / time_constant))
     assert stabilizer.state.height_difference == pytest.approx(expected, rel=0.01)  # [m] left lowered by half
-    swinging = Stabilizer(stabilizer.robot, 1000.0)
+    swinging = Stabilizer(stabilizer.robot, 1000.0, com_reference=WHOLE_BODY)
     run(swinging, {**inputs, "support": 2}, 100, loads=(0.0, 2.0))  # right stance: the left foot swings
     assert swinging.state.height_difference == 0.0
 
@@ -221,7 +224,7 @@ def test_the_swinging_foot_aims_at_its_planned_height_above_the_floor(roll: floa
     stabilizer, inputs, half = standing()
     robot = stabilizer.robot
     gains = dataclasses.replace(stabilizer.gains, landing_height_limit=0.02)
-    stabilizer = Stabilizer(robot, 1000.0, gains)
+    stabilizer = Stabilizer(robot, 1000.0, gains, com_reference=WHOLE_BODY)
     swing = {**inputs, "support": 2}  # right stance: the left foot swings
     targets = run(stabilizer, swing, 5000, loads=(0.0, 2.0), attitude=np.array([roll, 0.0]))  # 25 time constants
     assert robot.contact is not None
@@ -229,7 +232,8 @@ def test_the_swinging_foot_aims_at_its_planned_height_above_the_floor(roll: floa
     left, right = (np.asarray(a) for a in inputs["ankles_in_world"])  # type: ignore[attr-defined]
     expected = -math.sin(roll) * (left[1] - right[1]) + math.cos(roll) * compression
     assert left_ankle_height_change(stabilizer, swing, targets) == pytest.approx(expected, abs=1e-9)  # [m]
-    off = Stabilizer(robot, 1000.0, dataclasses.replace(gains, landing_height_limit=0.0))  # the pattern's height
+    off = Stabilizer(robot, 1000.0, dataclasses.replace(gains, landing_height_limit=0.0),  # the pattern's height
+                     com_reference=WHOLE_BODY)
     targets = run(off, swing, 100, loads=(0.0, 2.0))
     assert abs(left_ankle_height_change(off, swing, targets)) < 1e-9  # [m]
 
@@ -243,7 +247,8 @@ def test_a_floor_rising_ahead_moves_the_com_uphill_by_l_tan_slope() -> None:
     expected = stabilizer.robot.pendulum_length * math.tan(slope)
     assert stabilizer.state.slope_offset[0] == pytest.approx(expected, rel=0.01)  # 5 filter time constants
     assert abs(stabilizer.state.slope_offset[1]) < 1e-3 * expected
-    off = Stabilizer(stabilizer.robot, 1000.0, dataclasses.replace(stabilizer.gains, slope_time_constant=0.0))
+    off = Stabilizer(stabilizer.robot, 1000.0, dataclasses.replace(stabilizer.gains, slope_time_constant=0.0),
+                     com_reference=WHOLE_BODY)
     run(off, inputs, 100, attitude=np.array([0.0, -slope]))
     assert np.all(off.state.slope_offset == 0.0)
 
@@ -274,7 +279,7 @@ def off_plan(error_x: float, error_y: float = 0.0,
     [m] ahead and left of it: a DCM error of that much. Double support; the caller picks the support."""
     stabilizer, inputs, _ = standing()
     if gains is not None:
-        stabilizer = Stabilizer(stabilizer.robot, 1000.0, gains)
+        stabilizer = Stabilizer(stabilizer.robot, 1000.0, gains, com_reference=WHOLE_BODY)
     com = np.asarray(inputs["position_com_in_world"]) - np.array([error_x, error_y, 0.0])
     return stabilizer, {**inputs, "position_com_in_world": com}
 
@@ -346,13 +351,15 @@ def test_bad_gains_are_rejected(field: str) -> None:
     assert StabilizerGains(slope_time_constant=0.0).slope_time_constant == 0.0  # 0 turns the slope loop off
     with pytest.raises(InvalidParameterError, match="rate"):
         Stabilizer(load_robot("hubo"), 5.0)
+    with pytest.raises(InvalidParameterError, match=r"com_reference.*'pelvic'.*auto, pelvis, whole_body"):
+        Stabilizer(load_robot("hubo"), 1000.0, com_reference="pelvic")
 
 
 def test_inputs_as_lists_give_the_same_targets_and_bad_inputs_are_rejected_leaving_the_state() -> None:
     """The tick takes float64 vectors; lists and other dtypes are converted (same targets), short vectors and a
     support other than 0, 1, 2 raise an InvalidParameterError naming the input, and the state is as it was."""
     stabilizer, inputs, _ = standing()
-    twin = Stabilizer(stabilizer.robot, 1000.0)
+    twin = Stabilizer(stabilizer.robot, 1000.0, com_reference=WHOLE_BODY)
     run(stabilizer, inputs, 20, cop_shift=(0.01, -0.005))
     run(twin, inputs, 20, cop_shift=(0.01, -0.005))
     measurement = measured(stabilizer, inputs, cop_shift=(0.01, -0.005))
@@ -474,8 +481,9 @@ def test_servos_softer_than_kappa_m_g_l_get_an_encoder_loop_of_that_stiffness() 
     robot = hubo.robot
     assert robot.servos is not None
     soft = dataclasses.replace(robot, servos=dataclasses.replace(robot.servos, kp=100.0))
-    stiffened = Stabilizer(soft, 1000.0)
-    plain = Stabilizer(soft, 1000.0, dataclasses.replace(stiffened.gains, servo_stiffness=0.0))
+    stiffened = Stabilizer(soft, 1000.0, com_reference=WHOLE_BODY)
+    plain = Stabilizer(soft, 1000.0, dataclasses.replace(stiffened.gains, servo_stiffness=0.0),
+                       com_reference=WHOLE_BODY)
     weight_moment = robot.mass * robot.gravity * robot.pendulum_length  # the box legs' links sum to the mass
     kappa = StabilizerGains().servo_stiffness
     assert stiffened.servo_gain == pytest.approx(np.full(12, kappa * weight_moment / 100.0 - 1.0), rel=1e-9)
@@ -522,3 +530,36 @@ def test_a_sole_that_takes_the_load_with_no_tick_of_both_loaded_is_placed_by_the
     left, right = (np.asarray(a) for a in inputs["ankles_in_world"])  # type: ignore[attr-defined]
     expected = np.asarray(stabilizer._feet[0]) + (right - left)[:2]  # upright, heading 0: the legs as planned
     assert np.asarray(stabilizer._feet[1]) == pytest.approx(expected, abs=1e-9)
+
+
+WHOLE_BODY_TOL = 1e-12  # [m]
+
+
+def test_against_a_pelvis_point_the_com_offset_rests_where_the_planned_whole_body_com_stands_on_it() -> None:
+    """A box model's pattern plans its pelvis point as the cart-table's mass. The planned whole-body CoM lies
+    ``d`` from it (the legs at the pattern's angles and the rest of the body, turned by the pelvis yaw), and the
+    CoM offset rests at ``-d``: with no admittance, ``Delta c'' = -K_v Delta c' - K_p (Delta c + d)``, it
+    settles there (the gain ``whole_body_rest`` 1, HUBO's). Against a whole-body CoM point it stays at zero."""
+    whole, inputs, _ = standing()
+    robot = whole.robot
+    assert Stabilizer(robot, 1000.0).com_reference == "pelvis"  # "auto" for a box model
+    gains = dataclasses.replace(whole.gains, com_admittance=0.0, com_stiffness=10.0, com_damping=6.0,
+                                slope_time_constant=0.0, whole_body_rest=1.0)
+    yaw = 0.3  # [rad]
+    angles = np.asarray(inputs["joint_angles"])
+    rest, rest_com = rest_mass(robot)
+    moment, total = rest * np.asarray(rest_com), rest
+    for index, chain in enumerate(leg_chains(robot)):
+        moment = moment + chain.link_masses @ chain.link_com_positions(angles[None, 6 * index:6 * index + 6])[0]
+        total += float(chain.link_masses.sum())
+    in_base = moment[:2] / total
+    expected = np.array([math.cos(yaw) * in_base[0] - math.sin(yaw) * in_base[1],
+                         math.sin(yaw) * in_base[0] + math.cos(yaw) * in_base[1]])
+    assert np.linalg.norm(expected) > 0.005  # [m] HUBO's legs and body: a real offset to rest at
+    turned = {**inputs, "yaw_pelvis_in_world": yaw}
+    for reference, rest_at in (("pelvis", -expected), (WHOLE_BODY, np.zeros(2))):
+        stabilizer = Stabilizer(robot, 1000.0, gains, com_reference=reference)
+        run(stabilizer, turned, 1)
+        assert np.abs(stabilizer.state.whole_body_offset + rest_at).max() < WHOLE_BODY_TOL
+        run(stabilizer, turned, 4000)  # 4 s: K_p = 10 /s^2, K_v = 6 /s settle within 2 s
+        assert np.abs(stabilizer.state.com_offset - rest_at).max() < 0.01 * np.linalg.norm(expected) + 1e-12

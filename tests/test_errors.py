@@ -136,7 +136,7 @@ def test_a_robot_files_stabilizer_gains_are_checked(tmp_path, table, message):
     with pytest.raises(FileFormatError, match=message):
         load_robot(path)
     hubo = load_robot("hubo")
-    assert dict(hubo.stabilizer_gains) == {"com_stiffness": 3.0, "touchdown_speed": 0.2}
+    assert dict(hubo.stabilizer_gains) == {"com_stiffness": 3.0, "touchdown_speed": 0.2, "whole_body_rest": 1.0}
     gains = Stabilizer(hubo, 1000.0).gains
     assert (gains.com_stiffness, gains.touchdown_speed) == (3.0, 0.2)
     assert Stabilizer(load_robot("mju-biped"), 1000.0).gains.com_stiffness == 10.0  # the default
@@ -169,3 +169,18 @@ def test_numpy_scalars_are_numbers():
     command = StepCommand(duration=np.float32(0.8), forward=np.int64(0), sway=np.float64(0.03))
     assert type(command.duration) is float and command.duration == pytest.approx(0.8, abs=1e-7)  # [s]
     assert type(command.forward) is float and command.forward == 0.0
+
+
+def test_simulate_rejects_a_stabilizer_told_the_wrong_com_point():
+    """A box model's pattern gives its pelvis point; a multibody-corrected one its whole-body CoM: a stabilizer
+    made for the other is rejected with what the pattern gives, before anything is simulated."""
+    from zmpwalk.balance import Stabilizer
+    from zmpwalk.kinematics import pattern_joint_trajectory
+    from zmpwalk.patterns.polynomial import generate
+    from zmpwalk.sim import simulate
+
+    hubo = load_robot("hubo")
+    pattern = generate(hubo, [StepCommand(duration=0.8)], rate=1000.0)
+    joints = pattern_joint_trajectory(pattern)
+    with pytest.raises(InvalidParameterError, match=r"stabilizer.com_reference.*'whole_body'.*pelvis: the CoM"):
+        simulate(hubo, joints, pattern, stabilizer=Stabilizer(hubo, 1000.0, com_reference="whole_body"))

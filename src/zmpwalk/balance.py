@@ -22,8 +22,15 @@ separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega 
 
    (from ``xi' = omega (xi - p)``), kept :attr:`StabilizerGains.zmp_margin` inside the support polygon.
 2. **CoM admittance** realises ``p_d``: the commanded CoM accelerates by
-   ``Delta c'' = A (p_measured - p_d) - K_v Delta c' - K_p Delta c`` (in the cart-table model
-   ``p = c - c'' / omega^2``, accelerating forward moves the ZMP back).
+   ``Delta c'' = A (p_measured - p_d) - K_v Delta c' - K_p (Delta c - Delta c_rest)`` (in the cart-table
+   model ``p = c - c'' / omega^2``, accelerating forward moves the ZMP back). Where the pattern's CoM point
+   is its pelvis point (a box model's pattern: the cart-table's one mass at the base origin), the offset
+   can rest (:attr:`StabilizerGains.whole_body_rest`, HUBO's file) at ``Delta c_rest = -(c_planned -
+   c_pelvis)``, minus the planned whole-body CoM's offset from that
+   point (the legs at the pattern's angles and the rest of the body, the estimate's mass model), so that the
+   whole-body CoM stands where the cart-table puts its mass; resting at zero, the pull ``K_p`` held the CoM
+   that far ahead and the DCM loop answered with a desired ZMP ahead of the plan (HUBO's fig27: 14.7 mm on
+   average).
 3. **Ankle damping control** (the damping control of Kajita et al. 2010): each loaded sole's centre of
    pressure follows its share of ``p_d`` by turning the foot, ``delta' = -(tau_d - tau) / D - delta / T``,
    written per metre of CoP error.
@@ -83,6 +90,7 @@ Array = NDArray[np.float64]
 
 TIME_CONSTANTS = ("ankle_time_constant", "force_time_constant", "landing_time_constant", "landing_release")
 LOAD_FRACTION = 0.05  # [-] of the robot's weight: a sole carries load above this normal force
+COM_REFERENCES = ("auto", "pelvis", "whole_body")  # what the CoM point given to Stabilizer.update is
 
 
 @dataclass(frozen=True)
@@ -92,7 +100,8 @@ class StabilizerGains:
     Attributes:
         dcm: ``k_xi``, decay rate of the DCM error [1/s].
         com_admittance: ``A``, CoM acceleration per metre of ZMP error [1/s^2].
-        com_stiffness: ``K_p``, pull of the CoM offset back to the pattern [1/s^2].
+        com_stiffness: ``K_p``, pull of the CoM offset back to its rest point (the module docstring, steps 2
+            and 7) [1/s^2].
         com_damping: ``K_v`` [1/s].
         com_limit: Largest CoM offset [m].
         ankle_gain: Foot turn rate per metre of CoP error [rad/(s m)] (``F / D`` of Kajita's damping control).
@@ -135,6 +144,11 @@ class StabilizerGains:
         landing_height_limit: Largest height correction of a swinging foot that aims at its planned height
             above the floor [m]; 0 (the default) leaves the swing height to the pattern. The small biped's
             file sets it: its CoP - ZMP RMS 12.0 -> 9.5 mm; HUBO's gets worse with it (docs/balance.md).
+        whole_body_rest: Against a pelvis point (``com_reference`` ``"pelvis"``), the CoM offset rests at this
+            fraction of minus the planned whole-body CoM's offset from that point (the module docstring, step 2)
+            [-]; 0 (the default) rests it at zero. HUBO's file sets 1: fig27's CoP - ZMP RMS 26.3 -> 24.6 mm
+            on soft servos (28.1 -> 28.6 on stiff ones), the other scenarios 0-4 mm lower; the small biped's
+            9.5 -> 9.1 mm, but it then falls with 2 ms of sensor latency (docs/balance.md).
     """
 
     dcm: float = 3.0  # [1/s]
@@ -164,6 +178,7 @@ class StabilizerGains:
     feet_clearance: float = 0.02  # [m]
     touchdown_speed: float = 0.05  # [m/s]
     landing_height_limit: float = 0.0  # [m]
+    whole_body_rest: float = 0.0  # [-]
 
     def __post_init__(self) -> None:
         for name, value in vars(self).items():
@@ -210,6 +225,9 @@ class BalanceState:
         height_difference: Left foot lowered, right raised by half of this [m].
         pelvis_turn: Roll and pitch of the pelvis correction [rad], (2,).
         slope_offset: Where the floor's slope puts the CoM offset [m], (2,).
+        whole_body_offset: The planned whole-body CoM less the pattern's pelvis point, times the gain
+            ``whole_body_rest`` [m], (2,) (zero unless the stabilizer's ``com_reference`` is ``"pelvis"``); the
+            CoM offset rests at minus it (plus the slope's offset).
     """
 
     zmp_desired: Array
@@ -220,6 +238,7 @@ class BalanceState:
     height_difference: float
     pelvis_turn: Array
     slope_offset: Array = field(default_factory=lambda: np.zeros(2))
+    whole_body_offset: Array = field(default_factory=lambda: np.zeros(2))
 
 
 class Stabilizer:
@@ -231,14 +250,29 @@ class Stabilizer:
         gains: The gains (default: :class:`StabilizerGains` with the robot file's ``[stabilizer]`` gains, which
             HUBO's box model has; the defaults suit TALOS, Booster T1 and the small biped in the simulation;
             docs/balance.md).
+        com_reference: What :meth:`update`'s ``position_com_in_world`` is: ``"pelvis"``, the pattern's
+            pelvis point, which a box model's patterns plan as the cart-table's mass (the CoM offset can then
+            rest where it puts the planned whole-body CoM on that point: the module docstring, step 2);
+            ``"whole_body"``, the whole-body CoM (an imported robot's patterns, whose base is placed under
+            it, and a multibody-corrected pattern's ``position_com_in_world``); ``"auto"`` (default):
+            ``"whole_body"`` for an imported robot, else ``"pelvis"``.
+
+    Raises:
+        InvalidParameterError: A rate outside [10, 10000] Hz or an unknown ``com_reference``.
 
     The first :meth:`update` initialises the filters; :meth:`reset` forgets the state. The tick itself is
     :func:`zmpwalk.balance_kernel.tick`, compiled on first use (cached on disk afterwards).
     """
 
-    def __init__(self, robot: RobotModel, rate: float, gains: StabilizerGains | None = None) -> None:
+    def __init__(self, robot: RobotModel, rate: float, gains: StabilizerGains | None = None, *,
+                 com_reference: str = "auto") -> None:
         if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not 10.0 <= rate <= 10_000.0:
             raise InvalidParameterError("rate", rate, "a control rate in [10, 10000] Hz")
+        if com_reference not in COM_REFERENCES:
+            raise InvalidParameterError("com_reference", com_reference, f"one of {', '.join(COM_REFERENCES)}")
+        if com_reference == "auto":
+            com_reference = "whole_body" if robot.plant is not None else "pelvis"
+        self.com_reference = com_reference
         from zmpwalk import balance_kernel as kernel  # compiles (or loads) the tick: only where one is wanted
 
         self._kernel = kernel
@@ -275,6 +309,7 @@ class Stabilizer:
         params[kernel.P_FEET_CLEARANCE] = self.gains.feet_clearance
         params[kernel.P_TOUCHDOWN_SPEED] = self.gains.touchdown_speed
         params[kernel.P_LANDING_HEIGHT_LIMIT] = self.gains.landing_height_limit
+        params[kernel.P_WHOLE_BODY_REST] = self.gains.whole_body_rest if com_reference == "pelvis" else 0.0
         if robot.contact is not None:  # the soles' compliance, where the robot file gives it
             params[kernel.P_SOLE_STIFFNESS] = robot.contact.stiffness
             params[kernel.P_SOLE_EXPONENT] = robot.contact.exponent
@@ -300,7 +335,8 @@ class Stabilizer:
             ankle_offsets=log[kernel.L_ANKLE_OFFSETS:kernel.L_ANKLE_OFFSETS + 4].reshape(2, 2),
             height_difference=0.0,
             pelvis_turn=log[kernel.L_PELVIS_TURN:kernel.L_PELVIS_TURN + 2],
-            slope_offset=log[kernel.L_SLOPE_OFFSET:kernel.L_SLOPE_OFFSET + 2])
+            slope_offset=log[kernel.L_SLOPE_OFFSET:kernel.L_SLOPE_OFFSET + 2],
+            whole_body_offset=log[kernel.L_WHOLE_BODY_OFFSET:kernel.L_WHOLE_BODY_OFFSET + 2])
         # One tick on the legs' reference posture here, so that the first tick of the loop is no slower than the
         # others (numba's first call into a function is: about 0.5 ms).
         posture = np.concatenate([np.asarray(c.reference, dtype=float)[list(c.role_order)] for c in self.chains])
@@ -343,7 +379,8 @@ class Stabilizer:
 
         Args:
             support: The pattern's support at this tick: 0 double, 1 left, 2 right.
-            position_com_in_world: The pattern's CoM point [m] (3,) (the pelvis point of the pattern).
+            position_com_in_world: The pattern's CoM point [m] (3,): its pelvis point, or its whole-body CoM
+                (the constructor's ``com_reference`` says which).
             yaw_pelvis_in_world: [rad].
             zmp_in_world: The pattern's ZMP [m] (2,).
             ankles_in_world: Planned left and right ankle positions [m], each (3,).

@@ -74,7 +74,8 @@ P_TOUCHDOWN_SPEED = 56  # [m/s] the gain touchdown_speed
 P_LANDING_HEIGHT_LIMIT = 57  # [m] the gain landing_height_limit
 P_SOLE_STIFFNESS = 58  # [N/m^e] k of the sole's contact law f = k x^e (0: a rigid sole)
 P_SOLE_EXPONENT = 59  # [-] e
-PARAMETERS = 60
+P_WHOLE_BODY_REST = 60  # [-] the gain whole_body_rest where the CoM input is a pelvis point, else 0
+PARAMETERS = 61
 GAIN_NAMES = ("dcm", "com_admittance", "com_stiffness", "com_damping", "com_limit", "ankle_gain",
               "ankle_time_constant", "ankle_limit", "force_gain", "force_time_constant", "force_limit",
               "attitude_gain", "attitude_damping", "attitude_limit", "zmp_margin", "velocity_filter",
@@ -110,7 +111,8 @@ L_ANKLE_OFFSETS = 8  # (2, 2)
 L_HEIGHT_DIFFERENCE = 12
 L_PELVIS_TURN = 13  # (2)
 L_SLOPE_OFFSET = 15  # (2)
-LOG_SIZE = 17
+L_WHOLE_BODY_OFFSET = 17  # (2)
+LOG_SIZE = 19
 
 # --- what tick() returns besides 0: 1 + the index of a vector input with too few values (in the order of the
 # arguments: com, zmp, ankle_left, ankle_right, reference, wrench_left, wrench_right, attitude, rate, encoders),
@@ -392,6 +394,19 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
     dt, omega, h = p[P_DT], p[P_OMEGA], p[P_ANKLE_HEIGHT]
     started = state[S_STARTED] > 0.0
     rx, ry = com[0], com[1]
+    # the planned whole-body CoM's offset from a pelvis point (the pattern's legs at their planned angles)
+    whole_x = whole_y = 0.0
+    if p[P_WHOLE_BODY_REST] > 0.0:
+        qx, qy = p[P_REST_MOMENT], p[P_REST_MOMENT + 1]
+        for leg in range(2):
+            frames = work[2 * leg + 1]
+            for i in range(6):
+                f = frames[i + 1]
+                lx, ly, lz = chain[leg, i, 6], chain[leg, i, 7], chain[leg, i, 8]
+                mass = chain[leg, i, 9]
+                qx += mass * (f[0] * lx + f[1] * ly + f[2] * lz + f[9])
+                qy += mass * (f[3] * lx + f[4] * ly + f[5] * lz + f[10])
+        whole_x, whole_y = rotate2(p[P_WHOLE_BODY_REST] * qx / p[P_MASS], p[P_WHOLE_BODY_REST] * qy / p[P_MASS], yaw)
     if not started:
         state[S_PREVIOUS_REFERENCE], state[S_PREVIOUS_REFERENCE + 1] = rx, ry
     vrx = (rx - state[S_PREVIOUS_REFERENCE]) / dt
@@ -518,8 +533,11 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
         ax, ay = p[P_COM_ADMITTANCE] * (zmx - pdx), p[P_COM_ADMITTANCE] * (zmy - pdy)
     else:
         ax = ay = 0.0
-    ax -= p[P_COM_DAMPING] * state[S_OFFSET_RATE] + p[P_COM_STIFFNESS] * (state[S_OFFSET] + slope_x)
-    ay -= p[P_COM_DAMPING] * state[S_OFFSET_RATE + 1] + p[P_COM_STIFFNESS] * (state[S_OFFSET + 1] + slope_y)
+    # the offset rests where the slope wants the CoM and, against a pelvis point, where the planned whole-body CoM
+    # stands on that point (the cart-table's mass)
+    rest_x, rest_y = -(slope_x + whole_x), -(slope_y + whole_y)
+    ax -= p[P_COM_DAMPING] * state[S_OFFSET_RATE] + p[P_COM_STIFFNESS] * (state[S_OFFSET] - rest_x)
+    ay -= p[P_COM_DAMPING] * state[S_OFFSET_RATE + 1] + p[P_COM_STIFFNESS] * (state[S_OFFSET + 1] - rest_y)
     state[S_OFFSET_RATE] += ax * dt
     state[S_OFFSET_RATE + 1] += ay * dt
     state[S_OFFSET] += state[S_OFFSET_RATE] * dt
@@ -668,4 +686,5 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
     log[L_HEIGHT_DIFFERENCE] = height
     log[L_PELVIS_TURN], log[L_PELVIS_TURN + 1] = turn_roll, turn_pitch
     log[L_SLOPE_OFFSET], log[L_SLOPE_OFFSET + 1] = -slope_x, -slope_y
+    log[L_WHOLE_BODY_OFFSET], log[L_WHOLE_BODY_OFFSET + 1] = whole_x, whole_y
     return 0
