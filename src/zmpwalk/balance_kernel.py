@@ -189,6 +189,24 @@ def leg_kinematics(chain: np.ndarray, leg: int, columns: np.ndarray, frames: np.
 
 
 @njit(cache=True, nogil=True)
+def com_in_base(params: np.ndarray, chain: np.ndarray, work: np.ndarray, planned: int) -> tuple[float, float, float]:
+    """The whole-body CoM in the base frame [m] from the legs' frames in ``work`` (:func:`leg_kinematics`'s:
+    the measured legs' for ``planned`` 0, the pattern's for 1) and the rest of the body."""
+    mx, my, mz = params[P_REST_MOMENT], params[P_REST_MOMENT + 1], params[P_REST_MOMENT + 2]
+    for leg in range(2):
+        frames = work[2 * leg + planned]
+        for i in range(6):
+            f = frames[i + 1]
+            cx, cy, cz = chain[leg, i, 6], chain[leg, i, 7], chain[leg, i, 8]
+            mass = chain[leg, i, 9]
+            mx += mass * (f[0] * cx + f[1] * cy + f[2] * cz + f[9])
+            my += mass * (f[3] * cx + f[4] * cy + f[5] * cz + f[10])
+            mz += mass * (f[6] * cx + f[7] * cy + f[8] * cz + f[11])
+    total = params[P_MASS]
+    return mx / total, my / total, mz / total
+
+
+@njit(cache=True, nogil=True)
 def ankle_in_base(params: np.ndarray, leg: int, frames: np.ndarray) -> tuple[float, float, float]:
     """The ankle point of the leg's last frame, in the base frame [m]."""
     f = frames[6]
@@ -397,16 +415,8 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
     # the planned whole-body CoM's offset from a pelvis point (the pattern's legs at their planned angles)
     whole_x = whole_y = 0.0
     if p[P_WHOLE_BODY_REST] > 0.0:
-        qx, qy = p[P_REST_MOMENT], p[P_REST_MOMENT + 1]
-        for leg in range(2):
-            frames = work[2 * leg + 1]
-            for i in range(6):
-                f = frames[i + 1]
-                lx, ly, lz = chain[leg, i, 6], chain[leg, i, 7], chain[leg, i, 8]
-                mass = chain[leg, i, 9]
-                qx += mass * (f[0] * lx + f[1] * ly + f[2] * lz + f[9])
-                qy += mass * (f[3] * lx + f[4] * ly + f[5] * lz + f[10])
-        whole_x, whole_y = rotate2(p[P_WHOLE_BODY_REST] * qx / p[P_MASS], p[P_WHOLE_BODY_REST] * qy / p[P_MASS], yaw)
+        qx, qy, _ = com_in_base(p, chain, work, 1)
+        whole_x, whole_y = rotate2(p[P_WHOLE_BODY_REST] * qx, p[P_WHOLE_BODY_REST] * qy, yaw)
     if not started:
         state[S_PREVIOUS_REFERENCE], state[S_PREVIOUS_REFERENCE + 1] = rx, ry
     vrx = (rx - state[S_PREVIOUS_REFERENCE]) / dt
@@ -427,18 +437,7 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
     a0 = ankle_in_base(p, 0, work[0])
     a1 = ankle_in_base(p, 1, work[2])
     # CoM in the base from the measured legs
-    mx, my, mz = p[P_REST_MOMENT], p[P_REST_MOMENT + 1], p[P_REST_MOMENT + 2]
-    for leg in range(2):
-        frames = work[2 * leg]
-        for i in range(6):
-            f = frames[i + 1]
-            cx, cy, cz = chain[leg, i, 6], chain[leg, i, 7], chain[leg, i, 8]
-            mass = chain[leg, i, 9]
-            mx += mass * (f[0] * cx + f[1] * cy + f[2] * cz + f[9])
-            my += mass * (f[3] * cx + f[4] * cy + f[5] * cz + f[10])
-            mz += mass * (f[6] * cx + f[7] * cy + f[8] * cz + f[11])
-    total = p[P_MASS]
-    com_bx, com_by, com_bz = mx / total, my / total, mz / total
+    com_bx, com_by, com_bz = com_in_base(p, chain, work, 0)
     # each measured sole's normal (third column of its last frame) in world, horizontal part
     n0 = _rotate3(rot, work[0, 6, 2], work[0, 6, 5], work[0, 6, 8])
     n1 = _rotate3(rot, work[2, 6, 2], work[2, 6, 5], work[2, 6, 8])
