@@ -17,12 +17,23 @@ from zmpwalk.errors import InvalidParameterError
 from zmpwalk.kinematics import leg_chains, pattern_joint_trajectory, rest_mass
 from zmpwalk.patterns.polynomial import generate
 from zmpwalk.robots import load_robot
-from zmpwalk.robots.model import JOINT_NAMES
+from zmpwalk.robots.model import JOINT_NAMES, RobotModel
 
 TALOS = Path(__file__).resolve().parents[2] / "shared" / "robots" / "pal_talos" / "scene_position.xml"
 
 
 WHOLE_BODY = "whole_body"  # what standing() gives as the CoM point
+
+
+def com_in_base(robot: RobotModel, angles: np.ndarray) -> np.ndarray:
+    """The whole-body CoM in the base frame [m], (3,), of the legs at ``angles`` (12) and the rest of the body,
+    from the leg chains (independently of the stabilizer's compiled sum)."""
+    rest, rest_com = rest_mass(robot)
+    moment, total = rest * np.asarray(rest_com), rest
+    for index, chain in enumerate(leg_chains(robot)):
+        moment = moment + chain.link_masses @ chain.link_com_positions(angles[None, 6 * index:6 * index + 6])[0]
+        total += float(chain.link_masses.sum())
+    return np.asarray(moment / total)
 
 
 def standing() -> tuple[Stabilizer, dict[str, object], float]:
@@ -31,13 +42,7 @@ def standing() -> tuple[Stabilizer, dict[str, object], float]:
     robot = load_robot("hubo")
     pattern = generate(robot, [StepCommand(duration=0.8)], rate=1000.0)
     angles = pattern_joint_trajectory(pattern).angles[0]
-    rest, rest_com = rest_mass(robot)
-    moment = rest * rest_com
-    total = rest
-    for index, chain in enumerate(leg_chains(robot)):
-        moment = moment + chain.link_masses @ chain.link_com_positions(angles[None, 6 * index:6 * index + 6])[0]
-        total += float(chain.link_masses.sum())
-    com = pattern.position_pelvis_in_world[0] + moment / total
+    com = pattern.position_pelvis_in_world[0] + com_in_base(robot, angles)
     com[2] = pattern.position_pelvis_in_world[0, 2]
     inputs = {
         "support": 0, "position_com_in_world": com, "yaw_pelvis_in_world": 0.0, "zmp_in_world": com[:2].copy(),
@@ -546,13 +551,7 @@ def test_against_a_pelvis_point_the_com_offset_rests_where_the_planned_whole_bod
     gains = dataclasses.replace(whole.gains, com_admittance=0.0, com_stiffness=10.0, com_damping=6.0,
                                 slope_time_constant=0.0, whole_body_rest=1.0)
     yaw = 0.3  # [rad]
-    angles = np.asarray(inputs["joint_angles"])
-    rest, rest_com = rest_mass(robot)
-    moment, total = rest * np.asarray(rest_com), rest
-    for index, chain in enumerate(leg_chains(robot)):
-        moment = moment + chain.link_masses @ chain.link_com_positions(angles[None, 6 * index:6 * index + 6])[0]
-        total += float(chain.link_masses.sum())
-    in_base = moment[:2] / total
+    in_base = com_in_base(robot, np.asarray(inputs["joint_angles"]))
     expected = np.array([math.cos(yaw) * in_base[0] - math.sin(yaw) * in_base[1],
                          math.sin(yaw) * in_base[0] + math.cos(yaw) * in_base[1]])
     assert np.linalg.norm(expected) > 0.005  # [m] HUBO's legs and body: a real offset to rest at

@@ -26,11 +26,10 @@ separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega 
    model ``p = c - c'' / omega^2``, accelerating forward moves the ZMP back). Where the pattern's CoM point
    is its pelvis point (a box model's pattern: the cart-table's one mass at the base origin), the offset
    can rest (:attr:`StabilizerGains.whole_body_rest`, HUBO's file) at ``Delta c_rest = -(c_planned -
-   c_pelvis)``, minus the planned whole-body CoM's offset from that
-   point (the legs at the pattern's angles and the rest of the body, the estimate's mass model), so that the
-   whole-body CoM stands where the cart-table puts its mass; resting at zero, the pull ``K_p`` held the CoM
-   that far ahead and the DCM loop answered with a desired ZMP ahead of the plan (HUBO's fig27: 14.7 mm on
-   average).
+   c_pelvis)``, minus the planned whole-body CoM's offset from that point (the legs at the pattern's angles
+   and the rest of the body, the estimate's mass model), so that the whole-body CoM stands where the
+   cart-table puts its mass; resting at zero, the pull ``K_p`` held the CoM that far ahead and the DCM loop
+   answered with a desired ZMP ahead of the plan (HUBO's fig27: 14.7 mm on average).
 3. **Ankle damping control** (the damping control of Kajita et al. 2010): each loaded sole's centre of
    pressure follows its share of ``p_d`` by turning the foot, ``delta' = -(tau_d - tau) / D - delta / T``,
    written per metre of CoP error.
@@ -255,7 +254,8 @@ class Stabilizer:
             rest where it puts the planned whole-body CoM on that point: the module docstring, step 2);
             ``"whole_body"``, the whole-body CoM (an imported robot's patterns, whose base is placed under
             it, and a multibody-corrected pattern's ``position_com_in_world``); ``"auto"`` (default):
-            ``"whole_body"`` for an imported robot, else ``"pelvis"``.
+            ``"whole_body"`` for an imported robot, else ``"pelvis"``. A pattern's
+            :attr:`~zmpwalk.patterns.result.WalkingPattern.com_point` names the one it gives.
 
     Raises:
         InvalidParameterError: A rate outside [10, 10000] Hz or an unknown ``com_reference``.

@@ -403,8 +403,7 @@ def _simulate(args: argparse.Namespace) -> int:
         show(stages[2], 2, len(stages))
     from zmpwalk.balance import Stabilizer
 
-    reference = "auto" if pattern.position_com_in_world is None else "whole_body"  # a corrected pattern's CoM
-    stabilizer = Stabilizer(robot, 1000.0, com_reference=reference) if _balance(args, robot) else None
+    stabilizer = Stabilizer(robot, 1000.0, com_reference=pattern.com_point) if _balance(args, robot) else None
     result = simulate(robot, joints, pattern, mass_scale=args.mass_scale, stabilizer=stabilizer,
                       latency=args.latency, settle=SETTLE, hold=HOLD,
                       progress=None if show is None else lambda done: show("simulation", round(100 * done), 100))

@@ -149,6 +149,13 @@ class WalkingPattern:
         """Time of the last sample [s]."""
         return float(self.time[-1])
 
+    @property
+    def com_point(self) -> str:
+        """What a stabilizer tracks as this pattern's CoM (:class:`zmpwalk.balance.Stabilizer`'s
+        ``com_reference``): ``"whole_body"`` where it records ``position_com_in_world`` or its robot is imported
+        (the base is placed under the pattern's point), else ``"pelvis"`` (a box model's pelvis point)."""
+        return "whole_body" if self.position_com_in_world is not None or self.robot.plant is not None else "pelvis"
+
     def _in_pelvis(self, position: Array) -> Array:
         rel = position - self.position_pelvis_in_world
         c, s = np.cos(self.yaw_pelvis_in_world), np.sin(self.yaw_pelvis_in_world)

@@ -283,12 +283,9 @@ def simulate(
         raise InvalidParameterError("hold", hold, "a time in [0, 60] s")
     if not 0.0 <= latency <= 0.1:
         raise InvalidParameterError("latency", latency, "a delay in [0, 0.1] s")
-    # the CoM point the stabilizer gets: a corrected pattern's whole-body CoM, an imported robot's pattern point
-    # (its base is placed under it), else a box model's pelvis point
-    whole_body = pattern.position_com_in_world is not None or robot.plant is not None
-    if stabilizer is not None and stabilizer.com_reference != ("whole_body" if whole_body else "pelvis"):
+    if stabilizer is not None and stabilizer.com_reference != pattern.com_point:
         raise InvalidParameterError("stabilizer.com_reference", stabilizer.com_reference,
-                                    f"{'whole_body' if whole_body else 'pelvis'}: the CoM point this pattern gives")
+                                    f"{pattern.com_point}: the CoM point this pattern gives")
     plant = build_plant(robot, mass_scale)
     if feedforward is None:
         feedforward = plant.imported or stabilizer is not None
