@@ -367,6 +367,29 @@ class Stabilizer:
         """Their yaw corrections [rad], (2,), a view of the state."""
         return self._state[self._kernel.S_LANDING_YAW:self._kernel.S_LANDING_YAW + 2]
 
+    def landing_correction(self, foot: str) -> Array:
+        """The landing correction of ``foot`` (``"left"`` or ``"right"``) in world [m], (2,), a copy: where the
+        stabilizer aims the swinging foot, relative to its planned place.
+
+        Raises:
+            InvalidParameterError: ``foot`` is not ``"left"`` or ``"right"``.
+        """
+        if foot not in ("left", "right"):
+            raise InvalidParameterError("foot", foot, '"left" or "right"')
+        return self._landing[0 if foot == "left" else 1].copy()
+
+    def hand_over_landing(self, foot: str) -> Array:
+        """Clear the landing correction of ``foot`` and return it (:meth:`landing_correction`): a new plan
+        whose swing starts from the planned place plus it takes it over (a capture step,
+        :func:`zmpwalk.capture.capture_step`), so the foot's target does not jump.
+
+        Raises:
+            InvalidParameterError: ``foot`` is not ``"left"`` or ``"right"``.
+        """
+        correction = self.landing_correction(foot)
+        self._landing[0 if foot == "left" else 1] = 0.0
+        return correction
+
     def reset(self) -> None:
         """Forget the filters and offsets (the next update starts from the reference)."""
         self._kernel.initial_state(self._state, self._log)

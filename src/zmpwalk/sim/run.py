@@ -41,9 +41,10 @@ from mujoco import rollout
 from numpy.typing import NDArray
 
 from zmpwalk.balance import BalanceMeasurement, Stabilizer
-from zmpwalk.errors import InvalidParameterError
+from zmpwalk.capture import CapturePlan, CaptureSettings, capture_step
+from zmpwalk.errors import InvalidParameterError, UnreachableError
 from zmpwalk.files import atomic_output
-from zmpwalk.kinematics import JOINT_COLUMNS, JointTrajectory
+from zmpwalk.kinematics import JOINT_COLUMNS, JointTrajectory, pattern_joint_trajectory
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sim.mjcf import contact_mapping
@@ -67,6 +68,7 @@ AFTER_FALL = 0.3  # [s] simulated after a fall
 SETTLE = 1.0  # [s] default settle phase of a robot's own model
 HOLD = 2.0  # [s] default hold after the walk of a robot's own model
 LOADED_FRACTION = 0.15  # [-] of the weight: a sole carrying more is "loaded" (its CoP is measured)
+CAPTURE_INTERVAL = 0.02  # [s] least time between two capture steps planned in one single support
 NOSLIP_ITERATIONS = 5  # MuJoCo noslip iterations on a tilted floor (Disturbances.apply: no creep of loaded soles)
 
 
@@ -103,6 +105,8 @@ class SimulationResult:
         end_min_sole_force: Smallest normal force on either sole over the final hold [N] (both loaded: > 0).
         end_max_speed: Largest horizontal speed of the base over the final hold [m/s].
         end_attitude_range: Largest spread of torso roll or pitch over the final hold [rad].
+        captures: The capture steps taken (``simulate``'s ``capture``), in order; empty when the pattern was
+            played to its end.
     """
 
     robot: RobotModel
@@ -135,6 +139,7 @@ class SimulationResult:
     end_min_sole_force: float = math.nan  # [N]
     end_max_speed: float = math.nan  # [m/s]
     end_attitude_range: float = math.nan  # [rad]
+    captures: list[CapturePlan] = field(default_factory=list)
 
     @property
     def cop_error(self) -> Array:
@@ -238,6 +243,7 @@ def simulate(
     noise: SensorNoise | None = None,
     progress: Callable[[float], None] | None = None,
     disturbances: Disturbances | None = None,
+    capture: CaptureSettings | None = None,
 ) -> SimulationResult:
     """Simulate ``joints`` (made from ``pattern``) on ``robot`` and measure the walk.
 
@@ -263,6 +269,11 @@ def simulate(
         progress: Called with the fraction done [0, 1] now and then while a closed loop runs.
         disturbances: A push, a floor tilt or a mass error of the plant (:class:`Disturbances`); the pattern,
             the feedforward and the stabilizer keep the nominal robot.
+        capture: With a stabilizer: once its DCM error passes ``capture.trigger`` in a single support, the
+            rest of the walk is replaced by a capture step planned from its estimate
+            (:func:`zmpwalk.capture.capture_step`; the joint references and the feedforward re-made for it),
+            at most once a walk; the result's ``captures`` lists it, and the walk's end (final feet, the
+            reference ZMP) is the capture's. None (default): the pattern is played to its end.
 
     Returns:
         The measurements. The same input gives the same result.
@@ -283,6 +294,11 @@ def simulate(
         raise InvalidParameterError("hold", hold, "a time in [0, 60] s")
     if not 0.0 <= latency <= 0.1:
         raise InvalidParameterError("latency", latency, "a delay in [0, 0.1] s")
+    if capture is not None and stabilizer is None:
+        raise InvalidParameterError("capture", capture, "None without a stabilizer (its DCM estimate triggers it)")
+    if capture is not None and pattern.position_com_in_world is not None:
+        raise InvalidParameterError("capture", capture, "None for a multibody-corrected pattern (a capture step "
+                                    "plans the pattern's CoM point)")
     if stabilizer is not None and stabilizer.com_reference != pattern.com_point:
         raise InvalidParameterError("stabilizer.com_reference", stabilizer.com_reference,
                                     f"{pattern.com_point}: the CoM point this pattern gives")
@@ -302,14 +318,14 @@ def simulate(
     settle_ticks = round(settle * CONTROL_RATE)
     time = np.arange(-settle_ticks, math.floor((pattern.time[-1] + hold) * CONTROL_RATE + 1e-9) + 1) / CONTROL_RATE
     pattern_time = np.clip(time, pattern.time[0], pattern.time[-1])
-    reference = np.column_stack([np.interp(pattern_time, joints.time, joints.angles[:, j]) for j in range(12)])
-    zmp_ref = np.column_stack([np.interp(pattern_time, pattern.time, pattern.zmp_in_world[:, i]) for i in range(2)])
+    zmp_ref = _rows_at(pattern_time, pattern.time, pattern.zmp_in_world)
     # Standing still before the walk the ZMP is under the CoM (c'' = 0 in p = c - c'' l / g, Eqs. 1-2); the
     # pattern's first sample is already the walk's (a start stage that accelerates, the start transient of
     # Lim et al. whose ZMP jumps), which neither the feedforward nor the stabilizer may hold during the settle.
     planned_com = pattern.position_pelvis_in_world if pattern.position_com_in_world is None \
         else pattern.position_com_in_world
     zmp_ref[time < pattern.time[0]] = planned_com[0, :2]
+    reference, control, planned_torques = _controls(plant, pattern, joints, pattern_time, zmp_ref, feedforward)
     base_planned = (pattern.position_pelvis_in_world if joints.position_base_in_world is None
                     else joints.position_base_in_world)
     set_initial_state(plant, data, base_planned[0], float(pattern.yaw_pelvis_in_world[0]), reference[0], penetration)
@@ -318,22 +334,51 @@ def simulate(
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     state = np.empty(mujoco.mj_stateSize(model, spec))
     mujoco.mj_getState(model, data, state, spec)
-    control = np.repeat(plant.ctrl_hold[None, :], n, axis=0)
-    control[:, plant.leg_actuators] = reference
-    planned_torques: Array | None = None
-    if feedforward:
-        index = np.clip(np.searchsorted(pattern.time, pattern_time), 0, len(pattern.time) - 1)
-        base_path = np.column_stack([np.interp(pattern_time, pattern.time, base_planned[:, i]) for i in range(3)])
-        yaw_path = np.interp(pattern_time, pattern.time, pattern.yaw_pelvis_in_world)
-        planned_ankles = [np.column_stack([np.interp(pattern_time, pattern.time, a[:, i]) for i in range(3)])
-                          for a in (pattern.position_left_ankle_in_world, pattern.position_right_ankle_in_world)]
-        qpos_path = plant_qpos(plant, base_path, yaw_path, reference)
-        rates = np.column_stack([np.interp(pattern_time, joints.time, joints.velocities[:, j]) for j in range(12)])
-        control[:, plant.leg_actuators] += damping_feedforward(plant, rates)
-        needed = servo_torques(plant, qpos_path, zmp_ref, pattern.support[index],
-                               (planned_ankles[0], planned_ankles[1]))
-        control += servo_offsets(plant, needed)
-        planned_torques = needed[:, plant.leg_actuators]
+    captures: list[tuple[CapturePlan, WalkingPattern]] = []
+
+    def capture_tail(k: int, stabilizer: Stabilizer, stance_support: int) -> dict[str, Array]:
+        """The references from tick ``k + 1`` on, re-made for a capture step planned from the stabilizer's
+        estimate at tick ``k`` (its DCM error; the swinging foot's landing correction handed over), in the single
+        support ``stance_support`` (1 left, 2 right)."""
+        source, touchdown = pattern, None
+        if captures:  # a capture step under way is re-planned from its own plan, landing no later than needed
+            source, touchdown = captures[-1][1], captures[-1][0].time + captures[-1][0].swing_time
+        at = float(np.clip(time[k + 1], source.time[0], source.time[-1]))
+        position_com = _rows_at(np.array([at]), source.time, source.position_pelvis_in_world)[0]
+        velocity_com = _rows_at(np.array([at]), source.time, source.velocity_pelvis_in_world)[0]
+        dcm = position_com[:2] + velocity_com[:2] / stabilizer.omega + stabilizer.state.dcm_error
+        stance = "left" if stance_support == 1 else "right"
+        swing = "right" if stance == "left" else "left"
+        ankles = [_rows_at(np.array([at]), source.time, a)[0]
+                  for a in (source.position_left_ankle_in_world, source.position_right_ankle_in_world)]
+        rates = [_rows_at(np.array([at]), source.time, v)[0]
+                 for v in (source.velocity_left_ankle_in_world, source.velocity_right_ankle_in_world)]
+        ankles[0 if swing == "left" else 1][:2] += stabilizer.landing_correction(swing)
+        yaws = (float(np.interp(at, source.time, source.yaw_left_foot_in_world)),
+                float(np.interp(at, source.time, source.yaw_right_foot_in_world)))
+        tail, plan = capture_step(
+            robot, time=float(time[k + 1]), rate=CONTROL_RATE, end=float(time[-1]), stance=stance,
+            position_com_in_world=position_com, dcm_in_world=dcm,
+            yaw_pelvis_in_world=float(np.interp(at, source.time, source.yaw_pelvis_in_world)),
+            ankles_in_world=(ankles[0], ankles[1]), ankle_velocities_in_world=(rates[0], rates[1]), foot_yaws=yaws,
+            settings=capture, touchdown=touchdown)
+        stabilizer.hand_over_landing(swing)  # the capture's swing starts where the correction aimed it
+        captures.append((plan, tail))
+        tail_time = np.clip(time[k + 1:], tail.time[0], tail.time[-1])
+        zmp = _rows_at(tail_time, tail.time, tail.zmp_in_world)
+        tail_reference, tail_control, torques = _controls(
+            plant, tail, pattern_joint_trajectory(tail, check_limits=False), tail_time, zmp, feedforward)
+        if planned_torques is not None and torques is not None:
+            planned_torques[k + 1:] = torques
+        return {"com": _rows_at(tail_time, tail.time, tail.position_pelvis_in_world),
+                "yaw": np.interp(tail_time, tail.time, tail.yaw_pelvis_in_world),
+                "left": _rows_at(tail_time, tail.time, tail.position_left_ankle_in_world),
+                "right": _rows_at(tail_time, tail.time, tail.position_right_ankle_in_world),
+                "left_yaw": np.interp(tail_time, tail.time, tail.yaw_left_foot_in_world),
+                "right_yaw": np.interp(tail_time, tail.time, tail.yaw_right_foot_in_world),
+                "support": _support_at(tail, tail_time), "zmp": zmp, "reference": tail_reference,
+                "control": tail_control}
+
     if disturbances is not None:  # the world changes after the controller's model is made
         disturbances.apply(model)
     balance_log: dict[str, Array] | None = None
@@ -343,7 +388,8 @@ def simulate(
     else:
         readings, balance_log = _closed_loop(model, data, plant, stabilizer, pattern, pattern_time, reference,
                                              control, zmp_ref, steps_per_tick, sensors, latency, noise, progress,
-                                             disturbances, time)
+                                             disturbances, time, None if capture is None else capture.trigger,
+                                             capture_tail)
     # --- measurements
     pelvis = sensors.take(readings, "pelvis_pos")
     rpy = _rpy(sensors.take(readings, "pelvis_quat"))
@@ -393,9 +439,10 @@ def simulate(
     # How the walk ends: the feet against the plan, and the last `hold` seconds (standing still?).
     feet_error = feet_yaw_error = math.nan
     end_force = end_speed = end_attitude = math.nan
+    final = captures[-1][1] if captures else pattern  # after a capture step the walk ends as it planned
     if fall_index is None:
-        planned = (pattern.position_left_ankle_in_world[-1], pattern.position_right_ankle_in_world[-1])
-        planned_yaw = (pattern.yaw_left_foot_in_world[-1], pattern.yaw_right_foot_in_world[-1])
+        planned = (final.position_left_ankle_in_world[-1], final.position_right_ankle_in_world[-1])
+        planned_yaw = (final.yaw_left_foot_in_world[-1], final.yaw_right_foot_in_world[-1])
         feet_error = max(float(np.linalg.norm(ankles[-1, f] - planned[f][:2])) for f in range(2))
         yaws = [_rpy(sensors.take(readings[-1:], f"{label}_ankle_quat"))[0, 2] for label in ("left", "right")]
         feet_yaw_error = max(abs(float((yaws[f] - planned_yaw[f] + math.pi) % (2 * math.pi) - math.pi))
@@ -417,6 +464,7 @@ def simulate(
         balance=None if balance_log is None else {k: v[:end] for k, v in balance_log.items()},
         ankle_positions=np.stack([sensors.take(readings, f"{label}_ankle_pos") for label in ("left", "right")], axis=1),
         planned_torques=None if planned_torques is None else planned_torques[:end],
+        captures=[plan for plan, _ in captures],
     )
 
 
@@ -547,13 +595,50 @@ class _MeasurementReader:
                                   joint_angles=row[self._joints])
 
 
+def _rows_at(times: Array, pattern_times: Array, values: Array) -> Array:
+    """Each column of ``values`` (m, k) linearly interpolated at ``times`` (n,): (n, k)."""
+    return np.column_stack([np.interp(times, pattern_times, values[:, i]) for i in range(values.shape[1])])
+
+
+def _support_at(pattern: WalkingPattern, times: Array) -> NDArray[np.int8]:
+    """The pattern's support code at each of ``times`` (a time at a phase change has the phase that begins)."""
+    return pattern.support[np.clip(np.searchsorted(pattern.time, times - 1e-9), 0, len(pattern.time) - 1)]
+
+
+def _controls(plant: Plant, pattern: WalkingPattern, joints: JointTrajectory, pattern_time: Array, zmp_ref: Array,
+              feedforward: bool) -> tuple[Array, Array, Array | None]:
+    """The leg joint references (n, 12) at ``pattern_time`` (n,), the controls (n, nu) with the feedforwards of
+    the planned motion where ``feedforward`` (gravity, ground reaction and servo damping, docs/balance.md), and
+    the planned leg torques (n, 12) [N m] or None."""
+    reference = _rows_at(pattern_time, joints.time, joints.angles)
+    control = np.repeat(plant.ctrl_hold[None, :], len(pattern_time), axis=0)
+    control[:, plant.leg_actuators] = reference
+    if not feedforward:
+        return reference, control, None
+    base_planned = (pattern.position_pelvis_in_world if joints.position_base_in_world is None
+                    else joints.position_base_in_world)
+    base_path = _rows_at(pattern_time, pattern.time, base_planned)
+    yaw_path = np.interp(pattern_time, pattern.time, pattern.yaw_pelvis_in_world)
+    planned_ankles = [_rows_at(pattern_time, pattern.time, a)
+                      for a in (pattern.position_left_ankle_in_world, pattern.position_right_ankle_in_world)]
+    qpos_path = plant_qpos(plant, base_path, yaw_path, reference)
+    control[:, plant.leg_actuators] += damping_feedforward(plant, _rows_at(pattern_time, joints.time, joints.velocities))
+    index = np.clip(np.searchsorted(pattern.time, pattern_time), 0, len(pattern.time) - 1)
+    needed = servo_torques(plant, qpos_path, zmp_ref, pattern.support[index], (planned_ankles[0], planned_ankles[1]))
+    control += servo_offsets(plant, needed)
+    return reference, control, needed[:, plant.leg_actuators]
+
+
 def _closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabilizer: Stabilizer | None,
                  pattern: WalkingPattern, pattern_time: Array, reference: Array, control: Array, zmp_ref: Array,
                  steps_per_tick: int, sensors: _Sensors, latency: float, noise: SensorNoise | None,
                  progress: Callable[[float], None] | None = None, disturbances: Disturbances | None = None,
-                 time: Array | None = None) -> tuple[Array, dict[str, Array]]:
+                 time: Array | None = None, capture_trigger: float | None = None,
+                 capture_tail: Callable[[int, Stabilizer, int], dict[str, Array]] | None = None,
+                 ) -> tuple[Array, dict[str, Array]]:
     """Step the model tick by tick (the stabilizer in the loop where given, pushes applied); sensor rows
-    (n, nsensordata) and the stabilizer's log."""
+    (n, nsensordata) and the stabilizer's log. Once the stabilizer's DCM error passes ``capture_trigger`` in a
+    single support, ``capture_tail`` re-makes the references from the next tick on (once)."""
     n = len(pattern_time)
     time = pattern_time if time is None else time
     interp = np.interp
@@ -578,6 +663,7 @@ def _closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabi
     push_body = int(model.site_bodyid[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "pelvis")])
     if stabilizer is not None:
         stabilizer.reset()
+    last_capture = -n
     for k in range(n):
         if progress is not None and k % 500 == 0:
             progress(k / n)
@@ -616,6 +702,21 @@ def _closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabi
         log["ankle_offsets"][k] = state.ankle_offsets.ravel()
         log["height_difference"][k] = state.height_difference
         log["pelvis_turn"][k] = state.pelvis_turn
+        tail: dict[str, Array] = {}
+        if (capture_tail is not None and capture_trigger is not None and k + 1 < n and support[k] != 0 and support[k + 1] == support[k]
+                and k - last_capture >= CAPTURE_INTERVAL * CONTROL_RATE and math.hypot(float(state.dcm_error[0]), float(state.dcm_error[1])) > capture_trigger):
+            last_capture = k
+            try:
+                tail = capture_tail(k, stabilizer, int(support[k]))
+            except UnreachableError:  # no capture step fits the legs: the plan goes on as it was
+                tail = {}
+        if tail:
+            com[k + 1:], yaw[k + 1:], support[k + 1:], zmp_ref[k + 1:] = (tail["com"], tail["yaw"], tail["support"],
+                                                                          tail["zmp"])
+            ankles[0][k + 1:], ankles[1][k + 1:] = tail["left"], tail["right"]
+            foot_yaws[0][k + 1:], foot_yaws[1][k + 1:] = tail["left_yaw"], tail["right_yaw"]
+            reference[k + 1:], control[k + 1:] = tail["reference"], tail["control"]
+            offsets[k + 1:] = control[k + 1:, plant.leg_actuators] - reference[k + 1:]
         if not np.all(np.isfinite(data.qpos)):
             readings[k + 1:] = readings[k]
             break
