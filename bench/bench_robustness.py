@@ -5,7 +5,9 @@ Run: python bench/bench_robustness.py [--quick]. Prints Markdown tables; asserts
 Push recovery: the largest impulse [N s] on the torso, applied over 0.1 s in the middle of a single support
 (the fourth step's), below which the walk survives (no fall to its end) every push on a 2 N s grid, forward,
 backward and sideways (towards the swinging foot's side), open loop (the feedforward only) and with the
-stabilizer. TALOS needs ../shared/robots (skipped when absent).
+stabilizer, and with the stabilizer and capture steps (:func:`zmpwalk.capture.capture_step`: the rest of the walk
+re-planned from the stabilizer's DCM estimate once its error passes the trigger). TALOS needs ../shared/robots
+(skipped when absent).
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from pathlib import Path
 
 from zmpwalk import StepCommand, load_robot
 from zmpwalk.balance import Stabilizer
+from zmpwalk.capture import CaptureSettings
 from zmpwalk.kinematics import pattern_joint_trajectory
 from zmpwalk.patterns.polynomial import generate
 from zmpwalk.robots.model import RobotModel
@@ -45,9 +48,13 @@ def walk(name: str) -> list[StepCommand]:
     return load_scenario("fig10")[:1] + [StepCommand(duration=0.95, forward=0.2)] * 8
 
 
-def run(job: tuple[str, str, bool, float]) -> tuple[str, str, bool, float, bool, bool]:
-    """(robot, condition, stabilizer, value) -> (..., fell, verdict passed)."""
-    name, condition, balance, value = job
+MODES = ("off", "stabilizer", "capture")  # open loop (feedforward only); the stabilizer; and capture steps
+
+
+def run(job: tuple[str, str, str, float]) -> tuple[str, str, str, float, bool, bool]:
+    """(robot, condition, mode of :data:`MODES`, value) -> (..., fell, verdict passed)."""
+    name, condition, mode, value = job
+    balance = mode != "off"
     model = robot(name)
     pattern = generate(model, walk(name), rate=1000.0)
     joints = pattern_joint_trajectory(pattern, check_limits=False)
@@ -65,61 +72,67 @@ def run(job: tuple[str, str, bool, float]) -> tuple[str, str, bool, float, bool,
                      "push-sideways": (0.0, 1.0 if step.swing == "left" else -1.0)}[condition]
         disturbances = Disturbances(push_time=middle, push_impulse=(direction[0] * value, direction[1] * value, 0.0))
     result = simulate(model, joints, pattern, stabilizer=Stabilizer(model, 1000.0) if balance else None,
-                      feedforward=True, settle=0.5, hold=2.0, latency=latency, disturbances=disturbances)
-    return name, condition, balance, value, result.fell, walk_verdict(result, 2.0).passed
+                      feedforward=True, settle=0.5, hold=2.0, latency=latency, disturbances=disturbances,
+                      capture=CaptureSettings() if mode == "capture" else None)
+    return name, condition, mode, value, result.fell, walk_verdict(result, 2.0).passed
 
 
 PUSH_STEP = 2.0  # [N s] grid of the push scan
 
 
-def largest_push(name: str, direction: str, balance: bool, high: float) -> float:
+def largest_push(name: str, direction: str, mode: str, high: float) -> float:
     """The largest impulse [N s] up to which every impulse on a :data:`PUSH_STEP` grid is survived: pushes
     of 2, 4, 6 ... N s until the first fall (up to ``high``). Not a bisection: survival is not monotonic in
     the impulse (HUBO sideways with the stabilizer survives 10 and 16 N s but falls at 12 and 14)."""
     survived = 0.0
     impulse = PUSH_STEP
     while impulse <= high:
-        if run((name, direction, balance, impulse))[4]:
+        if run((name, direction, mode, impulse))[4]:
             break
         survived, impulse = impulse, impulse + PUSH_STEP
     return survived
 
 
-def push_job(job: tuple[str, str, bool, float]) -> tuple[str, str, bool, float]:
-    name, direction, balance, high = job
-    return name, direction, balance, largest_push(name, direction, balance, high)
+def push_job(job: tuple[str, str, str, float]) -> tuple[str, str, str, float]:
+    name, direction, mode, high = job
+    return name, direction, mode, largest_push(name, direction, mode, high)
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true", help="HUBO only, no pushes")
     parser.add_argument("--no-push", action="store_true", help="the conditions only, no push search")
+    parser.add_argument("--push-only", action="store_true", help="the push search only, no conditions")
+    parser.add_argument("--modes", nargs="+", choices=MODES, default=list(MODES), help="the push search's loops")
     args = parser.parse_args()
     robots = ["hubo", "hubo-soft"] + ([] if args.quick or not TALOS.is_file() else ["talos"])
     conditions = [("latency", 10.0), ("mass", 0.05), ("mass", -0.05), ("tilt-pitch", 2.0), ("tilt-pitch", -2.0),
                   ("tilt-roll", 2.0)]
-    jobs = [(r, c, b, v) for r in robots for c, v in conditions for b in (False, True)]
-    print("| robot | condition | stabilizer | fell | verdict |")
-    print("|---|---|---|---|---|")
+    jobs = [(r, c, m, v) for r in robots for c, v in conditions for m in ("off", "stabilizer")]
     with ProcessPoolExecutor(max_workers=os.cpu_count()) as pool:
-        for name, condition, balance, value, fell, passed in pool.map(run, jobs):
-            unit = {"latency": " ms", "mass": "", "tilt-pitch": " deg", "tilt-roll": " deg"}[condition]
-            shown = f"{value:+.0%}" if condition == "mass" else f"{value:g}{unit}"
-            print(f"| {name} | {condition} {shown} | {'on' if balance else 'off'} | {'yes' if fell else 'no'} | "
-                  f"{'pass' if passed else 'FAIL'} |", flush=True)
+        if not args.push_only:
+            print("| robot | condition | stabilizer | fell | verdict |")
+            print("|---|---|---|---|---|")
+            for name, condition, mode, value, fell, passed in pool.map(run, jobs):
+                unit = {"latency": " ms", "mass": "", "tilt-pitch": " deg", "tilt-roll": " deg"}[condition]
+                shown = f"{value:+.0%}" if condition == "mass" else f"{value:g}{unit}"
+                print(f"| {name} | {condition} {shown} | {'on' if mode != 'off' else 'off'} | "
+                      f"{'yes' if fell else 'no'} | {'pass' if passed else 'FAIL'} |", flush=True)
         if args.quick or args.no_push:
             return
-        print("\n| robot | push | every push survived up to, open loop [N s] | with the stabilizer [N s] | ratio |")
-        print("|---|---|---|---|---|")
+        print("\n| robot | push | every push survived up to, open loop [N s] | with the stabilizer [N s] | ratio "
+              "| with the stabilizer and capture steps [N s] | ratio |")
+        print("|---|---|---|---|---|---|---|")
         pushed = [r for r in robots if r != "hubo-soft"]
-        pushes = [(r, d, b, 96.0 if r == "talos" else 48.0) for r in pushed
-                  for d in ("push-forward", "push-backward", "push-sideways") for b in (False, True)]
-        found = {(n, d, b): v for n, d, b, v in pool.map(push_job, pushes)}
+        pushes = [(r, d, m, 96.0 if r == "talos" else 64.0) for r in pushed
+                  for d in ("push-forward", "push-backward", "push-sideways") for m in args.modes]
+        found = {(n, d, m): v for n, d, m, v in pool.map(push_job, pushes)}
         for r in pushed:
             for d in ("push-forward", "push-backward", "push-sideways"):
-                off, on = found[(r, d, False)], found[(r, d, True)]
-                ratio = f"{on / off:.1f}" if off > 0 else "inf"
-                print(f"| {r} | {d[5:]} | {off:.0f} | {on:.0f} | {ratio} |", flush=True)
+                off, on, capture = (found.get((r, d, m), math.nan) for m in MODES)
+                ratios = [f"{v / off:.1f}" if off > 0 else "inf" for v in (on, capture)]
+                print(f"| {r} | {d[5:]} | {off:.0f} | {on:.0f} | {ratios[0]} | {capture:.0f} | {ratios[1]} |",
+                      flush=True)
 
 
 if __name__ == "__main__":

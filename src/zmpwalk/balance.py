@@ -376,7 +376,7 @@ class Stabilizer:
         """
         if foot not in ("left", "right"):
             raise InvalidParameterError("foot", foot, '"left" or "right"')
-        return self._landing[0 if foot == "left" else 1].copy()
+        return np.array(self._landing[0 if foot == "left" else 1], dtype=np.float64)
 
     def hand_over_landing(self, foot: str) -> Array:
         """Clear the landing correction of ``foot`` and return it (:meth:`landing_correction`): a new plan

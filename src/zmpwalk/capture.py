@@ -44,7 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk.curves import smoothstep5
-from zmpwalk.errors import InvalidParameterError, UnreachableError
+from zmpwalk.errors import InfeasiblePatternError, InvalidParameterError, UnreachableError
 from zmpwalk.footsteps import Pose2D
 from zmpwalk.kinematics import hip_positions_in_world, leg_reach_excess
 from zmpwalk.patterns.result import (
@@ -65,6 +65,8 @@ REACH_MARGIN = 0.01  # [m] the landing keeps this much of the leg's reach in han
 REACH_SHRINK = 0.9  # [-] a landing out of reach is pulled towards the stance foot by this factor, then checked
 REACH_TRIES = 12  # pulls before the landing is given up as out of reach
 CROUCH_LEAST_TIME = 0.1  # [s] the CoM point is lowered for the legs' reach over at least this time
+SETTLE_TRIES = 3  # the settle is doubled up to this many times to keep the ZMP in the feet
+ZMP_TOLERANCE = 1e-9  # [m]
 LEAST_REPLANNED_SWING = 0.08  # [s] a capture step re-planned during its swing lands at least this much later
 
 
@@ -137,9 +139,10 @@ class CapturePlan:
     reached: bool
 
 
-def _rotate(x: float, y: float, yaw: float) -> Array:
+def _rotate(vector: Array, yaw: float) -> Array:
+    """``vector`` (2,) turned by ``yaw`` [rad]."""
     c, s = math.cos(yaw), math.sin(yaw)
-    return np.array([c * x - s * y, s * x + c * y])
+    return np.array([c * vector[0] - s * vector[1], s * vector[0] + c * vector[1]])
 
 
 def quintic_from_rest(start: Array, velocity: Array, end: Array, duration: float, s: Array) -> tuple[Array, Array]:
@@ -213,6 +216,8 @@ def capture_step(
     Raises:
         InvalidParameterError: ``stance`` not ``"left"`` or ``"right"``, a bad rate, ``end`` before ``time``, or
             an input with the wrong number of values.
+        InfeasiblePatternError: The DCM at touchdown lies where no ZMP in the feet brings it to rest (a fall
+            towards the stance side, which a step of the other foot would have to catch).
         UnreachableError: No landing pulled towards the stance foot, nor lowering the CoM point, keeps both legs
             within reach (:data:`REACH_MARGIN` in hand): the body is already too far from the stance foot.
     """
@@ -238,15 +243,15 @@ def capture_step(
     sw_center_local = np.array([robot.sole_center_x, sw_side * robot.sole_center_y])
     st_ankle = ankles[st][:2]
     # 1. the stance ZMP: the stance sole's point nearest to the DCM, inside its edges
-    local = _rotate(*(dcm - st_ankle), -st_yaw) - st_center_local
+    local = _rotate(dcm - st_ankle, -st_yaw) - st_center_local
     inside = np.clip(local, -(half - settings.zmp_inset), half - settings.zmp_inset)
-    p1 = st_ankle + _rotate(*(st_center_local + inside), st_yaw)
+    p1 = st_ankle + _rotate(st_center_local + inside, st_yaw)
     # 2. the landing, for each swing time on the grid
     gap_least = 2 * half[1] - 2 * robot.sole_center_y + settings.feet_clearance  # ankle gap across the stance
     swing_now = ankles[sw][:2]
     shortest = settings.shortest_swing if touchdown is None else max(touchdown - time, LEAST_REPLANNED_SWING)
-    durations = np.arange(round(shortest / SWING_GRID),
-                          max(round(settings.longest_swing / SWING_GRID), round(shortest / SWING_GRID)) + 1) * SWING_GRID
+    first = round(shortest / SWING_GRID)
+    durations = np.arange(first, max(round(settings.longest_swing / SWING_GRID), first) + 1) * SWING_GRID
     chosen: tuple[float, Array, Array] | None = None
     best: tuple[float, float, Array, Array] | None = None
     for duration in durations:
@@ -254,11 +259,11 @@ def capture_step(
         ahead = dcm_touchdown - p1
         norm = float(np.linalg.norm(ahead))
         sole_center = dcm_touchdown + (settings.landing_inset * ahead / norm if norm > 0 else 0.0)
-        landing = sole_center - _rotate(*sw_center_local, st_yaw)
-        across = _rotate(*(landing - st_ankle), -st_yaw)
+        landing = sole_center - _rotate(sw_center_local, st_yaw)
+        across = _rotate(landing - st_ankle, -st_yaw)
         if sw_side * across[1] < gap_least:  # never across the stance foot
             across[1] = sw_side * gap_least
-            landing = st_ankle + _rotate(*across, st_yaw)
+            landing = st_ankle + _rotate(across, st_yaw)
         way = float(np.linalg.norm(landing - swing_now))
         if way <= settings.foot_speed * duration:
             chosen = (float(duration), dcm_touchdown, landing)
@@ -273,9 +278,25 @@ def capture_step(
     n = max(math.ceil((max(end, time + swing_time + settings.settle + 1.0 / omega) - time) * rate - 1e-9), 1) + 1
     s = np.arange(n) / rate
     reached = True
+    settle = settings.settle
     for attempt in range(REACH_TRIES + 1):
-        pattern, rest = _build(robot, time, rate, s, settings, omega, st, com, dcm, p1, swing_time, landing,
+        pattern, rest = _build(robot, time, rate, s, settings, settle, omega, st, com, dcm, p1, swing_time, landing,
                                st_yaw, float(yaw_pelvis_in_world), ankles, velocities, foot_yaws)
+        if attempt == 0:  # the DCM's way to the rest point: slower until its ZMP stays in the feet
+            for _ in range(SETTLE_TRIES):
+                if float(pattern.zmp_margin().min()) >= -ZMP_TOLERANCE:
+                    break
+                settle *= 2.0
+                n = max(n, math.ceil((swing_time + settle + 1.0 / omega) * rate) + 1)
+                s = np.arange(n) / rate
+                pattern, rest = _build(robot, time, rate, s, settings, settle, omega, st, com, dcm, p1, swing_time,
+                                       landing, st_yaw, float(yaw_pelvis_in_world), ankles, velocities, foot_yaws)
+            margin = float(pattern.zmp_margin().min())
+            if margin < -ZMP_TOLERANCE:
+                raise InfeasiblePatternError(
+                    f"capture step: the DCM at touchdown {np.round(dcm_touchdown, 3).tolist()} m lies outside the "
+                    f"feet (its ZMP leaves them by {-margin * 1e3:.1f} mm on the way to rest, settle "
+                    f"{settle:g} s): no single step catches it")
         excess = leg_reach_excess(pattern.position_pelvis_in_world, pattern.yaw_pelvis_in_world,
                                   pattern.position_left_ankle_in_world, pattern.position_right_ankle_in_world, robot)
         worst = int(np.argmax([excess[0].max(), excess[1].max()]))
@@ -288,10 +309,15 @@ def capture_step(
                                    f"capture step, after {REACH_TRIES} landings pulled towards the stance foot")
         reached = False
         landing = st_ankle + REACH_SHRINK * (landing - st_ankle)
-        across = _rotate(*(landing - st_ankle), -st_yaw)
+        across = _rotate(landing - st_ankle, -st_yaw)
         if sw_side * across[1] < gap_least:
             across[1] = sw_side * gap_least
-            landing = st_ankle + _rotate(*across, st_yaw)
+            landing = st_ankle + _rotate(across, st_yaw)
+    margin = float(pattern.zmp_margin().min())
+    if margin < -ZMP_TOLERANCE:  # a landing pulled in for the legs' reach may leave the DCM out of the feet
+        raise InfeasiblePatternError(f"capture step: pulled in for the legs' reach, its ZMP leaves the feet by "
+                                     f"{-margin * 1e3:.1f} mm on the way to rest")
+    dcm_touchdown = p1 + (dcm - p1) * math.exp(omega * swing_time)
     plan = CapturePlan(time=time, swing=("left", "right")[sw], swing_time=swing_time, zmp_stance=p1, dcm_start=dcm,
                        dcm_touchdown=dcm_touchdown, landing=(float(landing[0]), float(landing[1]), st_yaw), rest=rest,
                        reached=reached)
@@ -321,18 +347,18 @@ def _crouch(robot: RobotModel, s: Array, pelvis: Array, pelvis_velocity: Array, 
     pelvis_velocity[:, 2] -= drop * slope / ramp
 
 
-def _build(robot: RobotModel, time: float, rate: float, s: Array, settings: CaptureSettings, omega: float, st: int,
-           com: Array, dcm: Array, p1: Array, swing_time: float, landing: Array, st_yaw: float, pelvis_yaw: float,
-           ankles: list[Array], velocities: list[Array], foot_yaws: tuple[float, float]) -> tuple[WalkingPattern, Array]:
+def _build(robot: RobotModel, time: float, rate: float, s: Array, settings: CaptureSettings, settle: float,
+           omega: float, st: int, com: Array, dcm: Array, p1: Array, swing_time: float, landing: Array, st_yaw: float,
+           pelvis_yaw: float, ankles: list[Array], velocities: list[Array],
+           foot_yaws: tuple[float, float]) -> tuple[WalkingPattern, Array]:
     """The capture pattern for one landing (the module docstring's three phases)."""
     sw = 1 - st
     n = len(s)
     st_side, sw_side = (1, -1) if st == 0 else (-1, 1)
-    centers = [ankles[st][:2] + _rotate(robot.sole_center_x, st_side * robot.sole_center_y, st_yaw),
-               landing + _rotate(robot.sole_center_x, sw_side * robot.sole_center_y, st_yaw)]
+    centers = [ankles[st][:2] + _rotate(np.array([robot.sole_center_x, st_side * robot.sole_center_y]), st_yaw),
+               landing + _rotate(np.array([robot.sole_center_x, sw_side * robot.sole_center_y]), st_yaw)]
     rest = (centers[0] + centers[1]) / 2
     dcm_touchdown = p1 + (dcm - p1) * math.exp(omega * swing_time)
-    settle = settings.settle
 
     def dcm_at(t: Array) -> tuple[Array, Array]:
         """The planned DCM [m] and its rate [m/s] at times ``t`` (n,) after the capture."""

@@ -42,7 +42,7 @@ from numpy.typing import NDArray
 
 from zmpwalk.balance import BalanceMeasurement, Stabilizer
 from zmpwalk.capture import CapturePlan, CaptureSettings, capture_step
-from zmpwalk.errors import InvalidParameterError, UnreachableError
+from zmpwalk.errors import InfeasiblePatternError, InvalidParameterError, UnreachableError
 from zmpwalk.files import atomic_output
 from zmpwalk.kinematics import JOINT_COLUMNS, JointTrajectory, pattern_joint_trajectory
 from zmpwalk.patterns.result import WalkingPattern
@@ -336,7 +336,7 @@ def simulate(
     mujoco.mj_getState(model, data, state, spec)
     captures: list[tuple[CapturePlan, WalkingPattern]] = []
 
-    def capture_tail(k: int, stabilizer: Stabilizer, stance_support: int) -> dict[str, Array]:
+    def capture_tail(k: int, stabilizer: Stabilizer, stance_support: int) -> dict[str, NDArray[np.generic]]:
         """The references from tick ``k + 1`` on, re-made for a capture step planned from the stabilizer's
         estimate at tick ``k`` (its DCM error; the swinging foot's landing correction handed over), in the single
         support ``stance_support`` (1 left, 2 right)."""
@@ -622,7 +622,8 @@ def _controls(plant: Plant, pattern: WalkingPattern, joints: JointTrajectory, pa
     planned_ankles = [_rows_at(pattern_time, pattern.time, a)
                       for a in (pattern.position_left_ankle_in_world, pattern.position_right_ankle_in_world)]
     qpos_path = plant_qpos(plant, base_path, yaw_path, reference)
-    control[:, plant.leg_actuators] += damping_feedforward(plant, _rows_at(pattern_time, joints.time, joints.velocities))
+    rates = _rows_at(pattern_time, joints.time, joints.velocities)
+    control[:, plant.leg_actuators] += damping_feedforward(plant, rates)
     index = np.clip(np.searchsorted(pattern.time, pattern_time), 0, len(pattern.time) - 1)
     needed = servo_torques(plant, qpos_path, zmp_ref, pattern.support[index], (planned_ankles[0], planned_ankles[1]))
     control += servo_offsets(plant, needed)
@@ -634,7 +635,7 @@ def _closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabi
                  steps_per_tick: int, sensors: _Sensors, latency: float, noise: SensorNoise | None,
                  progress: Callable[[float], None] | None = None, disturbances: Disturbances | None = None,
                  time: Array | None = None, capture_trigger: float | None = None,
-                 capture_tail: Callable[[int, Stabilizer, int], dict[str, Array]] | None = None,
+                 capture_tail: Callable[[int, Stabilizer, int], dict[str, NDArray[np.generic]]] | None = None,
                  ) -> tuple[Array, dict[str, Array]]:
     """Step the model tick by tick (the stabilizer in the loop where given, pushes applied); sensor rows
     (n, nsensordata) and the stabilizer's log. Once the stabilizer's DCM error passes ``capture_trigger`` in a
@@ -702,13 +703,14 @@ def _closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabi
         log["ankle_offsets"][k] = state.ankle_offsets.ravel()
         log["height_difference"][k] = state.height_difference
         log["pelvis_turn"][k] = state.pelvis_turn
-        tail: dict[str, Array] = {}
-        if (capture_tail is not None and capture_trigger is not None and k + 1 < n and support[k] != 0 and support[k + 1] == support[k]
-                and k - last_capture >= CAPTURE_INTERVAL * CONTROL_RATE and math.hypot(float(state.dcm_error[0]), float(state.dcm_error[1])) > capture_trigger):
+        tail: dict[str, NDArray[np.generic]] = {}
+        if (capture_tail is not None and capture_trigger is not None and k + 1 < n and support[k] != 0
+                and support[k + 1] == support[k] and k - last_capture >= CAPTURE_INTERVAL * CONTROL_RATE
+                and math.hypot(float(state.dcm_error[0]), float(state.dcm_error[1])) > capture_trigger):
             last_capture = k
             try:
                 tail = capture_tail(k, stabilizer, int(support[k]))
-            except UnreachableError:  # no capture step fits the legs: the plan goes on as it was
+            except (UnreachableError, InfeasiblePatternError):  # no capture step fits: the plan goes on as it was
                 tail = {}
         if tail:
             com[k + 1:], yaw[k + 1:], support[k + 1:], zmp_ref[k + 1:] = (tail["com"], tail["yaw"], tail["support"],

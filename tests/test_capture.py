@@ -1,0 +1,184 @@
+"""The capture step: continuity with the plan, the ZMP in the feet, the pendulum's dynamics, the landing rule,
+the legs' reach; and in MuJoCo, a backward push that the stabilizer alone does not survive."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from zmpwalk import InfeasiblePatternError, InvalidParameterError, StepCommand, UnreachableError, generate
+from zmpwalk.capture import REACH_MARGIN, CaptureSettings, capture_step, quintic_from_rest
+from zmpwalk.footsteps import Pose2D, foot_corners
+from zmpwalk.kinematics import leg_reach_excess, pattern_joint_trajectory
+from zmpwalk.scenarios import load_scenario
+from zmpwalk.zmp import point_margin
+
+RATE = 1000.0  # [Hz]
+
+
+@pytest.fixture(scope="module")
+def walk(hubo):
+    """HUBO's push walk (fig10's first step, eight 20 cm steps) and the middle of its fifth step's single support."""
+    pattern = generate(hubo, load_scenario("fig10")[:1] + [StepCommand(duration=0.95, forward=0.2)] * 8, rate=RATE)
+    step = pattern.steps[4]
+    index = int(np.searchsorted(pattern.time, step.start + step.duration / 2))
+    assert pattern.support[index] != 0  # the test's premise: single support there
+    return pattern, index
+
+
+def capture(hubo, walk, push, **kwargs):
+    """A capture step from the middle of the walk's fifth step with the DCM moved by ``push`` [m]."""
+    pattern, index = walk
+    omega = math.sqrt(hubo.gravity / hubo.pendulum_length)
+    com = pattern.position_pelvis_in_world[index]
+    dcm = com[:2] + pattern.velocity_pelvis_in_world[index, :2] / omega + np.asarray(push)
+    return capture_step(
+        hubo, time=float(pattern.time[index]), rate=RATE, end=float(pattern.time[index]) + 3.0,
+        stance="left" if pattern.support[index] == 1 else "right", position_com_in_world=com, dcm_in_world=dcm,
+        yaw_pelvis_in_world=float(pattern.yaw_pelvis_in_world[index]),
+        ankles_in_world=(pattern.position_left_ankle_in_world[index], pattern.position_right_ankle_in_world[index]),
+        ankle_velocities_in_world=(pattern.velocity_left_ankle_in_world[index],
+                                   pattern.velocity_right_ankle_in_world[index]),
+        foot_yaws=(float(pattern.yaw_left_foot_in_world[index]), float(pattern.yaw_right_foot_in_world[index])),
+        **kwargs)
+
+
+PUSHES = [(-0.15, 0.0), (0.12, 0.0), (0.0, -0.1), (-0.1, -0.05), (0.05, 0.02)]  # [m] DCM moved (not to the stance side)
+
+
+@pytest.mark.parametrize("push", PUSHES)
+def test_capture_starts_on_the_plan_and_keeps_the_zmp_in_the_feet(hubo, walk, push):
+    pattern, index = walk
+    tail, plan = capture(hubo, walk, push)
+    # continuous with the plan where it starts (the joint references do not jump)
+    assert np.allclose(tail.position_pelvis_in_world[0], pattern.position_pelvis_in_world[index], atol=1e-12)
+    for new, old in ((tail.position_left_ankle_in_world, pattern.position_left_ankle_in_world),
+                     (tail.position_right_ankle_in_world, pattern.position_right_ankle_in_world)):
+        assert np.allclose(new[0], old[index], atol=1e-12)
+    swing = 0 if plan.swing == "left" else 1
+    old_velocity = (pattern.velocity_left_ankle_in_world, pattern.velocity_right_ankle_in_world)[swing][index]
+    new_velocity = (tail.velocity_left_ankle_in_world, tail.velocity_right_ankle_in_world)[swing][0]
+    assert np.allclose(new_velocity, old_velocity, atol=1e-9)
+    # the ZMP inside the support polygon at every sample: the stance sole in single support, inside it by the
+    # inset; the hull of both soles after touchdown
+    margin = tail.zmp_margin()
+    single = tail.support != 0
+    assert margin[single].min() >= CaptureSettings().zmp_inset - 1e-9
+    assert margin[~single].min() >= -1e-9
+    # it ends at rest: the CoM on the midpoint of the soles, within 1 mm, still to 1 mm/s
+    assert np.linalg.norm(tail.position_pelvis_in_world[-1, :2] - plan.rest) < 1e-3
+    assert np.linalg.norm(tail.velocity_pelvis_in_world[-1]) < 1e-3
+
+
+@pytest.mark.parametrize("push", PUSHES)
+def test_capture_follows_the_pendulum(hubo, walk, push):
+    """p = c - c'' / omega^2 (Eqs. 1-2, the LIPM) on central differences, away from the ZMP's jumps; the DCM
+    c + c' / omega in closed form up to touchdown; velocities the positions' derivatives."""
+    tail, plan = capture(hubo, walk, push)
+    omega = math.sqrt(hubo.gravity / hubo.pendulum_length)
+    c, dt = tail.position_pelvis_in_world[:, :2], 1.0 / RATE
+    acceleration = (c[2:] - 2 * c[1:-1] + c[:-2]) / dt**2
+    zmp = c[1:-1] - acceleration / omega**2
+    s = tail.time - tail.time[0]
+    away = np.abs(s[1:-1] - plan.swing_time) > 2.5 * dt
+    assert np.abs(zmp - tail.zmp_in_world[1:-1])[away].max() < 2e-4  # [m]
+    dcm = c + tail.velocity_pelvis_in_world[:, :2] / omega
+    single = s < plan.swing_time - 1e-9
+    closed = plan.zmp_stance + (plan.dcm_start - plan.zmp_stance) * np.exp(omega * s[single])[:, None]
+    assert np.abs(dcm[single] - closed).max() < 1e-9
+    touchdown = round(plan.swing_time * RATE)
+    assert np.allclose(dcm[touchdown], plan.dcm_touchdown, atol=1e-9)
+    swing = tail.position_left_ankle_in_world if plan.swing == "left" else tail.position_right_ankle_in_world
+    rate = tail.velocity_left_ankle_in_world if plan.swing == "left" else tail.velocity_right_ankle_in_world
+    assert np.abs(np.gradient(swing, tail.time, axis=0)[1:-1] - rate[1:-1]).max() < 5e-3  # [m/s]
+    assert np.abs(np.gradient(c, tail.time, axis=0)[1:-1] - tail.velocity_pelvis_in_world[1:-1, :2]).max() < 5e-3
+
+
+@pytest.mark.parametrize("push", PUSHES)
+def test_capture_lands_on_the_dcm_within_reach_and_not_across(hubo, walk, push):
+    tail, plan = capture(hubo, walk, push)
+    sw = 1 if plan.swing == "left" else -1
+    landing = Pose2D(*plan.landing)
+    stance_ankle = (tail.position_right_ankle_in_world if plan.swing == "left" else
+                    tail.position_left_ankle_in_world)[0]
+    # the landing ankle at the end of the tail, on the floor at the stance ankle's height
+    end = (tail.position_left_ankle_in_world if plan.swing == "left" else tail.position_right_ankle_in_world)[-1]
+    assert np.allclose(end, [landing.x, landing.y, stance_ankle[2]], atol=1e-12)
+    corners = foot_corners(landing, sw, hubo)
+    inner_gap = abs(float(np.dot(np.array([landing.x, landing.y]) - stance_ankle[:2],
+                                 [-math.sin(landing.yaw), math.cos(landing.yaw)])))
+    least = hubo.foot_width - 2 * hubo.sole_center_y + CaptureSettings().feet_clearance
+    assert inner_gap >= least - 1e-9
+    if inner_gap > least + 1e-6 and plan.reached:  # not held off the stance foot: the DCM lands inside the sole
+        assert point_margin(*plan.dcm_touchdown, [tuple(p) for p in corners]) >= CaptureSettings().landing_inset - 1e-9
+    excess = leg_reach_excess(tail.position_pelvis_in_world, tail.yaw_pelvis_in_world,
+                              tail.position_left_ankle_in_world, tail.position_right_ankle_in_world, hubo)
+    assert max(excess[0].max(), excess[1].max()) <= -REACH_MARGIN + 1e-12
+    pattern_joint_trajectory(tail, check_limits=False)  # the closed-form legs follow it
+    # the swinging sole clears the floor by the lift on its way
+    swing = (tail.position_left_ankle_in_world if plan.swing == "left" else tail.position_right_ankle_in_world)
+    assert swing[: round(plan.swing_time * RATE), 2].max() >= stance_ankle[2] + CaptureSettings().lift - 1e-9
+
+
+def test_a_fall_beyond_the_stance_foot_is_not_caught_by_one_step(hubo, walk):
+    """Pushed towards the stance side (HUBO's fifth step stands on its left foot): the swinging foot may not cross
+    the stance foot, so no ZMP in the feet brings the DCM to rest; said, not planned."""
+    pattern, index = walk
+    assert pattern.support[index] == 1
+    with pytest.raises(InfeasiblePatternError, match="outside the feet"):
+        capture(hubo, walk, (0.0, 0.15))
+
+
+def test_a_backward_push_steps_back(hubo, walk):
+    tail, plan = capture(hubo, walk, (-0.15, 0.0))
+    stance_ankle = (tail.position_right_ankle_in_world if plan.swing == "left" else
+                    tail.position_left_ankle_in_world)[0]
+    assert plan.landing[0] < stance_ankle[0] - 0.1  # at least 10 cm behind the stance ankle
+    assert plan.dcm_touchdown[0] < plan.dcm_start[0] < plan.zmp_stance[0] + 1e-12
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(dx=st.floats(-0.25, 0.25), dy=st.floats(-0.2, 0.2))
+def test_any_capture_keeps_the_zmp_in_the_feet_and_the_legs_in_reach(hubo, walk, dx, dy):
+    try:
+        tail, _ = capture(hubo, walk, (dx, dy))
+    except (UnreachableError, InfeasiblePatternError):
+        return  # said so (the leg and its excess, or the DCM outside the feet): nothing fits
+    assert tail.zmp_margin().min() >= -1e-9
+    excess = leg_reach_excess(tail.position_pelvis_in_world, tail.yaw_pelvis_in_world,
+                              tail.position_left_ankle_in_world, tail.position_right_ankle_in_world, hubo)
+    assert max(excess[0].max(), excess[1].max()) <= -REACH_MARGIN + 1e-12
+
+
+def test_quintic_from_rest_meets_its_ends():
+    rng = np.random.default_rng(3)
+    start, velocity, end = rng.normal(size=3), rng.normal(size=3), rng.normal(size=3)
+    duration = 0.37
+    s = np.array([0.0, duration])
+    value, rate = quintic_from_rest(start, velocity, end, duration, s)
+    assert np.allclose(value, [start, end], atol=1e-12) and np.allclose(rate, [velocity, np.zeros(3)], atol=1e-12)
+    h = 1e-7  # zero acceleration at both ends: the rate's one-sided differences vanish with h
+    _, near = quintic_from_rest(start, velocity, end, duration, np.array([h, duration - h]))
+    assert np.allclose((near[0] - velocity) / h, 0.0, atol=1e-3)
+    assert np.allclose(-near[1] / h, 0.0, atol=1e-3)
+
+
+def test_bad_input_is_rejected(hubo, walk):
+    with pytest.raises(InvalidParameterError, match="stance"):
+        capture_step(hubo, time=0.0, rate=RATE, end=1.0, stance="middle", position_com_in_world=np.zeros(3),
+                     dcm_in_world=np.zeros(2), yaw_pelvis_in_world=0.0, ankles_in_world=(np.zeros(3), np.zeros(3)),
+                     ankle_velocities_in_world=(np.zeros(3), np.zeros(3)), foot_yaws=(0.0, 0.0))
+    with pytest.raises(InvalidParameterError, match="end"):
+        capture_step(hubo, time=2.0, rate=RATE, end=1.0, stance="left", position_com_in_world=np.zeros(3),
+                     dcm_in_world=np.zeros(2), yaw_pelvis_in_world=0.0, ankles_in_world=(np.zeros(3), np.zeros(3)),
+                     ankle_velocities_in_world=(np.zeros(3), np.zeros(3)), foot_yaws=(0.0, 0.0))
+    with pytest.raises(InvalidParameterError, match="shortest_swing"):
+        CaptureSettings(shortest_swing=0.7, longest_swing=0.6)
+    with pytest.raises(InvalidParameterError, match=r"capture\.trigger"):
+        CaptureSettings(trigger=-0.1)
+    with pytest.raises(InvalidParameterError, match="foot_speed"):
+        CaptureSettings(foot_speed=0.0)
