@@ -182,3 +182,29 @@ def test_bad_input_is_rejected(hubo, walk):
         CaptureSettings(trigger=-0.1)
     with pytest.raises(InvalidParameterError, match="foot_speed"):
         CaptureSettings(foot_speed=0.0)
+
+
+def test_a_backward_push_is_survived_with_a_capture_step_and_not_without(hubo, walk):
+    """HUBO pushed backward with 36 N s mid single support (``bench/bench_robustness.py``'s case): with the
+    stabilizer alone it falls; with capture steps it steps back, comes to rest and ends with its feet where the
+    capture planned them (within 20 mm, the verdict's bound)."""
+    from zmpwalk import Stabilizer
+    from zmpwalk.sim import simulate
+    from zmpwalk.sim.run import Disturbances
+
+    pattern, index = walk
+    joints = pattern_joint_trajectory(pattern, check_limits=False)
+    push = Disturbances(push_time=float(pattern.time[index]), push_impulse=(-36.0, 0.0, 0.0))
+    results = [simulate(hubo, joints, pattern, stabilizer=Stabilizer(hubo, RATE), settle=0.5, hold=2.0,
+                        disturbances=push, capture=capture) for capture in (None, CaptureSettings())]
+    assert results[0].fell and not results[0].captures
+    result = results[1]
+    assert not result.fell
+    assert 1 <= len(result.captures) <= 5
+    first = result.captures[0]
+    assert first.swing == pattern.steps[4].swing
+    assert push.push_time < first.time < push.push_time + 0.2  # planned within the push's first 0.2 s
+    assert result.final_feet_error < 0.02  # [m]
+    assert result.end_min_sole_force > 0.0  # ends on both feet
+    with pytest.raises(InvalidParameterError, match="capture"):
+        simulate(hubo, joints, pattern, capture=CaptureSettings())  # needs the stabilizer's estimate

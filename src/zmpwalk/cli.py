@@ -207,6 +207,11 @@ def _parser() -> argparse.ArgumentParser:
     simulate_cmd.add_argument("--zmp-correction", action="store_true",
                               help="move the pelvis until the multibody ZMP (Eq. 3) follows the planned ZMP "
                               "(box models with [bodies]; off by default: docs/balance.md)")
+    simulate_cmd.add_argument("--push", type=float, nargs=3, metavar=("TIME", "X", "Y"),
+                              help="push the torso at TIME [s] with an impulse X, Y [N s] in world over 0.1 s")
+    simulate_cmd.add_argument("--capture", action="store_true",
+                              help="with the stabilizer: after a push, re-plan the rest of the walk as a capture "
+                              "step and a stop once its DCM error passes 80 mm (zmpwalk.capture)")
     simulate_cmd.add_argument("--out", type=Path, help="folder for the result files")
     simulate_cmd.add_argument("--json", action="store_true", help="print a JSON summary")
 
@@ -404,8 +409,19 @@ def _simulate(args: argparse.Namespace) -> int:
     from zmpwalk.balance import Stabilizer
 
     stabilizer = Stabilizer(robot, 1000.0, com_reference=pattern.com_point) if _balance(args, robot) else None
+    if args.capture and stabilizer is None:
+        raise _UsageError("--capture needs the stabilizer (--balance on): its DCM estimate triggers the capture step")
+    if args.capture and correction is not None:
+        raise _UsageError("--capture plans the pattern's CoM point; it does not combine with --zmp-correction")
+    from zmpwalk.capture import CaptureSettings
+    from zmpwalk.sim.run import Disturbances
+
+    disturbances = None
+    if args.push is not None:
+        disturbances = Disturbances(push_time=args.push[0], push_impulse=(args.push[1], args.push[2], 0.0))
     result = simulate(robot, joints, pattern, mass_scale=args.mass_scale, stabilizer=stabilizer,
-                      latency=args.latency, settle=SETTLE, hold=HOLD,
+                      latency=args.latency, settle=SETTLE, hold=HOLD, disturbances=disturbances,
+                      capture=CaptureSettings() if args.capture else None,
                       progress=None if show is None else lambda done: show("simulation", round(100 * done), 100))
     verdict = walk_verdict(result, HOLD)
     if show:
@@ -422,6 +438,8 @@ def _simulate(args: argparse.Namespace) -> int:
         "final_feet_error": result.final_feet_error, "final_feet_yaw_error": result.final_feet_yaw_error,
         "end_min_sole_force": result.end_min_sole_force, "end_max_speed": result.end_max_speed,
         "end_attitude_range": result.end_attitude_range, "verdict": verdict.as_dict(),
+        "captures": [{"time": c.time, "swing": c.swing, "swing_time": c.swing_time, "landing": list(c.landing),
+                      "reached": c.reached} for c in result.captures],
         "zmp_correction": None if correction is None else {
             "passes": correction.passes, "multibody_error_rms_before": correction.before.rms,
             "multibody_error_rms_after": correction.after.rms},
@@ -444,6 +462,11 @@ def _simulate(args: argparse.Namespace) -> int:
         if correction is not None:
             print(f"multibody ZMP - planned ZMP: RMS {correction.before.rms * 1e3:.1f} mm as generated, "
                   f"{correction.after.rms * 1e3:.1f} mm corrected (passes kept: {correction.passes})")
+        if result.captures:
+            last = result.captures[-1]
+            print(f"capture steps planned: {len(result.captures)}, the first at t = {result.captures[0].time:.3f} s; "
+                  f"the walk ended on the last: {last.swing} foot to ({last.landing[0]:.3f}, {last.landing[1]:.3f}) "
+                  f"m at t = {last.time + last.swing_time:.3f} s, then standing (the commanded steps after it dropped)")
         print(f"CoP - reference ZMP: RMS {rms * 1e3:.1f} mm, max {largest * 1e3:.1f} mm; "
               f"min CoP margin {summary['min_cop_margin'] * 1e3:+.1f} mm")  # type: ignore[operator]
         top = max(rows, key=lambda r: r.peak_torque)
