@@ -208,3 +208,22 @@ def test_a_backward_push_is_survived_with_a_capture_step_and_not_without(hubo, w
     assert result.end_min_sole_force > 0.0  # ends on both feet
     with pytest.raises(InvalidParameterError, match="capture"):
         simulate(hubo, joints, pattern, capture=CaptureSettings())  # needs the stabilizer's estimate
+
+
+def test_capture_without_what_it_needs_is_refused(hubo, walk, capsys):
+    """A multibody-corrected pattern (its CoM point is not the pelvis point a capture step plans) and the command
+    line without the stabilizer: one clear error each, before anything is simulated."""
+    import dataclasses
+
+    from zmpwalk import Stabilizer
+    from zmpwalk.cli import main
+    from zmpwalk.sim import simulate
+
+    pattern, _ = walk
+    corrected = dataclasses.replace(pattern, position_com_in_world=pattern.position_pelvis_in_world.copy())
+    joints = pattern_joint_trajectory(pattern, check_limits=False)
+    with pytest.raises(InvalidParameterError, match="multibody-corrected"):
+        simulate(hubo, joints, corrected, stabilizer=Stabilizer(hubo, RATE, com_reference="whole_body"),
+                 capture=CaptureSettings())
+    assert main(["simulate", "--scenario", "fig10", "--balance", "off", "--capture"]) == 2
+    assert "--capture needs the stabilizer" in capsys.readouterr().err

@@ -248,80 +248,77 @@ def capture_step(
     p1 = st_ankle + _rotate(st_center_local + inside, st_yaw)
     # 2. the landing, for each swing time on the grid
     gap_least = 2 * half[1] - 2 * robot.sole_center_y + settings.feet_clearance  # ankle gap across the stance
-    swing_now = ankles[sw][:2]
-    shortest = settings.shortest_swing if touchdown is None else max(touchdown - time, LEAST_REPLANNED_SWING)
-    first = round(shortest / SWING_GRID)
-    durations = np.arange(first, max(round(settings.longest_swing / SWING_GRID), first) + 1) * SWING_GRID
-    chosen: tuple[float, Array, Array] | None = None
-    best: tuple[float, float, Array, Array] | None = None
-    for duration in durations:
+
+    def off_the_stance(landing: Array) -> Array:
+        """``landing`` moved out across the stance foot until the soles' inner edges keep the clearance."""
+        across = _rotate(landing - st_ankle, -st_yaw)
+        if sw_side * across[1] >= gap_least:
+            return landing
+        across[1] = sw_side * gap_least
+        return st_ankle + _rotate(across, st_yaw)
+
+    def landing_after(duration: float) -> tuple[float, Array, Array]:
+        """How far the foot misses the way at the foot speed [m] (<= 0: it makes it), xi(T) and the landing."""
         dcm_touchdown = p1 + (dcm - p1) * math.exp(omega * duration)
         ahead = dcm_touchdown - p1
         norm = float(np.linalg.norm(ahead))
         sole_center = dcm_touchdown + (settings.landing_inset * ahead / norm if norm > 0 else 0.0)
-        landing = sole_center - _rotate(sw_center_local, st_yaw)
-        across = _rotate(landing - st_ankle, -st_yaw)
-        if sw_side * across[1] < gap_least:  # never across the stance foot
-            across[1] = sw_side * gap_least
-            landing = st_ankle + _rotate(across, st_yaw)
-        way = float(np.linalg.norm(landing - swing_now))
-        if way <= settings.foot_speed * duration:
-            chosen = (float(duration), dcm_touchdown, landing)
-            break
-        shortfall = way - settings.foot_speed * duration
-        if best is None or shortfall < best[0]:
-            best = (shortfall, float(duration), dcm_touchdown, landing)
-    if chosen is None:  # no time fits the foot speed: the one that misses it least
-        nearest = best if best is not None else (0.0, float(durations[0]), dcm, swing_now)
-        chosen = (nearest[1], nearest[2], nearest[3])
-    swing_time, dcm_touchdown, landing = chosen
+        landing = off_the_stance(sole_center - _rotate(sw_center_local, st_yaw))
+        return float(np.linalg.norm(landing - ankles[sw][:2])) - settings.foot_speed * duration, dcm_touchdown, landing
+
+    shortest = settings.shortest_swing if touchdown is None else max(touchdown - time, LEAST_REPLANNED_SWING)
+    first = round(shortest / SWING_GRID)
+    durations = np.arange(first, max(round(settings.longest_swing / SWING_GRID), first) + 1) * SWING_GRID
+    candidates = [(float(duration), *landing_after(float(duration))) for duration in durations]
+    fitting = [c for c in candidates if c[1] <= 0.0]
+    # the shortest swing that makes its way at the foot speed, else the one that misses it least
+    swing_time, _, dcm_touchdown, landing = fitting[0] if fitting else min(candidates, key=lambda c: c[1])
     n = max(math.ceil((max(end, time + swing_time + settings.settle + 1.0 / omega) - time) * rate - 1e-9), 1) + 1
-    s = np.arange(n) / rate
     reached = True
-    settle = settings.settle
     for attempt in range(REACH_TRIES + 1):
-        pattern, rest = _build(robot, time, rate, s, settings, settle, omega, st, com, dcm, p1, swing_time, landing,
-                               st_yaw, float(yaw_pelvis_in_world), ankles, velocities, foot_yaws)
-        if attempt == 0:  # the DCM's way to the rest point: slower until its ZMP stays in the feet
-            for _ in range(SETTLE_TRIES):
-                if float(pattern.zmp_margin().min()) >= -ZMP_TOLERANCE:
-                    break
-                settle *= 2.0
-                n = max(n, math.ceil((swing_time + settle + 1.0 / omega) * rate) + 1)
-                s = np.arange(n) / rate
-                pattern, rest = _build(robot, time, rate, s, settings, settle, omega, st, com, dcm, p1, swing_time,
-                                       landing, st_yaw, float(yaw_pelvis_in_world), ankles, velocities, foot_yaws)
-            margin = float(pattern.zmp_margin().min())
-            if margin < -ZMP_TOLERANCE:
-                raise InfeasiblePatternError(
-                    f"capture step: the DCM at touchdown {np.round(dcm_touchdown, 3).tolist()} m lies outside the "
-                    f"feet (its ZMP leaves them by {-margin * 1e3:.1f} mm on the way to rest, settle "
-                    f"{settle:g} s): no single step catches it")
+        pattern, rest, settle, margin = _settled(robot, time, rate, n, settings, omega, st, com, dcm, p1, swing_time,
+                                                 landing, st_yaw, float(yaw_pelvis_in_world), ankles, velocities,
+                                                 foot_yaws)
         excess = leg_reach_excess(pattern.position_pelvis_in_world, pattern.yaw_pelvis_in_world,
                                   pattern.position_left_ankle_in_world, pattern.position_right_ankle_in_world, robot)
         worst = int(np.argmax([excess[0].max(), excess[1].max()]))
         if float(excess[worst].max()) <= -REACH_MARGIN:
             break
         if attempt == REACH_TRIES:
-            first = int(np.argmax(excess[worst] > -REACH_MARGIN))
-            raise UnreachableError(("left", "right")[worst], float(pattern.time[first]),
+            out = int(np.argmax(excess[worst] > -REACH_MARGIN))
+            raise UnreachableError(("left", "right")[worst], float(pattern.time[out]),
                                    float(excess[worst].max()) + REACH_MARGIN,
                                    f"capture step, after {REACH_TRIES} landings pulled towards the stance foot")
         reached = False
-        landing = st_ankle + REACH_SHRINK * (landing - st_ankle)
-        across = _rotate(landing - st_ankle, -st_yaw)
-        if sw_side * across[1] < gap_least:
-            across[1] = sw_side * gap_least
-            landing = st_ankle + _rotate(across, st_yaw)
-    margin = float(pattern.zmp_margin().min())
-    if margin < -ZMP_TOLERANCE:  # a landing pulled in for the legs' reach may leave the DCM out of the feet
-        raise InfeasiblePatternError(f"capture step: pulled in for the legs' reach, its ZMP leaves the feet by "
-                                     f"{-margin * 1e3:.1f} mm on the way to rest")
-    dcm_touchdown = p1 + (dcm - p1) * math.exp(omega * swing_time)
+        landing = off_the_stance(st_ankle + REACH_SHRINK * (landing - st_ankle))
+    if margin < -ZMP_TOLERANCE:
+        pulled = ", pulled in for the legs' reach," if not reached else ""
+        raise InfeasiblePatternError(
+            f"capture step: the DCM at touchdown {np.round(dcm_touchdown, 3).tolist()} m lies outside the feet"
+            f"{pulled} (its ZMP leaves them by {-margin * 1e3:.1f} mm on the way to rest, settle {settle:g} s): "
+            "no single step catches it")
     plan = CapturePlan(time=time, swing=("left", "right")[sw], swing_time=swing_time, zmp_stance=p1, dcm_start=dcm,
                        dcm_touchdown=dcm_touchdown, landing=(float(landing[0]), float(landing[1]), st_yaw), rest=rest,
                        reached=reached)
     return pattern, plan
+
+
+def _settled(robot: RobotModel, time: float, rate: float, n: int, settings: CaptureSettings, omega: float, st: int,
+             com: Array, dcm: Array, p1: Array, swing_time: float, landing: Array, st_yaw: float, pelvis_yaw: float,
+             ankles: list[Array], velocities: list[Array],
+             foot_yaws: tuple[float, float]) -> tuple[WalkingPattern, Array, float, float]:
+    """:func:`_build` with the settle doubled (up to :data:`SETTLE_TRIES` times) until the ZMP stays in the feet:
+    the pattern, the rest point, the settle [s] and the least ZMP margin [m] (< 0: it leaves them)."""
+    settle = settings.settle
+    for tries in range(SETTLE_TRIES + 1):
+        samples = max(n, math.ceil((swing_time + settle + 1.0 / omega) * rate) + 1)
+        pattern, rest = _build(robot, time, rate, np.arange(samples) / rate, settings, settle, omega, st, com, dcm,
+                               p1, swing_time, landing, st_yaw, pelvis_yaw, ankles, velocities, foot_yaws)
+        margin = float(pattern.zmp_margin().min())
+        if margin >= -ZMP_TOLERANCE or tries == SETTLE_TRIES:
+            break
+        settle *= 2.0
+    return pattern, rest, settle, margin
 
 
 def _crouch(robot: RobotModel, s: Array, pelvis: Array, pelvis_velocity: Array, pelvis_yaw: float,

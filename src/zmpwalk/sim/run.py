@@ -272,8 +272,9 @@ def simulate(
         capture: With a stabilizer: once its DCM error passes ``capture.trigger`` in a single support, the
             rest of the walk is replaced by a capture step planned from its estimate
             (:func:`zmpwalk.capture.capture_step`; the joint references and the feedforward re-made for it),
-            at most once a walk; the result's ``captures`` lists it, and the walk's end (final feet, the
-            reference ZMP) is the capture's. None (default): the pattern is played to its end.
+            re-planned while its swing lasts whenever the error passes the trigger again (a push still acting),
+            at most every :data:`CAPTURE_INTERVAL`; the result's ``captures`` lists them, and the walk's end (final
+            feet, the reference ZMP) is the last one's. None (default): the pattern is played to its end.
 
     Returns:
         The measurements. The same input gives the same result.
@@ -343,23 +344,24 @@ def simulate(
         source, touchdown = pattern, None
         if captures:  # a capture step under way is re-planned from its own plan, landing no later than needed
             source, touchdown = captures[-1][1], captures[-1][0].time + captures[-1][0].swing_time
-        at = float(np.clip(time[k + 1], source.time[0], source.time[-1]))
-        position_com = _rows_at(np.array([at]), source.time, source.position_pelvis_in_world)[0]
-        velocity_com = _rows_at(np.array([at]), source.time, source.velocity_pelvis_in_world)[0]
+        at = np.array([np.clip(time[k + 1], source.time[0], source.time[-1])])
+
+        def sample(values: Array) -> Array:
+            return np.asarray(_rows_at(at, source.time, values)[0], dtype=np.float64)
+
+        position_com, velocity_com = sample(source.position_pelvis_in_world), sample(source.velocity_pelvis_in_world)
         dcm = position_com[:2] + velocity_com[:2] / stabilizer.omega + stabilizer.state.dcm_error
         stance = "left" if stance_support == 1 else "right"
         swing = "right" if stance == "left" else "left"
-        ankles = [_rows_at(np.array([at]), source.time, a)[0]
-                  for a in (source.position_left_ankle_in_world, source.position_right_ankle_in_world)]
-        rates = [_rows_at(np.array([at]), source.time, v)[0]
-                 for v in (source.velocity_left_ankle_in_world, source.velocity_right_ankle_in_world)]
+        ankles = [sample(a) for a in (source.position_left_ankle_in_world, source.position_right_ankle_in_world)]
+        rates = [sample(v) for v in (source.velocity_left_ankle_in_world, source.velocity_right_ankle_in_world)]
         ankles[0 if swing == "left" else 1][:2] += stabilizer.landing_correction(swing)
-        yaws = (float(np.interp(at, source.time, source.yaw_left_foot_in_world)),
-                float(np.interp(at, source.time, source.yaw_right_foot_in_world)))
+        yaws = (float(np.interp(at[0], source.time, source.yaw_left_foot_in_world)),
+                float(np.interp(at[0], source.time, source.yaw_right_foot_in_world)))
         tail, plan = capture_step(
             robot, time=float(time[k + 1]), rate=CONTROL_RATE, end=float(time[-1]), stance=stance,
             position_com_in_world=position_com, dcm_in_world=dcm,
-            yaw_pelvis_in_world=float(np.interp(at, source.time, source.yaw_pelvis_in_world)),
+            yaw_pelvis_in_world=float(np.interp(at[0], source.time, source.yaw_pelvis_in_world)),
             ankles_in_world=(ankles[0], ankles[1]), ankle_velocities_in_world=(rates[0], rates[1]), foot_yaws=yaws,
             settings=capture, touchdown=touchdown)
         stabilizer.hand_over_landing(swing)  # the capture's swing starts where the correction aimed it
@@ -370,14 +372,7 @@ def simulate(
             plant, tail, pattern_joint_trajectory(tail, check_limits=False), tail_time, zmp, feedforward)
         if planned_torques is not None and torques is not None:
             planned_torques[k + 1:] = torques
-        return {"com": _rows_at(tail_time, tail.time, tail.position_pelvis_in_world),
-                "yaw": np.interp(tail_time, tail.time, tail.yaw_pelvis_in_world),
-                "left": _rows_at(tail_time, tail.time, tail.position_left_ankle_in_world),
-                "right": _rows_at(tail_time, tail.time, tail.position_right_ankle_in_world),
-                "left_yaw": np.interp(tail_time, tail.time, tail.yaw_left_foot_in_world),
-                "right_yaw": np.interp(tail_time, tail.time, tail.yaw_right_foot_in_world),
-                "support": _support_at(tail, tail_time), "zmp": zmp, "reference": tail_reference,
-                "control": tail_control}
+        return {**_tracked(tail, tail_time), "zmp": zmp, "reference": tail_reference, "control": tail_control}
 
     if disturbances is not None:  # the world changes after the controller's model is made
         disturbances.apply(model)
@@ -388,8 +383,8 @@ def simulate(
     else:
         readings, balance_log = _closed_loop(model, data, plant, stabilizer, pattern, pattern_time, reference,
                                              control, zmp_ref, steps_per_tick, sensors, latency, noise, progress,
-                                             disturbances, time, None if capture is None else capture.trigger,
-                                             capture_tail)
+                                             disturbances, time,
+                                             None if capture is None else (capture.trigger, capture_tail))
     # --- measurements
     pelvis = sensors.take(readings, "pelvis_pos")
     rpy = _rpy(sensors.take(readings, "pelvis_quat"))
@@ -600,9 +595,20 @@ def _rows_at(times: Array, pattern_times: Array, values: Array) -> Array:
     return np.column_stack([np.interp(times, pattern_times, values[:, i]) for i in range(values.shape[1])])
 
 
-def _support_at(pattern: WalkingPattern, times: Array) -> NDArray[np.int8]:
-    """The pattern's support code at each of ``times`` (a time at a phase change has the phase that begins)."""
-    return pattern.support[np.clip(np.searchsorted(pattern.time, times - 1e-9), 0, len(pattern.time) - 1)]
+def _tracked(pattern: WalkingPattern, times: Array) -> dict[str, NDArray[np.generic]]:
+    """What the stabilizer tracks of ``pattern`` at ``times`` (n,): its CoM point ``com`` (n, 3), pelvis ``yaw``,
+    ankles ``left`` and ``right`` (n, 3), foot yaws ``left_yaw`` and ``right_yaw``, and the ``support`` code (a
+    time at a phase change has the phase that begins)."""
+    planned_com = (pattern.position_pelvis_in_world if pattern.position_com_in_world is None
+                   else pattern.position_com_in_world)
+    return {"com": _rows_at(times, pattern.time, planned_com),
+            "yaw": np.interp(times, pattern.time, pattern.yaw_pelvis_in_world),
+            "left": _rows_at(times, pattern.time, pattern.position_left_ankle_in_world),
+            "right": _rows_at(times, pattern.time, pattern.position_right_ankle_in_world),
+            "left_yaw": np.interp(times, pattern.time, pattern.yaw_left_foot_in_world),
+            "right_yaw": np.interp(times, pattern.time, pattern.yaw_right_foot_in_world),
+            "support": pattern.support[np.clip(np.searchsorted(pattern.time, times - 1e-9), 0,
+                                               len(pattern.time) - 1)]}
 
 
 def _controls(plant: Plant, pattern: WalkingPattern, joints: JointTrajectory, pattern_time: Array, zmp_ref: Array,
@@ -634,24 +640,18 @@ def _closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabi
                  pattern: WalkingPattern, pattern_time: Array, reference: Array, control: Array, zmp_ref: Array,
                  steps_per_tick: int, sensors: _Sensors, latency: float, noise: SensorNoise | None,
                  progress: Callable[[float], None] | None = None, disturbances: Disturbances | None = None,
-                 time: Array | None = None, capture_trigger: float | None = None,
-                 capture_tail: Callable[[int, Stabilizer, int], dict[str, NDArray[np.generic]]] | None = None,
+                 time: Array | None = None,
+                 capture: tuple[float, Callable[[int, Stabilizer, int], dict[str, NDArray[np.generic]]]] | None = None,
                  ) -> tuple[Array, dict[str, Array]]:
     """Step the model tick by tick (the stabilizer in the loop where given, pushes applied); sensor rows
-    (n, nsensordata) and the stabilizer's log. Once the stabilizer's DCM error passes ``capture_trigger`` in a
-    single support, ``capture_tail`` re-makes the references from the next tick on (once)."""
+    (n, nsensordata) and the stabilizer's log. With ``capture = (trigger, tail)``: whenever the stabilizer's DCM
+    error passes ``trigger`` [m] in a single support (at most every :data:`CAPTURE_INTERVAL`), ``tail`` re-makes
+    the references from the next tick on (:func:`_tracked`'s, the ZMP, the joint references and the controls)."""
     n = len(pattern_time)
     time = pattern_time if time is None else time
-    interp = np.interp
-    planned_com = (pattern.position_pelvis_in_world if pattern.position_com_in_world is None
-                   else pattern.position_com_in_world)
-    com = np.column_stack([interp(pattern_time, pattern.time, planned_com[:, i]) for i in range(3)])
-    yaw = interp(pattern_time, pattern.time, pattern.yaw_pelvis_in_world)
-    ankles = [np.column_stack([interp(pattern_time, pattern.time, a[:, i]) for i in range(3)])
-              for a in (pattern.position_left_ankle_in_world, pattern.position_right_ankle_in_world)]
-    foot_yaws = [interp(pattern_time, pattern.time, y) for y in (pattern.yaw_left_foot_in_world,
-                                                                 pattern.yaw_right_foot_in_world)]
-    support = pattern.support[np.clip(np.searchsorted(pattern.time, pattern_time - 1e-9), 0, len(pattern.time) - 1)]
+    tracked = _tracked(pattern, pattern_time)
+    com, yaw, support = tracked["com"], tracked["yaw"], tracked["support"]
+    ankles, foot_yaws = (tracked["left"], tracked["right"]), (tracked["left_yaw"], tracked["right_yaw"])
     offsets = control[:, plant.leg_actuators] - reference  # the feedforward's share of the leg controls
     readings = np.empty((n, model.nsensordata))
     delay = round(latency * CONTROL_RATE)
@@ -703,22 +703,19 @@ def _closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabi
         log["ankle_offsets"][k] = state.ankle_offsets.ravel()
         log["height_difference"][k] = state.height_difference
         log["pelvis_turn"][k] = state.pelvis_turn
-        tail: dict[str, NDArray[np.generic]] = {}
-        if (capture_tail is not None and capture_trigger is not None and k + 1 < n and support[k] != 0
-                and support[k + 1] == support[k] and k - last_capture >= CAPTURE_INTERVAL * CONTROL_RATE
-                and math.hypot(float(state.dcm_error[0]), float(state.dcm_error[1])) > capture_trigger):
+        if (capture is not None and k + 1 < n and support[k] != 0 and support[k + 1] == support[k]
+                and k - last_capture >= CAPTURE_INTERVAL * CONTROL_RATE
+                and math.hypot(float(state.dcm_error[0]), float(state.dcm_error[1])) > capture[0]):
             last_capture = k
             try:
-                tail = capture_tail(k, stabilizer, int(support[k]))
-            except (UnreachableError, InfeasiblePatternError):  # no capture step fits: the plan goes on as it was
-                tail = {}
-        if tail:
-            com[k + 1:], yaw[k + 1:], support[k + 1:], zmp_ref[k + 1:] = (tail["com"], tail["yaw"], tail["support"],
-                                                                          tail["zmp"])
-            ankles[0][k + 1:], ankles[1][k + 1:] = tail["left"], tail["right"]
-            foot_yaws[0][k + 1:], foot_yaws[1][k + 1:] = tail["left_yaw"], tail["right_yaw"]
-            reference[k + 1:], control[k + 1:] = tail["reference"], tail["control"]
-            offsets[k + 1:] = control[k + 1:, plant.leg_actuators] - reference[k + 1:]
+                tail = capture[1](k, stabilizer, int(support[k]))
+            except (UnreachableError, InfeasiblePatternError):
+                pass  # no capture step fits: the plan goes on as it was
+            else:
+                for key, values in tracked.items():
+                    values[k + 1:] = tail[key]
+                zmp_ref[k + 1:], reference[k + 1:], control[k + 1:] = tail["zmp"], tail["reference"], tail["control"]
+                offsets[k + 1:] = control[k + 1:, plant.leg_actuators] - reference[k + 1:]
         if not np.all(np.isfinite(data.qpos)):
             readings[k + 1:] = readings[k]
             break
