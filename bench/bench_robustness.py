@@ -98,6 +98,17 @@ def push_job(job: tuple[str, str, str, float]) -> tuple[str, str, str, float]:
     return name, direction, mode, largest_push(name, direction, mode, high)
 
 
+def _impulse(value: float | None) -> str:
+    """A scan's figure [N s], or "-" where that loop was not scanned (``--modes``)."""
+    return "-" if value is None else f"{value:.0f}"
+
+
+def _ratio(value: float | None, open_loop: float | None) -> str:
+    if value is None or open_loop is None:
+        return "-"
+    return f"{value / open_loop:.1f}" if open_loop > 0 else "inf"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true", help="HUBO only, no pushes")
@@ -129,10 +140,9 @@ def main() -> None:
         found = {(n, d, m): v for n, d, m, v in pool.map(push_job, pushes)}
         for r in pushed:
             for d in ("push-forward", "push-backward", "push-sideways"):
-                off, on, capture = (found.get((r, d, m), math.nan) for m in MODES)
-                ratios = [f"{v / off:.1f}" if off > 0 else "inf" for v in (on, capture)]
-                print(f"| {r} | {d[5:]} | {off:.0f} | {on:.0f} | {ratios[0]} | {capture:.0f} | {ratios[1]} |",
-                      flush=True)
+                off, on, capture = (found.get((r, d, m)) for m in MODES)
+                cells = [_impulse(off), _impulse(on), _ratio(on, off), _impulse(capture), _ratio(capture, off)]
+                print(f"| {r} | {d[5:]} | {' | '.join(cells)} |", flush=True)
 
 
 if __name__ == "__main__":
