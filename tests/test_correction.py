@@ -34,6 +34,9 @@ def test_multibody_zmp_follows_the_plan_after_correction(fig10: object) -> None:
     assert again.rms == pytest.approx(correction.after.rms, abs=1e-12)
     assert correction.pattern.position_com_in_world is not None
     assert np.abs(correction.pattern.position_com_in_world - again.center_of_mass).max() <= EXACT
+    # the CoM point a stabilizer tracks: the whole-body CoM after the correction, the pelvis point before
+    assert np.abs(correction.pattern.position_com_point_in_world - again.center_of_mass).max() <= EXACT
+    assert np.abs(fig10.position_com_point_in_world - fig10.position_pelvis_in_world).max() <= EXACT  # type: ignore[attr-defined]
 
 
 def test_only_the_pelvis_moves(fig10: object) -> None:

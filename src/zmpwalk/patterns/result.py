@@ -156,6 +156,12 @@ class WalkingPattern:
         (the base is placed under the pattern's point), else ``"pelvis"`` (a box model's pelvis point)."""
         return "whole_body" if self.position_com_in_world is not None or self.robot.plant is not None else "pelvis"
 
+    @property
+    def position_com_point_in_world(self) -> Array:
+        """The CoM point a stabilizer tracks [m], (n, 3): ``position_com_in_world`` where the pattern records it
+        (a multibody-corrected pattern), else the pelvis point."""
+        return self.position_pelvis_in_world if self.position_com_in_world is None else self.position_com_in_world
+
     def _in_pelvis(self, position: Array) -> Array:
         rel = position - self.position_pelvis_in_world
         c, s = np.cos(self.yaw_pelvis_in_world), np.sin(self.yaw_pelvis_in_world)

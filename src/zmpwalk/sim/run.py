@@ -323,9 +323,7 @@ def simulate(
     # Standing still before the walk the ZMP is under the CoM (c'' = 0 in p = c - c'' l / g, Eqs. 1-2); the
     # pattern's first sample is already the walk's (a start stage that accelerates, the start transient of
     # Lim et al. whose ZMP jumps), which neither the feedforward nor the stabilizer may hold during the settle.
-    planned_com = pattern.position_pelvis_in_world if pattern.position_com_in_world is None \
-        else pattern.position_com_in_world
-    zmp_ref[time < pattern.time[0]] = planned_com[0, :2]
+    zmp_ref[time < pattern.time[0]] = pattern.position_com_point_in_world[0, :2]
     reference, control, planned_torques = _controls(plant, pattern, joints, pattern_time, zmp_ref, feedforward)
     base_planned = (pattern.position_pelvis_in_world if joints.position_base_in_world is None
                     else joints.position_base_in_world)
@@ -599,9 +597,7 @@ def _tracked(pattern: WalkingPattern, times: Array) -> dict[str, NDArray[np.gene
     """What the stabilizer tracks of ``pattern`` at ``times`` (n,): its CoM point ``com`` (n, 3), pelvis ``yaw``,
     ankles ``left`` and ``right`` (n, 3), foot yaws ``left_yaw`` and ``right_yaw``, and the ``support`` code (a
     time at a phase change has the phase that begins)."""
-    planned_com = (pattern.position_pelvis_in_world if pattern.position_com_in_world is None
-                   else pattern.position_com_in_world)
-    return {"com": _rows_at(times, pattern.time, planned_com),
+    return {"com": _rows_at(times, pattern.time, pattern.position_com_point_in_world),
             "yaw": np.interp(times, pattern.time, pattern.yaw_pelvis_in_world),
             "left": _rows_at(times, pattern.time, pattern.position_left_ankle_in_world),
             "right": _rows_at(times, pattern.time, pattern.position_right_ankle_in_world),
