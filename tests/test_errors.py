@@ -184,3 +184,71 @@ def test_simulate_rejects_a_stabilizer_told_the_wrong_com_point():
     joints = pattern_joint_trajectory(pattern)
     with pytest.raises(InvalidParameterError, match=r"stabilizer.com_reference.*'whole_body'.*pelvis: the CoM"):
         simulate(hubo, joints, pattern, stabilizer=Stabilizer(hubo, 1000.0, com_reference="whole_body"))
+
+
+def _every_error_class() -> set[type[ZmpwalkError]]:
+    import importlib
+    import pkgutil
+
+    import zmpwalk
+
+    for module in pkgutil.walk_packages(zmpwalk.__path__, "zmpwalk."):
+        if module.name != "zmpwalk.__main__":
+            importlib.import_module(module.name)
+    found: set[type[ZmpwalkError]] = set()
+    todo = [ZmpwalkError]
+    while todo:
+        kind = todo.pop()
+        found.add(kind)
+        todo.extend(kind.__subclasses__())
+    return found
+
+
+def _error_examples() -> list[ZmpwalkError]:
+    from zmpwalk.errors import InfeasiblePatternError
+    from zmpwalk.kinematics import JointLimitError
+
+    reach = UnreachableError("left", 1.25, 0.012, "stage 3")
+    reach.sample, reach.stage = 125, 3
+    return [
+        ZmpwalkError("the walk has no samples"),
+        InvalidParameterError("duration", 800, "a step time in [0.3, 5] s", context="step 2"),
+        InfeasibleCommandError("forward", 0.9, {"forward": 0.41}, reach),
+        InfeasibleCommandError("side", 0.3, {}, InfeasiblePatternError("ZMP outside the feet")),
+        UnknownNameError("robot", "hubbo", ["hubo", "mju-biped"]),
+        reach,
+        FileFormatError("steps.toml", "[[steps]] 2: missing field 'duration'"),
+        InfeasiblePatternError("the sway cubic reverses"),
+        JointLimitError("left_knee", 2.7, 1.5, (0.0, 2.6)),
+    ]
+
+
+def test_every_error_survives_pickling_with_its_message_and_fields():
+    """A worker process's error reaches the pool's caller as raised (a pool that cannot unpickle one hangs)."""
+    import pickle
+
+    examples = _error_examples()
+    assert {type(e) for e in examples} >= _every_error_class(), "an error class without a pickling example"
+    for error in examples:
+        for protocol in range(pickle.HIGHEST_PROTOCOL + 1):
+            copy = pickle.loads(pickle.dumps(error, protocol))
+            assert type(copy) is type(error) and str(copy) == str(error)
+            assert vars(copy).keys() == vars(error).keys()
+            for name, value in vars(error).items():
+                assert str(getattr(copy, name)) == str(value), name
+    context = pickle.loads(pickle.dumps(FileFormatError("robot.toml", "bad").in_context("loading")))
+    assert str(context) == "loading: robot.toml: bad" and context.path == "robot.toml"
+
+
+def test_an_error_raised_in_a_worker_process_reaches_the_caller():
+    import multiprocessing
+
+    with multiprocessing.get_context("spawn").Pool(1) as pool:
+        result = pool.apply_async(_raise_in_worker)
+        with pytest.raises(InvalidParameterError, match=r"duration = 800 is not allowed") as info:
+            result.get(timeout=60)
+    assert info.value.parameter == "duration" and info.value.value == 800
+
+
+def _raise_in_worker() -> None:
+    raise InvalidParameterError("duration", 800, "a step time in [0.3, 5] s")
