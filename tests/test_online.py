@@ -412,3 +412,77 @@ def test_online_samples_with_joints_equal_the_batch_path_on_random_walks(hubo, s
     np.testing.assert_allclose([_rows(s) for s in samples], _pattern_rows(pattern), atol=1e-9, rtol=0)
     np.testing.assert_allclose([s.joint_angles for s in samples], joints.angles, atol=1e-9, rtol=0)
     np.testing.assert_allclose([s.joint_velocities for s in samples], joints.velocities, atol=1e-9, rtol=0)
+
+
+def _pose(sample):
+    """Pelvis and both ankles: position and yaw [m, rad]."""
+    return np.concatenate([sample.position_pelvis_in_world, [sample.yaw_pelvis_in_world],
+                           sample.position_left_ankle_in_world, [sample.yaw_left_foot_in_world],
+                           sample.position_right_ankle_in_world, [sample.yaw_right_foot_in_world]])
+
+
+def _stopping(hubo, rate, generator, steps, stop_at):
+    """A walker that walked ``steps`` and was asked to stop ``stop_at`` of the way into the last (None: it
+    stops by itself), ticked until its stop (closing step and settle) is under way; the stop's plan."""
+    walker = OnlineWalker(hubo, rate=rate, generator=generator)
+    for step in steps:
+        walker.command(step, wait=True)
+        while walker.queued is not None:
+            walker.tick()
+    if stop_at is not None:
+        for _ in range(int(stop_at * steps[-1].duration * rate)):
+            walker.tick()
+        walker.stop()
+    while walker._current is None or not walker._current.command.stop:
+        walker.tick()
+    return walker, walker._current
+
+
+def _walk_commanded_at(hubo, setup, delay, wait):
+    """The walk ``command`` given ``delay`` of the way from the start of the settle to 1 s after its end (None:
+    at its first tick of standing still): every tick's pose from the tick the walk starts on (the rule of the
+    module docstring), and the poses between the end of the settle and that tick."""
+    from zmpwalk.online import START_DELAY
+
+    rate, generator, steps, stop_at, command = setup
+    walker, stop = _stopping(hubo, rate, generator, steps, stop_at)
+    settle = math.floor(stop.stages[-1].start * rate)  # about where the settle begins
+    rest = stop.first_index + len(stop.rows)  # the first tick of standing still
+    given = rest if delay is None else settle + int(delay * (rest + rate - settle))
+    while walker._index < given:
+        walker.tick()
+    walker.command(command, wait=wait)
+    start = max(rest, given + (0 if wait else math.ceil(START_DELAY * rate - 1e-9)))
+    before, after = [], []
+    while len(after) < 8 * command.duration * rate:  # the walk (at most 7 step times) and standing after it
+        index = walker._index
+        pose = _pose(walker.tick())
+        if index >= start:
+            after.append(pose)
+        elif index >= rest:
+            before.append(pose)
+    assert not walker.walking
+    return np.array(before), np.array(after)
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(st.sampled_from([100.0, 250.0]), st.sampled_from(["polynomial", "hyperbolic"]),
+       st.lists(st.builds(StepCommand, st.floats(0.7, 0.95), st.floats(0.0, 0.2), turn=st.floats(-0.1, 0.1)),
+                min_size=1, max_size=3),
+       st.one_of(st.none(), st.floats(0.0, 0.9)),
+       st.builds(StepCommand, st.floats(0.7, 0.95), st.floats(-0.1, 0.2), turn=st.floats(-0.1, 0.1)),
+       st.floats(0.0, 1.0), st.booleans())
+def test_a_walk_after_a_stop_is_the_same_whenever_in_the_settle_it_is_commanded(
+        hubo, rate, generator, steps, stop_at, command, delay, wait):
+    """A command given at any tick of the settle that ends a stop, or after it: the walk starts from the
+    standing state on the tick the rule gives (the first at or after the end of the settle and START_DELAY
+    after the command, without the delay with wait), and from there its pelvis and feet are those of the
+    same command given with wait at the first tick of standing still, to 1e-9 m, sample for sample (before
+    the issue's fix: up to 8.6 mm apart, 49 of 49 random walkers at 100 Hz)."""
+    setup = (rate, generator, steps, stop_at, command)
+    _, reference = _walk_commanded_at(hubo, setup, None, True)
+    standing, walk = _walk_commanded_at(hubo, setup, delay, wait)
+    assert np.abs(reference[1] - reference[0]).max() > 1e-9  # it starts moving at once
+    np.testing.assert_allclose(walk, reference, atol=1e-9, rtol=0)
+    if len(standing):  # standing still until it starts, where the walk starts
+        np.testing.assert_allclose(standing, np.broadcast_to(reference[0], standing.shape), atol=1e-9, rtol=0)

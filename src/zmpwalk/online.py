@@ -32,6 +32,12 @@ Behaviour:
 * ``command(step, wait=True)`` runs the same check whole in the call (milliseconds: scripts, tests,
   loops without a hard deadline): a rejected command raises and leaves the walker exactly as it was (the
   queued command, if any, stays), and a walk from standstill starts at once.
+* A walk commanded while the walker stands, or while it stops (its closing step and settle), starts from
+  the standing state the stop ends in, at the first tick at or after both the end of the settle and
+  :data:`START_DELAY` (in whole ticks, rounded up) after the tick of the command (without the delay with
+  ``wait``). It starts on a tick, so whichever tick it was commanded at, its footsteps and trajectories
+  are the same, shifted by whole ticks (the cart-table ZMP too, except that a sample falling exactly on a
+  stage boundary, to rounding, may take either stage's value where the ZMP jumps there).
 * If no command is queued when the step under way ends, the walker stops
   safely: a closing step of the last step time (the swinging foot lands beside
   the other one) and a settle stage, after which it stands still in the ready
@@ -101,6 +107,11 @@ _WIDTH = 15
 _WIDTH_WITH_JOINTS = 39
 SLICE_ROWS = 200  # samples per block of a command's check (each block's pattern and legs in parts of tens of us)
 START_DELAY = 0.6  # [s] a walk commanded from standstill starts this much later (its check is done by then)
+
+
+def start_delay_ticks(rate: float) -> int:
+    """:data:`START_DELAY` in whole ticks at ``rate`` [Hz] (rounded up)."""
+    return math.ceil(START_DELAY * rate - 1e-9)
 HINT_RATE = 100.0  # [Hz] sampling of the search for the largest stride that fits, in a rejection
 HINT_CONFIRMATIONS = 5  # tries at the control rate, each HINT_SHRINK smaller
 HINT_SHRINK = 0.98
@@ -193,6 +204,7 @@ class _Job:
     planning: Parts[_Plan | None]
     origin: tuple[Stance, Boundary]  # the walker's end of plan when given: the job is stale once it changes
     expected: int  # parts its check is expected to take
+    given: int  # index of the tick at which it was commanded
     parts: int = 0  # parts run so far
 
 
@@ -296,7 +308,8 @@ class OnlineWalker:
         Args:
             command: The step.
             wait: Check it whole in this call instead (milliseconds), raise if it is rejected, and start a
-                walk from standstill at once rather than :data:`START_DELAY` later.
+                walk from standstill at once (a stopping walker: at the first tick of standing still) rather
+                than :data:`START_DELAY` later.
 
         Raises:
             InvalidParameterError: ``command`` is not a :class:`StepCommand`.
@@ -305,11 +318,16 @@ class OnlineWalker:
         """
         if not isinstance(command, StepCommand):
             raise InvalidParameterError("command", command, "a StepCommand")
+        self._submit(command, self._index, wait)
+
+    def _submit(self, command: StepCommand, given: int, wait: bool) -> None:
+        """:meth:`command` given at tick ``given`` (a check restarted when the walk it follows changed keeps the
+        tick of the command)."""
         stance, boundary = self._stance, self._boundary
         origin = (stance, boundary)
+        if boundary.at_rest:
+            boundary = self._rest_start(boundary, given + (0 if wait else start_delay_ticks(self.rate)))
         if wait:
-            if boundary.at_rest:
-                boundary = Boundary(max(boundary.time, self.time))
             try:
                 plan = run_to_end(self._checked(command, stance, boundary, self.rate))
             except _TOO_LARGE as error:
@@ -318,8 +336,6 @@ class OnlineWalker:
             self._rejection = None
             self._pending = plan  # None: a stop while standing
             return
-        if boundary.at_rest:
-            boundary = Boundary(max(boundary.time, self.time + START_DELAY))
         self._rejection = None
         start = first_sample_at(boundary.time, self.rate)
         # parts to expect: as many as the last check took, at least a guess from the samples (the step, its
@@ -327,7 +343,17 @@ class OnlineWalker:
         blocks = math.ceil((3.0 if self._current is not None else 4.0) * command.duration * self.rate / SLICE_ROWS)
         expected = max(self._check_parts, PARTS_PER_BLOCK * blocks)
         self._job = _Job(command, stance, boundary, start,
-                         self._checked(command, stance, boundary, self.rate, sliced=True), origin, expected)
+                         self._checked(command, stance, boundary, self.rate, sliced=True), origin, expected, given)
+
+    def _rest_start(self, rest: Boundary, earliest: int) -> Boundary:
+        """Where a walk from standstill starts: from the standing state (the pelvis at rest above the middle of
+        the ankles, as the standing row holds it), at the first tick at or after both the end of the walk
+        before it (``rest``: its settle) and tick ``earliest``.
+
+        On a tick exactly, so that the walk's samples fall at the same times after its start whenever in the
+        settle (or after it) it was commanded: the same walk, shifted by whole ticks."""
+        index = max(first_sample_at(rest.time, self.rate), earliest)
+        return Boundary(index / self.rate)
 
     @property
     def checking(self) -> StepCommand | None:
@@ -358,7 +384,7 @@ class OnlineWalker:
         if job.origin[0] is not self._stance or job.origin[1] is not self._boundary:
             # the step it was to follow has changed (a queued command started meanwhile): check it again from
             # the new end of the walk
-            self.command(job.command)
+            self._submit(job.command, job.given, wait=False)
             job = self._job
             if job is None:  # pragma: no cover - command() always sets a job
                 return
