@@ -107,3 +107,16 @@ def test_bad_motor_files(tmp_path: Path, text: str, words: str) -> None:
     path.write_text(text, encoding="utf-8")
     with pytest.raises(FileFormatError, match=words):
         load_motors(path)
+
+
+def test_the_markdown_table_has_as_many_cells_in_its_header_as_in_each_row() -> None:
+    import math
+
+    from zmpwalk.sim.actuators import ActuatorRow, actuator_markdown
+
+    rows = [ActuatorRow("left_knee", 61.0, 70.0, 15.0, 2.0, 20.0, 2.0, 60.0, 27.0),  # over its limit
+            ActuatorRow("left_hip_yaw", 5.0, 6.0, 2.0, 0.5, 2.0, 0.3, math.inf, math.nan)]
+    lines = actuator_markdown(rows).splitlines()
+    counts = [len(line.strip().strip("|").split("|")) for line in lines]
+    assert counts == [9] * 4
+    assert "60 (102 %, EXCEEDED)" in lines[2] and "| none | - |" in lines[3]

@@ -56,6 +56,18 @@ def test_plan_exit_status_outside_the_polygon_and_the_default_rate(tmp_path, cap
     assert json.loads(capsys.readouterr().out)["rate"] == 1000.0  # the default rate, as report's
 
 
+def test_plan_without_out_writes_nothing_and_says_so(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(["plan", "--scenario", "fig27", "--rate", "100"]) == 0
+    assert "no CSV written (give --out FILE to write it)" in capsys.readouterr().out
+    assert list(tmp_path.iterdir()) == []
+    assert main(["plan", "--scenario", "fig27", "--rate", "100", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["out"] is None
+    out = tmp_path / "fig27.csv"
+    assert main(["plan", "--scenario", "fig27", "--rate", "100", "--out", str(out), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["out"] == str(out) and out.is_file()
+
+
 def test_plan_json_and_rate(tmp_path, capsys):
     steps = tmp_path / "walk.toml"
     steps.write_text("[[steps]]\nduration = 0.8\nforward = 0.2\nrepeat = 4\n")

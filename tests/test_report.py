@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import math
+import re
 import shutil
 import subprocess
 import tempfile
@@ -38,6 +40,18 @@ def test_demo_writes_the_report_folder(demo):
     assert page.count("data:image/png;base64,") == 6 and page.count("data:image/gif;base64,") == 1
     assert "The stabilizer" in page
     assert "right_hip_roll" in page and "ZMP margin per step" in page
+    header, *rows = _table_cells(page, "actuators")
+    assert len(header) == 9 and all(len(row) == len(header) for row in rows) and len(rows) == 12
+    # HUBO's box model has no actuator limits: that criterion is not measured, so the page is never green
+    assert "class='good'>passes every criterion" not in page
+    assert "<td class='none'>not measured</td>" in page
+    assert "passes the 8 criteria measured" in page
+
+
+def _table_cells(page: str, table_id: str) -> list[list[str]]:
+    """The cells of a table of the page, one list per row (header cells and data cells alike)."""
+    table = page.split(f'<table id="{table_id}">')[1].split("</table>")[0]
+    return [re.findall(r"<t[hd][^>]*>(.*?)</t[hd]>", row) for row in table.split("</tr>") if "<t" in row]
 
 
 @pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed (.ci/run installs it)")
@@ -66,17 +80,32 @@ def test_headless_browser_loads_every_image_and_the_animation(demo):
 @pytest.mark.parametrize("argv, message", [
     (["demo", "--scenario", "nope"], "unknown scenario 'nope'"),
     (["report", "--robot", "mju-biped", "--scenario", "fig28", "--no-animation"], "out of reach"),
-    (["report"], "give --scenario NAME or --steps FILE"),
+    (["report"], "give --scenario NAME or a steps file"),
+    (["report", "walk.toml", "--steps", "walk.toml"], "give the steps file once"),
+    (["report", "walk.toml", "--scenario", "fig28"], "give either a steps file or --scenario"),
 ])
 def test_report_errors(tmp_path, capsys, argv, message):
     assert main([*argv, "--out", str(tmp_path / "r")]) == 2
     assert message in capsys.readouterr().err
 
 
-def test_report_from_a_steps_file(tmp_path, capsys):
+@pytest.mark.parametrize("argv", [["report", "STEPS"], ["demo", "STEPS"], ["report", "--steps", "STEPS"]])
+def test_report_and_demo_take_a_steps_file_as_plan_and_simulate_do(tmp_path, capsys, argv):
     steps = tmp_path / "walk.toml"
     steps.write_text("[[steps]]\nduration = 0.8\nforward = 0.1\nrepeat = 2\n")
-    assert main(["report", "--steps", str(steps), "--no-animation", "--out", str(tmp_path / "r")]) == 0
+    argv = [str(steps) if a == "STEPS" else a for a in argv]
+    assert main([*argv, "--no-animation", "--out", str(tmp_path / "r")]) == 0
     printed = capsys.readouterr().out
-    assert "PASS (no fall)" in printed and "FAIL" not in printed
+    assert "PASS (no fall)" in printed and "FAIL" not in printed and "walk.toml" in printed
+    assert "(inside the support polygon)" in printed
     assert (tmp_path / "r" / "index.html").exists()
+
+
+def test_the_motor_table_header_has_as_many_cells_as_each_row():
+    from zmpwalk.report.page import actuator_html
+    from zmpwalk.sim.actuators import ActuatorRow
+
+    rows = [ActuatorRow("left_knee", 30.0, 35.0, 15.0, 2.0, 20.0, 2.0, 60.0, 27.0),
+            ActuatorRow("left_hip_yaw", 5.0, 6.0, 2.0, 0.5, 2.0, 0.3, math.inf, math.nan)]
+    cells = [re.findall(r"<t([hd])>", row) for row in actuator_html(rows).splitlines()]
+    assert cells[0] == ["h"] * 9 and cells[1:] == [["d"] * 9] * 2

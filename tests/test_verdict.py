@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import pytest
 
 from zmpwalk.cli import EXIT_FAILED, main
+from zmpwalk.sim.actuators import ActuatorRow
+from zmpwalk.sim.motors import MotorFit
+from zmpwalk.sim.verdict import ACTUATOR_LIMIT, Criterion, Verdict, actuator_criterion
 
 
 def test_a_too_long_stride_at_0_4_s_on_hubo_fails_and_exits_non_zero(tmp_path: Path,
@@ -20,6 +24,11 @@ def test_a_too_long_stride_at_0_4_s_on_hubo_fails_and_exits_non_zero(tmp_path: P
     by_name = {c["name"]: c for c in verdict["criteria"]}
     assert by_name["no fall"]["passed"] is False
     assert by_name["no fall"]["figure"] < by_name["no fall"]["limit"]  # fell before the end [s]
+    # the limit is the run's length (0.5 s standing, the pattern, 2 s holding), not the truncated record's
+    assert main(["plan", str(steps), "--json", "--allow-outside"]) == 0
+    duration = json.loads(capsys.readouterr().out)["duration"]
+    assert by_name["no fall"]["limit"] == pytest.approx(0.5 + duration + 2.0, abs=2e-3)
+    assert by_name["no fall"]["text"].startswith("fell after ")
 
 
 def test_the_small_biped_on_hubo_tables_fails_in_the_report(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -39,9 +48,16 @@ def test_the_papers_walk_passes_every_criterion(capsys: pytest.CaptureFixture[st
     assert main(["simulate", "--paper-example", "--robot", "mju-biped", "--json"]) == 0
     verdict = json.loads(capsys.readouterr().out)["verdict"]
     assert verdict["passed"] is True
-    assert len(verdict["criteria"]) == 7
+    assert len(verdict["criteria"]) == 9
     for criterion in verdict["criteria"]:
-        assert criterion["figure"] is not None and criterion["passed"] is True
+        assert criterion["passed"] is True
+        if criterion["name"] == "the joints stay within their actuators' limits":  # the box model has no limits
+            assert criterion["figure"] is None and criterion["state"] == "SKIP"
+            assert criterion["text"].startswith("not measured")
+        else:
+            assert criterion["figure"] is not None and criterion["state"] == "PASS"
+    # not every criterion was measured: never "passes every criterion", never green
+    assert verdict["complete"] is False and "passes every criterion" not in verdict["outcome"]
 
 
 def test_the_cop_criterion_skips_each_touchdown_the_first_sample_included() -> None:
@@ -97,3 +113,114 @@ def test_a_touchdown_starts_at_first_contact_not_when_the_sole_becomes_loaded() 
     assert cop_margin_outside_touchdowns(result) == pytest.approx(0.02, abs=1e-12)  # type: ignore[arg-type]
     margin[touch - 1] = -0.030  # before the contact: judged
     assert cop_margin_outside_touchdowns(result) == pytest.approx(-0.030, abs=1e-12)  # type: ignore[arg-type]
+
+
+FAST = "[[steps]]\nduration = 0.7\nforward = 0.2\nrepeat = 4\n"  # HUBO's V_y at 0.7 s: the plan leaves the soles
+
+
+def test_a_plan_outside_the_soles_fails_the_verdict_and_simulate_says_outside(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The plan's cart-table ZMP is 12.7 mm outside the soles (zmpwalk plan, docs/zmp-margins.md): the verdict
+    fails on it with that figure, and simulate's summary says OUTSIDE as plan does."""
+    steps = tmp_path / "fast.toml"
+    steps.write_text(FAST, encoding="utf-8")
+    assert main(["simulate", str(steps)]) == EXIT_FAILED
+    printed = capsys.readouterr().out
+    assert "plan: min ZMP margin -12.7 mm (OUTSIDE the support polygon)" in printed
+    assert "FAIL the plan keeps its ZMP inside the soles: -12.7 mm (limit: at least 0.0 mm)" in printed
+    assert main(["simulate", str(steps), "--json"]) == EXIT_FAILED
+    summary = json.loads(capsys.readouterr().out)
+    by_name = {c["name"]: c for c in summary["verdict"]["criteria"]}
+    plan = by_name["the plan keeps its ZMP inside the soles"]
+    assert plan["figure"] == pytest.approx(-0.0127, abs=0.1e-3) and plan["limit"] == 0.0
+    assert plan["passed"] is False and plan["state"] == "FAIL"
+    assert summary["plan_min_zmp_margin"] == pytest.approx(plan["figure"], abs=1e-12)
+    # the CoP margin two ways, each named: the verdict's (touchdowns left out) is never below every sample's
+    judged = by_name["CoP inside the loaded soles"]["figure"]
+    assert judged == pytest.approx(summary["min_cop_margin_judged"], abs=1e-12)
+    assert summary["min_cop_margin_judged"] >= summary["min_cop_margin"]
+
+
+def test_a_negative_sole_force_says_the_sole_was_off_the_floor(tmp_path: Path,
+                                                               capsys: pytest.CaptureFixture[str]) -> None:
+    """The fast walk ends rocking on one sole: the other's ankle sensor carries the hanging foot (HUBO's 2 kg),
+    a pull that reads as a negative ground force, and the verdict says so beside the figure."""
+    steps = tmp_path / "fast.toml"
+    steps.write_text(FAST, encoding="utf-8")
+    assert main(["simulate", str(steps), "--json"]) == EXIT_FAILED
+    by_name = {c["name"]: c for c in json.loads(capsys.readouterr().out)["verdict"]["criteria"]}
+    loaded = by_name["both soles loaded at the end"]
+    assert loaded["figure"] == pytest.approx(-2.0 * 9.81, rel=0.2)  # about the foot's weight, hanging [N]
+    assert loaded["passed"] is False and "off the floor" in loaded["note"] and "pull" in loaded["text"]
+
+
+def _row(joint: str, peak: float, limit: float) -> ActuatorRow:
+    return ActuatorRow(joint, peak, peak, peak / 2, 1.0, 10.0, 1.0, limit, math.nan)
+
+
+@pytest.mark.parametrize(("peak", "state", "figure"), [
+    (15.0, "PASS", 0.5),
+    (28.5, "WARN", 0.95),  # from ACTUATOR_WARNING: passes, amber
+    (30.0, "FAIL", 1.0),  # a simulated actuator clamped at its limit: saturated
+])
+def test_the_joint_limit_criterion_with_its_warning_band(peak: float, state: str, figure: float) -> None:
+    rows = [_row("left_hip_roll", peak, 30.0), _row("left_knee", 10.0, 60.0), _row("left_hip_yaw", 50.0, math.inf)]
+    criterion = actuator_criterion(rows, [])
+    assert criterion.figure == pytest.approx(figure, abs=1e-12) and criterion.limit == ACTUATOR_LIMIT
+    assert criterion.state == state
+    assert criterion.passed is (state != "FAIL") and criterion.warning is (state == "WARN")
+    if state != "PASS":
+        assert f"left_hip_roll held {peak:.3g} of 30 N m" in criterion.text()
+    verdict = Verdict((criterion,))
+    assert verdict.clean is (state == "PASS")  # only then green
+    assert ("passes every criterion" in verdict.outcome()) is (state == "PASS")
+
+
+def test_the_joint_limit_criterion_is_not_measured_without_limits_and_judges_a_motor_file() -> None:
+    unlimited = [_row("left_knee", 100.0, math.inf)]
+    criterion = actuator_criterion(unlimited, [])
+    assert math.isnan(criterion.figure) and criterion.passed and criterion.state == "SKIP"
+    verdict = Verdict((criterion,))
+    assert verdict.passed and not verdict.complete and not verdict.clean
+    assert "not measured: the joints stay within their actuators' limits" in verdict.outcome()
+    over = actuator_criterion(unlimited, [MotorFit("left_knee", "small", rms_use=0.5, peak_use=1.2)])
+    assert over.figure == pytest.approx(1.2, abs=1e-12) and over.state == "FAIL"
+    assert "torque-speed envelope of its motor 'small'" in over.text()
+
+
+def test_warnings_keep_a_passing_walk_off_green() -> None:
+    plain = Criterion("feet where planned", 0.001, 0.02, "m", True, "distance", "at most")
+    assert Verdict((plain,)).clean and Verdict((plain,)).outcome() == "passes every criterion"
+    warned = Verdict((plain,), ("the plan itself needs more than the actuators give: left_knee 70 of 60 N m",))
+    assert warned.passed and warned.state == "WARN" and not warned.clean
+    assert "passes every criterion" not in warned.outcome() and "1 warning below" in warned.outcome()
+
+
+T1 = Path(__file__).resolve().parents[2] / "shared" / "robots" / "booster_t1" / "scene.xml"
+
+
+@pytest.mark.skipif(not T1.is_file(), reason="../shared/robots is absent")
+def test_booster_t1_on_hubos_scaled_tables_is_not_a_pass(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """10 steps of 0.1 m at 0.9 s (docs/robot-import.md): it walks, but its plan's ZMP is 8.6 mm outside the
+    soles and the right ankle roll is held at its 15 N m limit. The console, the page and the JSON say so, with
+    the console's warning that the plan needs more than the actuators give."""
+    steps = tmp_path / "t1.toml"
+    steps.write_text("[[steps]]\nduration = 0.9\nforward = 0.1\nrepeat = 10\n", encoding="utf-8")
+    out = tmp_path / "r"
+    assert main(["report", str(steps), "--robot", str(T1), "--no-animation", "--out", str(out)]) == EXIT_FAILED
+    printed = capsys.readouterr().out
+    assert "plan's min ZMP margin -8.6 mm (OUTSIDE the support polygon)" in printed
+    warning = "the plan itself needs more than the actuators give"
+    assert f"warning: {warning}" in printed
+    summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    by_name = {c["name"]: c for c in summary["verdict"]["criteria"]}
+    plan = by_name["the plan keeps its ZMP inside the soles"]
+    assert plan["figure"] == pytest.approx(-0.0086, abs=0.1e-3) and plan["state"] == "FAIL"
+    joints = by_name["the joints stay within their actuators' limits"]
+    assert joints["figure"] == pytest.approx(1.0, abs=1e-6) and joints["state"] == "FAIL"
+    assert "right_ankle_roll held 15 of 15 N m (100 %, saturated)" in joints["note"]
+    assert any(w.startswith(warning) for w in summary["warnings"])
+    page = (out / "index.html").read_text(encoding="utf-8")
+    assert "passes every criterion" not in page and "class='good'>passes" not in page
+    assert f"<li class='warn'>warning: {warning}" in page
+    assert page.count("<td class='bad'>FAIL</td>") == 2

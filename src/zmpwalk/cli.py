@@ -32,7 +32,7 @@ from zmpwalk.robots.model import RobotModel
 from zmpwalk.scenarios import list_scenarios, load_scenario_with_labels, load_steps_file_with_labels
 from zmpwalk.schedule import Schedule
 from zmpwalk.sim.motors import Motor
-from zmpwalk.sim.verdict import HOLD, SETTLE
+from zmpwalk.sim.verdict import HOLD, SETTLE, Verdict
 from zmpwalk.tables import condition_margins, margins_markdown
 
 if TYPE_CHECKING:
@@ -170,7 +170,8 @@ def _parser() -> argparse.ArgumentParser:
     plan.add_argument("--generator", choices=GENERATORS, default="polynomial",
                       help="polynomial (HUBO, Park et al. 2008; default), hyperbolic (LIPM, Lim et al., stage by "
                            "stage) or preview (preview control, Kajita et al. 2003: the baseline)")
-    plan.add_argument("--out", type=Path, help="CSV file to write")
+    plan.add_argument("--out", type=Path, help="CSV file to write (without it nothing is written: the summary "
+                      "says so)")
     plan.add_argument("--joints", action="store_true", help="append the 12 leg joint angles [rad] to the CSV")
     plan.add_argument("--json", action="store_true", help="print a JSON summary")
 
@@ -217,9 +218,10 @@ def _parser() -> argparse.ArgumentParser:
 
     for name, help_text, example in (
         ("demo", "the first thing to run: walk HUBO, check the ZMP, simulate, and write a report",
-         "example: zmpwalk demo   |   zmpwalk demo --robot mju-biped --scenario fig30 --out my-report"),
+         "example: zmpwalk demo   |   zmpwalk demo --robot mju-biped --scenario fig30 --out my-report   |   "
+         "zmpwalk demo my_steps.toml"),
         ("report", "generate, check, simulate and report any walk as a self-contained HTML page",
-         "example: zmpwalk report --scenario fig28 --out fig28-report"),
+         "example: zmpwalk report --scenario fig28 --out fig28-report   |   zmpwalk report my_steps.toml"),
     ):
         report_cmd = commands.add_parser(
             name, help=help_text,
@@ -228,9 +230,12 @@ def _parser() -> argparse.ArgumentParser:
             "an animation of the simulated walk; self-contained, opens offline), figures, CSV and JSON files.",
             epilog=example,
         )
-        report_cmd.add_argument("--scenario", default="demo" if name == "demo" else None,
-                                help="built-in scenario" + (" (default: demo)" if name == "demo" else ""))
-        report_cmd.add_argument("--steps", type=Path, help="steps file (TOML) instead of a scenario")
+        report_cmd.add_argument("steps", nargs="?", type=Path, help="steps file (TOML), as plan and simulate take it")
+        report_cmd.add_argument("--scenario", default=None,
+                                help="built-in scenario" + (" (default: demo, without a steps file)" if name == "demo"
+                                                            else ""))
+        report_cmd.add_argument("--steps", type=Path, dest="steps_option", metavar="STEPS",
+                                help="the steps file given as an option (the same as the positional STEPS)")
         _robot_options(report_cmd)
         report_cmd.add_argument("--schedule", type=Path, help="your own parameter tables (TOML)")
         report_cmd.add_argument("--pelvis", choices=("cubic", "quintic"), default="cubic",
@@ -340,14 +345,19 @@ def _progress(stage: str, done: int, total: int) -> None:
 def _report(args: argparse.Namespace) -> int:
     from zmpwalk.report import build_report
 
-    if args.steps and args.scenario and args.command == "report":
-        raise _UsageError("give either --steps or --scenario, not both")
+    if args.steps and args.steps_option:
+        raise _UsageError("give the steps file once: STEPS or --steps STEPS")
+    args.steps = args.steps or args.steps_option
+    if args.steps and args.scenario:
+        raise _UsageError("give either a steps file or --scenario, not both")
+    if args.command == "demo" and not args.steps and not args.scenario:
+        args.scenario = "demo"
     if args.steps:
         (commands, labels), name = load_steps_file_with_labels(args.steps), args.steps.name
     elif args.scenario:
         (commands, labels), name = load_scenario_with_labels(args.scenario), args.scenario
     else:
-        raise _UsageError("give --scenario NAME or --steps FILE (see 'zmpwalk scenarios')")
+        raise _UsageError("give --scenario NAME or a steps file (see 'zmpwalk scenarios')")
     robot = _load_robot(args)
     quiet = args.json or not sys.stderr.isatty()
     with _source(str(args.steps) if args.steps else f"scenario {args.scenario}"):
@@ -363,10 +373,9 @@ def _report(args: argparse.Namespace) -> int:
     else:
         s = report.summary
         state = f"FELL at t = {s['fall_time']:.2f} s" if s["fell"] else "no fall"
-        print(f"{robot.name}, {name}: {'PASS' if verdict.passed else 'FAIL'} ({state}); min ZMP margin "
-              f"{float(s['min_zmp_margin']) * 1e3:+.1f} mm -> {report.index}")
-        for line in verdict.lines():
-            print(f"  {line}")
+        print(f"{robot.name}, {name}: {verdict.state} ({state}); plan's min ZMP margin "
+              f"{_margin_words(float(s['min_zmp_margin']))} -> {report.index}")
+        _print_verdict(verdict)
     return 0 if verdict.passed else EXIT_FAILED
 
 
@@ -376,7 +385,7 @@ def _simulate(args: argparse.Namespace) -> int:
     from zmpwalk.sim.actuators import planned_over_limit
     from zmpwalk.sim.motors import motor_fits
     from zmpwalk.sim.run import write_result_csv
-    from zmpwalk.sim.verdict import walk_verdict
+    from zmpwalk.sim.verdict import cop_margin_outside_touchdowns, walk_verdict
 
     robot = _load_robot(args)
     show = None if args.json or not sys.stderr.isatty() else _progress
@@ -423,17 +432,19 @@ def _simulate(args: argparse.Namespace) -> int:
                       latency=args.latency, settle=SETTLE, hold=HOLD, disturbances=disturbances,
                       capture=CaptureSettings() if args.capture else None,
                       progress=None if show is None else lambda done: show("simulation", round(100 * done), 100))
-    verdict = walk_verdict(result, HOLD)
+    motors = _motors(args)
+    verdict = walk_verdict(result, HOLD, motors)
     if show:
         show(stages[3], 4, len(stages))
     rows = actuator_table(result)
-    motors = _motors(args)
     fits = motor_fits(result, motors) if motors else []
     rms, largest = result.cop_error_stats()
     summary = {
         "robot": robot.name, "fell": result.fell, "fall_time": result.fall_time, "duration": float(result.time[-1]),
         "distance": result.distance, "average_speed": result.average_speed, "foot_slip": result.foot_slip,
         "cop_error_rms": rms, "cop_error_max": largest, "min_cop_margin": float(np.nanmin(result.cop_margin)),
+        "min_cop_margin_judged": cop_margin_outside_touchdowns(result),
+        "plan_min_zmp_margin": result.plan_zmp_margin,
         "mass_scale": result.mass_scale, "balance": stabilizer is not None,
         "final_feet_error": result.final_feet_error, "final_feet_yaw_error": result.final_feet_yaw_error,
         "end_min_sole_force": result.end_min_sole_force, "end_max_speed": result.end_max_speed,
@@ -447,6 +458,7 @@ def _simulate(args: argparse.Namespace) -> int:
                     "fits": f.fits} for f in fits],
         "actuators": [vars(row) for row in rows],
         "planned_over_limit": [row.joint for row in planned_over_limit(rows)],
+        "warnings": list(verdict.warnings),
     }
     if args.out:
         args.out.mkdir(parents=True, exist_ok=True)
@@ -467,23 +479,44 @@ def _simulate(args: argparse.Namespace) -> int:
             print(f"capture steps planned: {len(result.captures)}, the first at t = {result.captures[0].time:.3f} s; "
                   f"the walk ended on the last: {last.swing} foot to ({last.landing[0]:.3f}, {last.landing[1]:.3f}) "
                   f"m at t = {last.time + last.swing_time:.3f} s, then standing (the commanded steps after it dropped)")
+        print(f"plan: min ZMP margin {_margin_words(result.plan_zmp_margin)}")
         print(f"CoP - reference ZMP: RMS {rms * 1e3:.1f} mm, max {largest * 1e3:.1f} mm; "
-              f"min CoP margin {summary['min_cop_margin'] * 1e3:+.1f} mm")  # type: ignore[operator]
+              + _cop_margin_words(summary["min_cop_margin_judged"], summary["min_cop_margin"]))  # type: ignore[arg-type]
         top = max(rows, key=lambda r: r.peak_torque)
         power = max(rows, key=lambda r: r.peak_power)
         print(f"largest torque {top.peak_torque:.3g} N m at {top.joint}; largest power {power.peak_power:.3g} W "
               f"at {power.joint}")
-        over = planned_over_limit(rows)
-        if over:
-            print("the plan itself needs more than the actuators give (ideal robot, inverse dynamics): "
-                  + ", ".join(f"{r.joint} {r.planned_torque:.3g} of {r.torque_limit:.3g} N m" for r in over))
         for fit in fits:
-            print(f"motor {fit.motor!r} at {fit.joint}: RMS {fit.rms_use * 100:.0f} % of rated, held peak "
-                  f"{fit.peak_use * 100:.0f} % of the envelope: {fit.verdict}")
-        print(f"verdict: {'PASS' if verdict.passed else 'FAIL'}")
-        for line in verdict.lines():
-            print(f"  {line}")
+            if fit.fits:  # a motor that does not fit is a warning, printed with the verdict
+                print(f"motor {fit.motor!r} at {fit.joint}: RMS {fit.rms_use * 100:.0f} % of rated, held peak "
+                      f"{fit.peak_use * 100:.0f} % of the envelope: {fit.verdict}")
+        _print_verdict(verdict)
     return 0 if verdict.passed else EXIT_FAILED
+
+
+def _margin_words(margin: float, at: float | None = None) -> str:
+    """A ZMP margin as ``plan`` prints it: signed (positive inside), and whether it leaves the polygon."""
+    if not math.isfinite(margin):
+        return "not measured"
+    where = "inside the support polygon" if margin >= 0 else "OUTSIDE the support polygon"
+    return f"{margin * 1e3:+.1f} mm" + ("" if at is None else f" at t = {at:.3f} s") + f" ({where})"
+
+
+def _cop_margin_words(judged: float, every: float) -> str:
+    """The CoP margin two ways, each saying which samples it covers (the verdict judges the first)."""
+    from zmpwalk.sim.verdict import TOUCHDOWN_WINDOW
+
+    return (f"least CoP margin (positive inside) {judged * 1e3:+.1f} mm outside the {TOUCHDOWN_WINDOW * 1e3:g} ms "
+            f"after each touchdown (the verdict's), {every * 1e3:+.1f} mm over every sample")
+
+
+def _print_verdict(verdict: Verdict) -> None:
+    """The warnings, the outcome and every criterion: what the page shows too."""
+    for warning in verdict.warnings:
+        print(f"warning: {warning}")
+    print(f"verdict: {verdict.state}: the walk {verdict.outcome()}")
+    for line in verdict.lines():
+        print(f"  {line}")
 
 
 def _robot_by_name(args: argparse.Namespace) -> None:
@@ -646,16 +679,15 @@ def _run(args: argparse.Namespace) -> int:
             else:
                 for _ in stream:
                     pass
-        result = summary.result()
+        result = {**summary.result(), "out": str(args.out) if args.out else None}
         if args.json:
             print(json.dumps(result, indent=2))
         else:
             margin = float(result["min_zmp_margin"])  # type: ignore[arg-type]
-            verdict = "inside the support polygon" if margin >= 0 else "OUTSIDE the support polygon"
             print(f"{result['swings']} swings, {result['duration']:.3f} s, {result['samples']} samples at "
-                  f"{args.rate:g} Hz" + (f" -> {args.out}" if args.out else ""))
-            print(f"min ZMP margin: {margin * 1e3:+.1f} mm at t = {result['min_zmp_margin_time']:.3f} s "
-                  f"({verdict})")
+                  f"{args.rate:g} Hz" + (f" -> {args.out}" if args.out else
+                                         "; no CSV written (give --out FILE to write it)"))
+            print(f"min ZMP margin: {_margin_words(margin, float(result['min_zmp_margin_time']))}")  # type: ignore[arg-type]
         outside = float(result["min_zmp_margin"]) < 0  # type: ignore[arg-type]
         return EXIT_FAILED if outside and not args.allow_outside else 0
     if args.command in ("demo", "report"):

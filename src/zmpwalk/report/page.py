@@ -35,7 +35,7 @@ from zmpwalk.sim.actuators import (
 )
 from zmpwalk.sim.motors import Motor, MotorFit, motor_fits
 from zmpwalk.sim.run import simulate, write_result_csv
-from zmpwalk.sim.verdict import HOLD, SETTLE, Verdict, walk_verdict
+from zmpwalk.sim.verdict import FAIL, HOLD, PASS, SETTLE, SKIP, WARN, Verdict, walk_verdict
 
 Progress = Callable[[str, int, int], None]
 STAGES = ("pattern", "joints", "simulation", "plots", "animation", "page")
@@ -125,7 +125,7 @@ def build_report(
 
     result = simulate(robot, joints, pattern, stabilizer=stabilizer, latency=latency, settle=SETTLE, hold=HOLD,
                       progress=simulating)
-    report.verdict = walk_verdict(result, HOLD)
+    report.verdict = walk_verdict(result, HOLD, motors)
     rows = actuator_table(result)
     write_actuator_csv(rows, folder / "actuators.csv")
     write_result_csv(result, folder / "simulation.csv")
@@ -169,7 +169,7 @@ def build_report(
         "min_zmp_margin": margin, "min_zmp_margin_time": at, "fell": result.fell, "fall_time": result.fall_time,
         "distance": result.distance, "average_speed": result.average_speed, "foot_slip": result.foot_slip,
         "cop_error_rms": rms, "cop_error_max": largest, "balance": result.balance is not None,
-        "verdict": report.verdict.as_dict(),
+        "verdict": report.verdict.as_dict(), "warnings": list(report.verdict.warnings),
     }
     report.summary["motors"] = [{"joint": f.joint, "motor": f.motor, "rms_use": f.rms_use, "peak_use": f.peak_use,
                                  "fits": f.fits} for f in fits]
@@ -179,6 +179,33 @@ def build_report(
     write_text(folder / "summary.json", json.dumps(report.summary, indent=2))
     done("page")
     return report
+
+
+STATE_CLASS = {PASS: "good", WARN: "warn", FAIL: "bad", SKIP: "none"}
+STATE_WORD = {PASS: "pass", WARN: "warning", FAIL: "FAIL", SKIP: "not measured"}
+
+
+def _outcome_class(verdict: Verdict) -> str:
+    """Green only when every criterion passed with its figure and nothing is warned of."""
+    if verdict.state == FAIL:
+        return "bad"
+    if verdict.clean:
+        return "good"
+    return "warn" if verdict.state == WARN else "none"
+
+
+def actuator_html(rows: list[ActuatorRow]) -> str:
+    """The motor table's HTML rows, header first: the cells of :func:`actuator_markdown`, so the header and
+    every row have as many cells."""
+    esc = html.escape
+    lines = actuator_markdown(rows).splitlines()
+    header, body = lines[0], lines[2:]
+
+    def cells(line: str) -> list[str]:
+        return [esc(cell.strip()) for cell in line.strip().strip("|").split("|")]
+
+    return "\n".join(["<tr>" + "".join(f"<th>{cell}</th>" for cell in cells(header)) + "</tr>"]
+                     + ["<tr>" + "".join(f"<td>{cell}</td>" for cell in cells(line)) + "</tr>" for line in body])
 
 
 def _step_list(commands: Sequence[StepCommand], labels: Sequence[str] | None) -> str:
@@ -195,22 +222,18 @@ def _page(title: str, robot: RobotModel, summary: dict[str, Any], images: dict[s
           rows: list[ActuatorRow], verdict: Verdict, fits: list[MotorFit], steps: str) -> str:
     esc = html.escape
     fell = summary["fell"]
-    outcome = ("<b class='good'>passes every criterion</b>" if verdict.passed else
-               f"<b class='bad'>fails: {esc(', '.join(verdict.failed))}</b>"
+    outcome = (f"<b class='{_outcome_class(verdict)}'>{esc(verdict.outcome())}</b>"
                + (f" <b class='bad'>(fell at t = {summary['fall_time']:.2f} s)</b>" if fell else ""))
     criteria_rows = "\n".join(
-        f"<tr><td>{esc(line.split(' ', 1)[1].split(':')[0])}</td>"
-        f"<td class='{'good' if c.passed else 'bad'}'>{'pass' if c.passed else 'FAIL'}</td>"
-        f"<td>{esc(line.split(': ', 1)[1])}</td></tr>"
-        for c, line in zip(verdict.criteria, verdict.lines(), strict=True))
+        f"<tr><td>{esc(c.name)}</td><td class='{STATE_CLASS[c.state]}'>{STATE_WORD[c.state]}</td>"
+        f"<td>{esc(c.text())} ({esc(c.rule)})</td></tr>" for c in verdict.criteria)
+    warnings = ("<ul id='warnings'>" + "".join(f"<li class='warn'>warning: {esc(w)}</li>" for w in verdict.warnings)
+                + "</ul>" if verdict.warnings else "")
     margin_rows = "\n".join(
         f"<tr><td>{n}</td><td>{esc(kind)}</td><td>{esc(swing)}</td><td>{start:.2f}</td><td>{duration:.2f}</td>"
         f"<td class='{'good' if m >= 0 else 'bad'}'>{m * 1e3:+.1f}</td></tr>"
         for n, kind, swing, start, duration, m in margins)
-    table = actuator_markdown(rows).splitlines()
-    actuator_rows = "\n".join(
-        "<tr>" + "".join(f"<td>{esc(cell.strip())}</td>" for cell in line.strip("|").split("|")) + "</tr>"
-        for line in table[2:])
+    actuator_rows = actuator_html(rows)
     fit_rows = "\n".join(
         f"<tr><td>{esc(f.joint)}</td><td>{esc(f.motor)}</td><td>{f.rms_use * 100:.0f}</td>"
         f"<td>{f.peak_use * 100:.0f}</td><td class='{'good' if f.fits else 'bad'}'>{esc(f.verdict)}</td></tr>"
@@ -230,7 +253,7 @@ body {{ font-family: system-ui, sans-serif; max-width: 980px; margin: 2em auto; 
 table {{ border-collapse: collapse; margin: 1em 0; font-size: 0.9em; }}
 td, th {{ border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: right; }}
 th {{ background: #f3f3f3; }} td:first-child {{ text-align: left; }}
-.good {{ color: #1a7f37; }} .bad {{ color: #c0392b; }}
+.good {{ color: #1a7f37; }} .bad {{ color: #c0392b; }} .warn {{ color: #b36b00; }} .none {{ color: #666; }}
 figure {{ margin: 1.5em 0; }} img {{ max-width: 100%; }} figcaption {{ color: #555; font-size: 0.9em; }}
 </style></head>
 <body data-images-loaded="no">
@@ -242,12 +265,14 @@ figure {{ margin: 1.5em 0; }} img {{ max-width: 100%; }} figcaption {{ color: #5
 <table id="criteria"><tr><th>criterion</th><th>result</th><th>figure (limit; how it is judged)</th></tr>
 {criteria_rows}
 </table>
+{warnings}
 <p>Distance {summary['distance']:.3f} m, average speed
 {float(summary['average_speed']) * 1e3:.1f} mm/s, largest foot slip {float(summary['foot_slip']) * 1e3:.1f} mm;
 centre of pressure against the reference ZMP: RMS {float(summary['cop_error_rms']) * 1e3:.1f} mm,
 max {float(summary['cop_error_max']) * 1e3:.1f} mm.
 The pattern's cart-table ZMP stays {float(summary['min_zmp_margin']) * 1e3:+.1f} mm from the edge of the
-support polygon at its closest (t = {float(summary['min_zmp_margin_time']):.2f} s; negative is outside).</p>
+support polygon at its closest (t = {float(summary['min_zmp_margin_time']):.2f} s; positive inside, negative
+outside: {'inside' if float(summary['min_zmp_margin']) >= 0 else 'OUTSIDE'}).</p>
 {movie}
 <p>The simulated time series (every millisecond, SI units): <a id="series" href="simulation.csv">simulation.csv</a>;
 the pattern: <a href="pattern.csv">pattern.csv</a>; the motor table: <a href="actuators.csv">actuators.csv</a>.</p>
@@ -259,9 +284,7 @@ the pattern: <a href="pattern.csv">pattern.csv</a>; the motor table: <a href="ac
 <h2>Which motors?</h2>
 <p>Peaks are those held for at least {IMPACT_WINDOW * 1e3:g} ms (what sizes a motor); the largest single-sample
 torque, at touchdown impacts, has its own column.</p>
-<table><tr><th>joint</th><th>peak torque [N m]</th><th>impact peak [N m]</th><th>RMS torque [N m]</th>
-<th>peak velocity [rad/s]</th><th>peak power [W]</th><th>mean power [W]</th>
-<th>model's limit [N m] (held peak's share)</th></tr>
+<table id="actuators">
 {actuator_rows}
 </table>
 {fit_table}

@@ -17,6 +17,7 @@ from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import JOINT_NAMES
 from zmpwalk.sim.motors import Motor, motor_for
 from zmpwalk.sim.run import LOADED_FRACTION, SimulationResult
+from zmpwalk.sim.verdict import COP_MARGIN, TOUCHDOWN_WINDOW
 
 DPI = 100
 
@@ -139,9 +140,12 @@ def pelvis(pattern: WalkingPattern, result: SimulationResult) -> bytes:
     axes[2].plot(pattern.time, pattern.yaw_pelvis_in_world, color="0.3", lw=1.2, label="planned")
     axes[2].plot(result.time, result.torso_rpy[:, 2], color="C3", lw=0.9, label="simulated")
     axes[2].set_ylabel("pelvis yaw [rad]")
-    axes[3].plot(result.time, result.cop_margin * 1e3, color="C0", lw=0.8)
+    axes[3].plot(result.time, result.cop_margin * 1e3, color="C0", lw=0.8, label="every sample")
     axes[3].axhline(0.0, color="k", lw=0.6)
-    axes[3].set_ylabel("CoP margin [mm]")
+    axes[3].axhline(COP_MARGIN * 1e3, color="C3", lw=0.8, ls="--",
+                    label=f"the verdict's limit (touchdowns' {TOUCHDOWN_WINDOW * 1e3:g} ms not judged)")
+    axes[3].set_ylabel("CoP margin [mm]\n(> 0 inside)")
+    axes[3].legend(loc="lower right", fontsize=7)
     axes[3].set_xlabel("t [s]")
     axes[0].legend(loc="upper left", fontsize=8)
     axes[0].set_title("Pelvis against time; CoP distance inside the loaded soles")

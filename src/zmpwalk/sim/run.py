@@ -107,6 +107,9 @@ class SimulationResult:
         end_attitude_range: Largest spread of torso roll or pitch over the final hold [rad].
         captures: The capture steps taken (``simulate``'s ``capture``), in order; empty when the pattern was
             played to its end.
+        plan_zmp_margin: The simulated pattern's least cart-table ZMP margin to its support polygon [m] (> 0
+            inside; :meth:`WalkingPattern.min_zmp_margin`).
+        planned_end: When the run was to end, the final hold included [s] (``time[-1]`` unless it fell).
     """
 
     robot: RobotModel
@@ -140,6 +143,8 @@ class SimulationResult:
     end_max_speed: float = math.nan  # [m/s]
     end_attitude_range: float = math.nan  # [rad]
     captures: list[CapturePlan] = field(default_factory=list)
+    plan_zmp_margin: float = math.nan  # [m]
+    planned_end: float = math.nan  # [s]
 
     @property
     def cop_error(self) -> Array:
@@ -391,6 +396,7 @@ def simulate(
     fallen = (touch > 0) | (tilt > FALL_TILT) | (pelvis[:, 2] < FALL_HEIGHT_FRACTION * robot.pelvis_height)
     fall_index = int(np.argmax(fallen)) if fallen.any() else None
     end = n if fall_index is None else min(n, fall_index + int(AFTER_FALL * CONTROL_RATE) + 1)
+    planned_end = float(time[-1])
     readings, time, zmp_ref = readings[:end], time[:end], zmp_ref[:end]
     pelvis, rpy = pelvis[:end], rpy[:end]
     names_q = [f"{c}_q" for c in JOINT_COLUMNS]
@@ -457,7 +463,8 @@ def simulate(
         balance=None if balance_log is None else {k: v[:end] for k, v in balance_log.items()},
         ankle_positions=np.stack([sensors.take(readings, f"{label}_ankle_pos") for label in ("left", "right")], axis=1),
         planned_torques=None if planned_torques is None else planned_torques[:end],
-        captures=[plan for plan, _ in captures],
+        captures=[plan for plan, _ in captures], plan_zmp_margin=pattern.min_zmp_margin()[0],
+        planned_end=planned_end,
     )
 
 
