@@ -36,7 +36,10 @@ from zmpwalk.sim.verdict import HOLD, SETTLE, Verdict
 from zmpwalk.tables import condition_margins, margins_markdown
 
 if TYPE_CHECKING:
-    pass
+    from zmpwalk.patterns.correction import ZmpCorrection
+    from zmpwalk.sim.actuators import ActuatorRow
+    from zmpwalk.sim.motors import MotorFit
+    from zmpwalk.sim.run import SimulationResult
 
 EXIT_ERROR = 2
 EXIT_FAILED = 3  # the walk failed its verdict, or the plan's ZMP left the polygon
@@ -136,15 +139,8 @@ def _balance(args: argparse.Namespace, robot: RobotModel) -> bool:
     return bool(args.balance == "on")
 
 
-def _parser() -> argparse.ArgumentParser:
-    parser = _Parser(
-        prog="zmpwalk",
-        description="Online ZMP walking patterns for biped humanoids (HUBO polynomial pattern).",
-        epilog="example: zmpwalk plan --scenario fig28 --rate 1000 --out fig28.csv",
-    )
-    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
-    commands = parser.add_subparsers(dest="command", parser_class=_Parser)
-
+def _plan_parsers(commands: argparse._SubParsersAction[_Parser]) -> None:
+    """The scenarios, plan and hyperbolic commands."""
     scenarios = commands.add_parser(
         "scenarios", help="list the built-in scenarios",
         description="List the built-in scenarios (the paper's experiments).", epilog="example: zmpwalk scenarios",
@@ -186,6 +182,9 @@ def _parser() -> argparse.ArgumentParser:
                             "v_xD = 100 mm/s, t* = 0.2 s, tau* = 0.3 s, g = 9.8 m/s^2")
     hyperbolic.add_argument("--json", action="store_true", help="print a JSON object")
 
+
+def _simulate_parser(commands: argparse._SubParsersAction[_Parser]) -> None:
+    """The simulate command."""
     simulate_cmd = commands.add_parser(
         "simulate", help="walk a pattern in MuJoCo: falls, CoP, joint torques and powers",
         description="Generate the pattern of a steps file, a scenario or the paper example of Lim et al., "
@@ -216,6 +215,9 @@ def _parser() -> argparse.ArgumentParser:
     simulate_cmd.add_argument("--out", type=Path, help="folder for the result files")
     simulate_cmd.add_argument("--json", action="store_true", help="print a JSON summary")
 
+
+def _report_parsers(commands: argparse._SubParsersAction[_Parser]) -> None:
+    """The demo and report commands."""
     for name, help_text, example in (
         ("demo", "the first thing to run: walk HUBO, check the ZMP, simulate, and write a report",
          "example: zmpwalk demo   |   zmpwalk demo --robot mju-biped --scenario fig30 --out my-report   |   "
@@ -248,6 +250,9 @@ def _parser() -> argparse.ArgumentParser:
         report_cmd.add_argument("--no-animation", action="store_true", help="skip the rendered animation")
         report_cmd.add_argument("--json", action="store_true", help="print a JSON summary")
 
+
+def _batch_parsers(commands: argparse._SubParsersAction[_Parser]) -> None:
+    """The tables, sweep and tune commands."""
     tables = commands.add_parser(
         "tables", help="walk every condition of Tables 2-3 and print the ZMP margins",
         description="Walk each tuned condition of the parameter tables (Tables 2 and 3) for a number of "
@@ -293,6 +298,10 @@ def _parser() -> argparse.ArgumentParser:
     tune_cmd.add_argument("--timing", action="store_true",
                           help="also tune V_y and the double-support time of Table 2's rows (added as columns)")
     tune_cmd.add_argument("--json", action="store_true", help="print JSON")
+
+
+def _robot_parser(commands: argparse._SubParsersAction[_Parser]) -> None:
+    """The robot command."""
     robot_cmd = commands.add_parser(
         "robot", help="import a robot from its MJCF or URDF and show what zmpwalk derived",
         description="Load a robot (its own MJCF or URDF model, a robot file or a built-in name), print what "
@@ -307,6 +316,22 @@ def _parser() -> argparse.ArgumentParser:
                            help="folder holding a URDF's package:// packages (repeatable)")
     robot_cmd.add_argument("--write", type=Path, help="write a robot file (TOML) that loads this model")
     robot_cmd.add_argument("--json", action="store_true", help="print JSON")
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="zmpwalk",
+        description="Online ZMP walking patterns for biped humanoids (HUBO polynomial pattern).",
+        epilog="example: zmpwalk plan --scenario fig28 --rate 1000 --out fig28.csv",
+    )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    commands = parser.add_subparsers(dest="command", parser_class=_Parser)
+
+    _plan_parsers(commands)
+    _simulate_parser(commands)
+    _report_parsers(commands)
+    _batch_parsers(commands)
+    _robot_parser(commands)
     return parser
 
 
@@ -379,19 +404,10 @@ def _report(args: argparse.Namespace) -> int:
     return 0 if verdict.passed else EXIT_FAILED
 
 
-def _simulate(args: argparse.Namespace) -> int:
+def _simulated_pattern(args: argparse.Namespace, robot: RobotModel) -> tuple[WalkingPattern, ZmpCorrection | None]:
+    """The pattern ``simulate`` walks (the paper example, a steps file or a scenario) and its ZMP correction."""
     from zmpwalk.patterns.hyperbolic import paper_walk
-    from zmpwalk.sim import actuator_markdown, actuator_table, simulate, write_actuator_csv
-    from zmpwalk.sim.actuators import planned_over_limit
-    from zmpwalk.sim.motors import motor_fits
-    from zmpwalk.sim.run import write_result_csv
-    from zmpwalk.sim.verdict import cop_margin_outside_touchdowns, walk_verdict
 
-    robot = _load_robot(args)
-    show = None if args.json or not sys.stderr.isatty() else _progress
-    stages = ("pattern", "joints", "simulation", "measures")
-    if show:
-        show(stages[0], 0, len(stages))
     if args.paper_example:
         if args.steps or args.scenario:
             raise _UsageError("--paper-example takes no steps file or scenario")
@@ -404,27 +420,38 @@ def _simulate(args: argparse.Namespace) -> int:
         options = _pattern_options(args)
         with _source(_label(args)):
             pattern = make(robot, commands, rate=1000.0, labels=labels, **options)
-    correction = None
-    if args.zmp_correction:
-        from zmpwalk.patterns.correction import correct_pattern
+    if not args.zmp_correction:
+        return pattern, None
+    from zmpwalk.patterns.correction import correct_pattern
 
-        correction = correct_pattern(pattern)
-        pattern = correction.pattern
+    correction = correct_pattern(pattern)
+    return correction.pattern, correction
+
+
+def _simulate(args: argparse.Namespace) -> int:
+    from zmpwalk.balance import Stabilizer
+    from zmpwalk.capture import CaptureSettings
+    from zmpwalk.sim import actuator_markdown, actuator_table, simulate, write_actuator_csv
+    from zmpwalk.sim.motors import motor_fits
+    from zmpwalk.sim.run import Disturbances, write_result_csv
+    from zmpwalk.sim.verdict import walk_verdict
+
+    robot = _load_robot(args)
+    show = None if args.json or not sys.stderr.isatty() else _progress
+    stages = ("pattern", "joints", "simulation", "measures")
+    if show:
+        show(stages[0], 0, len(stages))
+    pattern, correction = _simulated_pattern(args, robot)
     if show:
         show(stages[1], 1, len(stages))
     joints = pattern_joint_trajectory(pattern, check_limits=False)
     if show:
         show(stages[2], 2, len(stages))
-    from zmpwalk.balance import Stabilizer
-
     stabilizer = Stabilizer(robot, 1000.0, com_reference=pattern.com_point) if _balance(args, robot) else None
     if args.capture and stabilizer is None:
         raise _UsageError("--capture needs the stabilizer (--balance on): its DCM estimate triggers the capture step")
     if args.capture and correction is not None:
         raise _UsageError("--capture plans the pattern's CoM point; it does not combine with --zmp-correction")
-    from zmpwalk.capture import CaptureSettings
-    from zmpwalk.sim.run import Disturbances
-
     disturbances = None
     if args.push is not None:
         disturbances = Disturbances(push_time=args.push[0], push_impulse=(args.push[1], args.push[2], 0.0))
@@ -438,14 +465,34 @@ def _simulate(args: argparse.Namespace) -> int:
         show(stages[3], 4, len(stages))
     rows = actuator_table(result)
     fits = motor_fits(result, motors) if motors else []
+    summary = {**_simulation_summary(result, verdict, rows, fits, correction), "balance": stabilizer is not None}
+    if args.out:
+        args.out.mkdir(parents=True, exist_ok=True)
+        write_actuator_csv(rows, args.out / "actuators.csv")
+        write_text(args.out / "actuators.md", actuator_markdown(rows) + "\n")
+        write_result_csv(result, args.out / "simulation.csv")
+    if args.json:
+        print(json.dumps(_json_safe(summary), indent=2, allow_nan=False))
+    else:
+        _print_simulation(result, verdict, rows, fits, correction)
+    return 0 if verdict.passed else EXIT_FAILED
+
+
+def _simulation_summary(result: SimulationResult, verdict: Verdict, rows: list[ActuatorRow], fits: list[MotorFit],
+                        correction: ZmpCorrection | None) -> dict[str, object]:
+    """What ``simulate --json`` prints (SI)."""
+    from zmpwalk.sim.actuators import planned_over_limit
+    from zmpwalk.sim.verdict import cop_margin_outside_touchdowns
+
     rms, largest = result.cop_error_stats()
-    summary = {
-        "robot": robot.name, "fell": result.fell, "fall_time": result.fall_time, "duration": float(result.time[-1]),
-        "distance": result.distance, "average_speed": result.average_speed, "foot_slip": result.foot_slip,
-        "cop_error_rms": rms, "cop_error_max": largest, "min_cop_margin": float(np.nanmin(result.cop_margin)),
+    return {
+        "robot": result.robot.name, "fell": result.fell, "fall_time": result.fall_time,
+        "duration": float(result.time[-1]), "distance": result.distance, "average_speed": result.average_speed,
+        "foot_slip": result.foot_slip, "cop_error_rms": rms, "cop_error_max": largest,
+        "min_cop_margin": float(np.nanmin(result.cop_margin)),
         "min_cop_margin_judged": cop_margin_outside_touchdowns(result),
         "plan_min_zmp_margin": result.plan_zmp_margin,
-        "mass_scale": result.mass_scale, "balance": stabilizer is not None,
+        "mass_scale": result.mass_scale,
         "final_feet_error": result.final_feet_error, "final_feet_yaw_error": result.final_feet_yaw_error,
         "end_min_sole_force": result.end_min_sole_force, "end_max_speed": result.end_max_speed,
         "end_attitude_range": result.end_attitude_range, "verdict": verdict.as_dict(),
@@ -460,38 +507,37 @@ def _simulate(args: argparse.Namespace) -> int:
         "planned_over_limit": [row.joint for row in planned_over_limit(rows)],
         "warnings": list(verdict.warnings),
     }
-    if args.out:
-        args.out.mkdir(parents=True, exist_ok=True)
-        write_actuator_csv(rows, args.out / "actuators.csv")
-        write_text(args.out / "actuators.md", actuator_markdown(rows) + "\n")
-        write_result_csv(result, args.out / "simulation.csv")
-    if args.json:
-        print(json.dumps(_json_safe(summary), indent=2, allow_nan=False))
-    else:
-        state = f"FELL at t = {result.fall_time:.3f} s" if result.fell else "walked to the end without falling"
-        print(f"{robot.name}: {state}; distance {result.distance:.3f} m, average speed "
-              f"{result.average_speed * 1e3:.1f} mm/s, foot slip {result.foot_slip * 1e3:.1f} mm")
-        if correction is not None:
-            print(f"multibody ZMP - planned ZMP: RMS {correction.before.rms * 1e3:.1f} mm as generated, "
-                  f"{correction.after.rms * 1e3:.1f} mm corrected (passes kept: {correction.passes})")
-        if result.captures:
-            last = result.captures[-1]
-            print(f"capture steps planned: {len(result.captures)}, the first at t = {result.captures[0].time:.3f} s; "
-                  f"the walk ended on the last: {last.swing} foot to ({last.landing[0]:.3f}, {last.landing[1]:.3f}) "
-                  f"m at t = {last.time + last.swing_time:.3f} s, then standing (the commanded steps after it dropped)")
-        print(f"plan: min ZMP margin {_margin_words(result.plan_zmp_margin)}")
-        print(f"CoP - reference ZMP: RMS {rms * 1e3:.1f} mm, max {largest * 1e3:.1f} mm; "
-              + _cop_margin_words(summary["min_cop_margin_judged"], summary["min_cop_margin"]))  # type: ignore[arg-type]
-        top = max(rows, key=lambda r: r.peak_torque)
-        power = max(rows, key=lambda r: r.peak_power)
-        print(f"largest torque {top.peak_torque:.3g} N m at {top.joint}; largest power {power.peak_power:.3g} W "
-              f"at {power.joint}")
-        for fit in fits:
-            if fit.fits:  # a motor that does not fit is a warning, printed with the verdict
-                print(f"motor {fit.motor!r} at {fit.joint}: RMS {fit.rms_use * 100:.0f} % of rated, held peak "
-                      f"{fit.peak_use * 100:.0f} % of the envelope: {fit.verdict}")
-        _print_verdict(verdict)
-    return 0 if verdict.passed else EXIT_FAILED
+
+
+def _print_simulation(result: SimulationResult, verdict: Verdict, rows: list[ActuatorRow], fits: list[MotorFit],
+                      correction: ZmpCorrection | None) -> None:
+    """What ``simulate`` prints: the walk, the plan's ZMP margin, the CoP, the motors, the warnings, the verdict."""
+    from zmpwalk.sim.verdict import cop_margin_outside_touchdowns
+
+    state = f"FELL at t = {result.fall_time:.3f} s" if result.fell else "walked to the end without falling"
+    print(f"{result.robot.name}: {state}; distance {result.distance:.3f} m, average speed "
+          f"{result.average_speed * 1e3:.1f} mm/s, foot slip {result.foot_slip * 1e3:.1f} mm")
+    if correction is not None:
+        print(f"multibody ZMP - planned ZMP: RMS {correction.before.rms * 1e3:.1f} mm as generated, "
+              f"{correction.after.rms * 1e3:.1f} mm corrected (passes kept: {correction.passes})")
+    if result.captures:
+        last = result.captures[-1]
+        print(f"capture steps planned: {len(result.captures)}, the first at t = {result.captures[0].time:.3f} s; "
+              f"the walk ended on the last: {last.swing} foot to ({last.landing[0]:.3f}, {last.landing[1]:.3f}) "
+              f"m at t = {last.time + last.swing_time:.3f} s, then standing (the commanded steps after it dropped)")
+    print(f"plan: min ZMP margin {_margin_words(result.plan_zmp_margin)}")
+    rms, largest = result.cop_error_stats()
+    print(f"CoP - reference ZMP: RMS {rms * 1e3:.1f} mm, max {largest * 1e3:.1f} mm; "
+          + _cop_margin_words(cop_margin_outside_touchdowns(result), float(np.nanmin(result.cop_margin))))
+    top = max(rows, key=lambda r: r.peak_torque)
+    power = max(rows, key=lambda r: r.peak_power)
+    print(f"largest torque {top.peak_torque:.3g} N m at {top.joint}; largest power {power.peak_power:.3g} W "
+          f"at {power.joint}")
+    for fit in fits:
+        if fit.fits:  # a motor that does not fit is a warning, printed with the verdict
+            print(f"motor {fit.motor!r} at {fit.joint}: RMS {fit.rms_use * 100:.0f} % of rated, held peak "
+                  f"{fit.peak_use * 100:.0f} % of the envelope: {fit.verdict}")
+    _print_verdict(verdict)
 
 
 def _margin_words(margin: float, at: float | None = None) -> str:
@@ -649,6 +695,40 @@ class _PlanSummary:
         }
 
 
+def _plan(args: argparse.Namespace) -> int:
+    """``zmpwalk plan``: the pattern to --out (nothing written without it, and it says so) and its ZMP margin."""
+    commands, labels = _commands(args)
+    robot = _load_robot(args)
+    make = generator(args.generator)
+    schedule = _schedule(args)
+    options = _pattern_options(args)
+    with _source(_label(args)):
+        if args.generator == "polynomial":  # long walks: planned whole, sampled and written piece by piece
+            pieces = generate_chunks(robot, commands, rate=args.rate, schedule=schedule, labels=labels,
+                                     pelvis=_pelvis(args))
+        else:
+            pieces = iter([make(robot, commands, rate=args.rate, labels=labels, **options)])
+        summary = _PlanSummary()
+        stream = ((piece, pattern_joint_trajectory(piece).columns() if args.joints else None)
+                  for piece in summary.follow(pieces))
+        if args.out:
+            write_pieces_csv(args.out, stream)
+        else:
+            for _ in stream:
+                pass
+    result = {**summary.result(), "out": str(args.out) if args.out else None}
+    if args.json:
+        print(json.dumps(result, indent=2))
+    else:
+        margin = float(result["min_zmp_margin"])  # type: ignore[arg-type]
+        print(f"{result['swings']} swings, {result['duration']:.3f} s, {result['samples']} samples at "
+              f"{args.rate:g} Hz" + (f" -> {args.out}" if args.out else
+                                     "; no CSV written (give --out FILE to write it)"))
+        print(f"min ZMP margin: {_margin_words(margin, float(result['min_zmp_margin_time']))}")  # type: ignore[arg-type]
+    outside = float(result["min_zmp_margin"]) < 0  # type: ignore[arg-type]
+    return EXIT_FAILED if outside and not args.allow_outside else 0
+
+
 def _run(args: argparse.Namespace) -> int:
     if args.command == "scenarios":
         scenarios = list_scenarios()
@@ -660,36 +740,7 @@ def _run(args: argparse.Namespace) -> int:
                 print(f"{name:<{width}}  {description}")
         return 0
     if args.command == "plan":
-        commands, labels = _commands(args)
-        robot = _load_robot(args)
-        make = generator(args.generator)
-        schedule = _schedule(args)
-        options = _pattern_options(args)
-        with _source(_label(args)):
-            if args.generator == "polynomial":  # long walks: planned whole, sampled and written piece by piece
-                pieces = generate_chunks(robot, commands, rate=args.rate, schedule=schedule, labels=labels,
-                                         pelvis=_pelvis(args))
-            else:
-                pieces = iter([make(robot, commands, rate=args.rate, labels=labels, **options)])
-            summary = _PlanSummary()
-            stream = ((piece, pattern_joint_trajectory(piece).columns() if args.joints else None)
-                      for piece in summary.follow(pieces))
-            if args.out:
-                write_pieces_csv(args.out, stream)
-            else:
-                for _ in stream:
-                    pass
-        result = {**summary.result(), "out": str(args.out) if args.out else None}
-        if args.json:
-            print(json.dumps(result, indent=2))
-        else:
-            margin = float(result["min_zmp_margin"])  # type: ignore[arg-type]
-            print(f"{result['swings']} swings, {result['duration']:.3f} s, {result['samples']} samples at "
-                  f"{args.rate:g} Hz" + (f" -> {args.out}" if args.out else
-                                         "; no CSV written (give --out FILE to write it)"))
-            print(f"min ZMP margin: {_margin_words(margin, float(result['min_zmp_margin_time']))}")  # type: ignore[arg-type]
-        outside = float(result["min_zmp_margin"]) < 0  # type: ignore[arg-type]
-        return EXIT_FAILED if outside and not args.allow_outside else 0
+        return _plan(args)
     if args.command in ("demo", "report"):
         return _report(args)
     if args.command == "simulate":

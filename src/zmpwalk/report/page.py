@@ -34,7 +34,7 @@ from zmpwalk.sim.actuators import (
     write_actuator_csv,
 )
 from zmpwalk.sim.motors import Motor, MotorFit, motor_fits
-from zmpwalk.sim.run import simulate, write_result_csv
+from zmpwalk.sim.run import SimulationResult, simulate, write_result_csv
 from zmpwalk.sim.verdict import FAIL, HOLD, PASS, SETTLE, SKIP, WARN, Verdict, walk_verdict
 
 Progress = Callable[[str, int, int], None]
@@ -130,6 +130,24 @@ def build_report(
     write_actuator_csv(rows, folder / "actuators.csv")
     write_result_csv(result, folder / "simulation.csv")
     done("simulation")
+    images = _figures(pattern, result, motors)
+    for index, payload in enumerate(images.values()):
+        write_bytes(folder / f"figure{index + 1}.png", payload)
+    done("plots")
+    animation, animation_note = _animation(robot, result, folder, progress) if animate else (None, "")
+    done("animation")
+    fits = motor_fits(result, motors) if motors else []
+    report.summary = _summary(pattern, result, report.verdict, fits, generator)
+    page = _page(title, robot, report.summary, images, animation, animation_note, step_margins(pattern), rows,
+                 report.verdict, fits, _step_list(commands, labels))
+    write_text(report.index, page)
+    write_text(folder / "summary.json", json.dumps(report.summary, indent=2))
+    done("page")
+    return report
+
+
+def _figures(pattern: WalkingPattern, result: SimulationResult, motors: list[Motor] | None) -> dict[str, bytes]:
+    """The page's figures (PNG) by caption."""
     from zmpwalk.report import plots
 
     images = {
@@ -143,42 +161,40 @@ def build_report(
     }
     if result.balance is not None:
         images["The stabilizer: pattern ZMP, desired ZMP and measured CoP; its corrections"] = plots.balance(result)
-    fits = motor_fits(result, motors) if motors else []
     if motors:
         images["Torque-speed operating points against the motors' envelopes (joint side)"] = \
             plots.motor_envelopes(result, motors)
-    for index, payload in enumerate(images.values()):
-        write_bytes(folder / f"figure{index + 1}.png", payload)
-    done("plots")
-    animation: bytes | None = None
-    animation_note = ""
-    if animate:
-        from zmpwalk.report.animation import render_gif
+    return images
 
-        try:
-            animation = render_gif(robot, result, progress=None if progress is None else
-                                   lambda done: progress("animation", round(100 * done), 100))
-            write_bytes(folder / "walk.gif", animation)
-        except Exception as error:  # no OpenGL context on this machine: say so on the page
-            animation_note = f"The animation could not be rendered here: {error}. Set MUJOCO_GL=egl or osmesa."
-    done("animation")
+
+def _animation(robot: RobotModel, result: SimulationResult, folder: Path,
+               progress: Progress | None) -> tuple[bytes | None, str]:
+    """The walk as a GIF (written to ``walk.gif``), or None and why it could not be rendered."""
+    from zmpwalk.report.animation import render_gif
+
+    try:
+        animation = render_gif(robot, result, progress=None if progress is None else
+                               lambda done: progress("animation", round(100 * done), 100))
+    except Exception as error:  # no OpenGL context on this machine: say so on the page
+        return None, f"The animation could not be rendered here: {error}. Set MUJOCO_GL=egl or osmesa."
+    write_bytes(folder / "walk.gif", animation)
+    return animation, ""
+
+
+def _summary(pattern: WalkingPattern, result: SimulationResult, verdict: Verdict, fits: list[MotorFit],
+             generator: str) -> dict[str, Any]:
+    """The numbers on the page (SI), as ``summary.json`` and ``report --json`` give them."""
     margin, at = pattern.min_zmp_margin()
     rms, largest = result.cop_error_stats()
-    report.summary = {
-        "robot": robot.name, "generator": generator, "duration": pattern.duration, "swings": len(pattern.steps),
-        "min_zmp_margin": margin, "min_zmp_margin_time": at, "fell": result.fell, "fall_time": result.fall_time,
-        "distance": result.distance, "average_speed": result.average_speed, "foot_slip": result.foot_slip,
-        "cop_error_rms": rms, "cop_error_max": largest, "balance": result.balance is not None,
-        "verdict": report.verdict.as_dict(), "warnings": list(report.verdict.warnings),
+    return {
+        "robot": result.robot.name, "generator": generator, "duration": pattern.duration,
+        "swings": len(pattern.steps), "min_zmp_margin": margin, "min_zmp_margin_time": at, "fell": result.fell,
+        "fall_time": result.fall_time, "distance": result.distance, "average_speed": result.average_speed,
+        "foot_slip": result.foot_slip, "cop_error_rms": rms, "cop_error_max": largest,
+        "balance": result.balance is not None, "verdict": verdict.as_dict(), "warnings": list(verdict.warnings),
+        "motors": [{"joint": f.joint, "motor": f.motor, "rms_use": f.rms_use, "peak_use": f.peak_use,
+                    "fits": f.fits} for f in fits],
     }
-    report.summary["motors"] = [{"joint": f.joint, "motor": f.motor, "rms_use": f.rms_use, "peak_use": f.peak_use,
-                                 "fits": f.fits} for f in fits]
-    page = _page(title, robot, report.summary, images, animation, animation_note, step_margins(pattern), rows,
-                 report.verdict, fits, _step_list(commands, labels))
-    write_text(report.index, page)
-    write_text(folder / "summary.json", json.dumps(report.summary, indent=2))
-    done("page")
-    return report
 
 
 STATE_CLASS = {PASS: "good", WARN: "warn", FAIL: "bad", SKIP: "none"}
@@ -217,29 +233,60 @@ def _step_list(commands: Sequence[StepCommand], labels: Sequence[str] | None) ->
         f"<td>{'yes' if c.stop else ''}</td></tr>" for n, c in enumerate(commands, start=1))
 
 
-def _page(title: str, robot: RobotModel, summary: dict[str, Any], images: dict[str, bytes],
-          animation: bytes | None, animation_note: str, margins: list[tuple[int, str, str, float, float, float]],
-          rows: list[ActuatorRow], verdict: Verdict, fits: list[MotorFit], steps: str) -> str:
+STYLE = """<style>
+body { font-family: system-ui, sans-serif; max-width: 980px; margin: 2em auto; color: #222; }
+table { border-collapse: collapse; margin: 1em 0; font-size: 0.9em; }
+td, th { border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: right; }
+th { background: #f3f3f3; } td:first-child { text-align: left; }
+.good { color: #1a7f37; } .bad { color: #c0392b; } .warn { color: #b36b00; } .none { color: #666; }
+figure { margin: 1.5em 0; } img { max-width: 100%; } figcaption { color: #555; font-size: 0.9em; }
+</style>"""
+SCRIPT = """<script>
+window.addEventListener("load", function () {
+  var images = Array.prototype.slice.call(document.images);
+  var ok = images.length > 0 && images.every(function (i) { return i.complete && i.naturalWidth > 0; });
+  document.body.setAttribute("data-images-loaded", ok ? "yes" : "no");
+  document.body.setAttribute("data-image-count", String(images.length));
+});
+</script>"""
+
+
+def _verdict_html(verdict: Verdict, summary: dict[str, Any]) -> str:
+    """The outcome (green only when :attr:`Verdict.clean`), every criterion with its state, figure and limit, and
+    every warning the console prints."""
     esc = html.escape
-    fell = summary["fell"]
     outcome = (f"<b class='{_outcome_class(verdict)}'>{esc(verdict.outcome())}</b>"
-               + (f" <b class='bad'>(fell at t = {summary['fall_time']:.2f} s)</b>" if fell else ""))
+               + (f" <b class='bad'>(fell at t = {summary['fall_time']:.2f} s)</b>" if summary["fell"] else ""))
     criteria_rows = "\n".join(
         f"<tr><td>{esc(c.name)}</td><td class='{STATE_CLASS[c.state]}'>{STATE_WORD[c.state]}</td>"
         f"<td>{esc(c.text())} ({esc(c.rule)})</td></tr>" for c in verdict.criteria)
     warnings = ("<ul id='warnings'>" + "".join(f"<li class='warn'>warning: {esc(w)}</li>" for w in verdict.warnings)
                 + "</ul>" if verdict.warnings else "")
+    return (f'<p id="verdict">In the MuJoCo simulation the walk {outcome}.</p>\n'
+            '<table id="criteria"><tr><th>criterion</th><th>result</th><th>figure (limit; how it is judged)</th></tr>\n'
+            f"{criteria_rows}\n</table>\n{warnings}")
+
+
+def _fit_table(fits: list[MotorFit]) -> str:
+    """Each joint against its motor (empty without a motor file)."""
+    esc = html.escape
+    fit_rows = "\n".join(
+        f"<tr><td>{esc(f.joint)}</td><td>{esc(f.motor)}</td><td>{f.rms_use * 100:.0f}</td>"
+        f"<td>{f.peak_use * 100:.0f}</td><td class='{'good' if f.fits else 'bad'}'>{esc(f.verdict)}</td></tr>"
+        for f in fits)
+    return ("<table><tr><th>joint</th><th>motor</th><th>RMS torque [% of rated]</th>"
+            f"<th>held peak [% of envelope]</th><th>verdict</th></tr>\n{fit_rows}\n</table>" if fits else "")
+
+
+def _page(title: str, robot: RobotModel, summary: dict[str, Any], images: dict[str, bytes],
+          animation: bytes | None, animation_note: str, margins: list[tuple[int, str, str, float, float, float]],
+          rows: list[ActuatorRow], verdict: Verdict, fits: list[MotorFit], steps: str) -> str:
+    esc = html.escape
     margin_rows = "\n".join(
         f"<tr><td>{n}</td><td>{esc(kind)}</td><td>{esc(swing)}</td><td>{start:.2f}</td><td>{duration:.2f}</td>"
         f"<td class='{'good' if m >= 0 else 'bad'}'>{m * 1e3:+.1f}</td></tr>"
         for n, kind, swing, start, duration, m in margins)
     actuator_rows = actuator_html(rows)
-    fit_rows = "\n".join(
-        f"<tr><td>{esc(f.joint)}</td><td>{esc(f.motor)}</td><td>{f.rms_use * 100:.0f}</td>"
-        f"<td>{f.peak_use * 100:.0f}</td><td class='{'good' if f.fits else 'bad'}'>{esc(f.verdict)}</td></tr>"
-        for f in fits)
-    fit_table = ("<table><tr><th>joint</th><th>motor</th><th>RMS torque [% of rated]</th>"
-                 f"<th>held peak [% of envelope]</th><th>verdict</th></tr>\n{fit_rows}\n</table>" if fits else "")
     figures = "\n".join(
         f"<figure><img src='{_data_uri('image/png', payload)}' alt='{esc(caption)}'>"
         f"<figcaption>{esc(caption)}</figcaption></figure>" for caption, payload in images.items())
@@ -248,24 +295,13 @@ def _page(title: str, robot: RobotModel, summary: dict[str, Any], images: dict[s
              if animation else f"<p class='bad'>{esc(animation_note)}</p>")
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>{esc(title)}</title>
-<style>
-body {{ font-family: system-ui, sans-serif; max-width: 980px; margin: 2em auto; color: #222; }}
-table {{ border-collapse: collapse; margin: 1em 0; font-size: 0.9em; }}
-td, th {{ border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: right; }}
-th {{ background: #f3f3f3; }} td:first-child {{ text-align: left; }}
-.good {{ color: #1a7f37; }} .bad {{ color: #c0392b; }} .warn {{ color: #b36b00; }} .none {{ color: #666; }}
-figure {{ margin: 1.5em 0; }} img {{ max-width: 100%; }} figcaption {{ color: #555; font-size: 0.9em; }}
-</style></head>
+{STYLE}</head>
 <body data-images-loaded="no">
 <h1>{esc(title)}</h1>
 <p>{esc(robot.description)}. Pattern: {esc(str(summary['generator']))} generator,
 {summary['swings']} swings over {summary['duration']:.2f} s, sampled at 1 kHz.</p>
 <h2>Does it walk?</h2>
-<p id="verdict">In the MuJoCo simulation the walk {outcome}.</p>
-<table id="criteria"><tr><th>criterion</th><th>result</th><th>figure (limit; how it is judged)</th></tr>
-{criteria_rows}
-</table>
-{warnings}
+{_verdict_html(verdict, summary)}
 <p>Distance {summary['distance']:.3f} m, average speed
 {float(summary['average_speed']) * 1e3:.1f} mm/s, largest foot slip {float(summary['foot_slip']) * 1e3:.1f} mm;
 centre of pressure against the reference ZMP: RMS {float(summary['cop_error_rms']) * 1e3:.1f} mm,
@@ -287,20 +323,13 @@ torque, at touchdown impacts, has its own column.</p>
 <table id="actuators">
 {actuator_rows}
 </table>
-{fit_table}
+{_fit_table(fits)}
 <h2>ZMP margin per step</h2>
 <table><tr><th>#</th><th>kind</th><th>swing</th><th>start [s]</th><th>duration [s]</th><th>min margin [mm]</th></tr>
 {margin_rows}
 </table>
 <h2>Figures</h2>
 {figures}
-<script>
-window.addEventListener("load", function () {{
-  var images = Array.prototype.slice.call(document.images);
-  var ok = images.length > 0 && images.every(function (i) {{ return i.complete && i.naturalWidth > 0; }});
-  document.body.setAttribute("data-images-loaded", ok ? "yes" : "no");
-  document.body.setAttribute("data-image-count", String(images.length));
-}});
-</script>
+{SCRIPT}
 </body></html>
 """

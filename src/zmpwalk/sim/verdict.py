@@ -162,8 +162,13 @@ class Verdict:
         return f"passes the {measured} criteria measured ({'; '.join(parts)})"
 
     def as_dict(self) -> dict[str, object]:
+        """As JSON takes it: a figure or limit that is not measured is None (null), not NaN."""
+        def finite(value: float) -> float | None:
+            return value if math.isfinite(value) else None
+
         return {"passed": self.passed, "state": self.state, "complete": self.complete, "outcome": self.outcome(),
-                "criteria": [{**asdict(c), "state": c.state, "text": c.text()} for c in self.criteria],
+                "criteria": [{**asdict(c), "figure": finite(c.figure), "limit": finite(c.limit), "state": c.state,
+                              "text": c.text()} for c in self.criteria],
                 "warnings": list(self.warnings)}
 
     def lines(self) -> list[str]:
