@@ -19,10 +19,12 @@ A walk passes when all of these hold (the limits are module constants, stated in
    :data:`PLAN_ZMP_MARGIN` (what ``zmpwalk plan`` calls inside the support polygon).
 6. **The joints stay within their actuators' limits**: the largest held (:data:`~zmpwalk.sim.actuators.IMPACT_WINDOW`)
    |torque| of a leg joint over its model's actuator limit, and with a motor file each motor's use of its
-   torque-speed envelope and of its rated torque (:mod:`zmpwalk.sim.motors`), below :data:`ACTUATOR_LIMIT`.
-   A simulated actuator gives at most its limit, so a held peak at the limit (100 %) is a saturated actuator
-   and fails. From :data:`ACTUATOR_WARNING` on it passes with a warning (amber: little left to spare). Where
-   the model gives no limit and no motor file is given it is not measured (shown so, never green).
+   torque-speed envelope and of its rated torque (:mod:`zmpwalk.sim.motors`), at most :data:`ACTUATOR_LIMIT`.
+   A simulated actuator gives at most its model's limit (MuJoCo clamps it), so a held peak at that limit
+   (100 %) is a saturated actuator: the walk was carried within the limit, with nothing to spare, and passes
+   with a warning, as does anything from :data:`ACTUATOR_WARNING` on (amber, never green). A motor file's
+   envelope or rating is not enforced by the simulation: a use beyond it (over 100 %) fails. Where the model
+   gives no limit and no motor file is given it is not measured (shown so, never green).
 
 Margins read the same way everywhere: positive inside, negative outside.
 """
@@ -51,7 +53,7 @@ COP_MARGIN = -0.005  # [m]: 5 mm of the sensors' CoP beyond an edge is the foot'
 TOUCHDOWN_WINDOW = 0.05  # [s]
 CONTACT_FRACTION = 0.01  # [-] of the weight: a sole carrying more touches the floor
 PLAN_ZMP_MARGIN = 0.0  # [m] the plan's cart-table ZMP on the edge of its support polygon at worst
-ACTUATOR_LIMIT = 1.0  # [-] of an actuator's limit: a held peak must stay below it
+ACTUATOR_LIMIT = 1.0  # [-] of an actuator's limit: a held peak (or a motor's use) must stay at most at it
 ACTUATOR_WARNING = 0.9  # [-] of an actuator's limit: from here a passing walk is shown amber
 SATURATION_TOL = 1e-6  # [-] a clamped actuator reads its limit to rounding
 
@@ -273,17 +275,17 @@ def actuator_criterion(rows: list[ActuatorRow], fits: list[MotorFit]) -> Criteri
                "; speed not judged: the model gives no speed limit, a motor file (--motors) does"))
     if not uses:
         return Criterion("the joints stay within their actuators' limits", math.nan, ACTUATOR_LIMIT, "fraction",
-                         True, rule, "below",
+                         True, rule, "at most",
                          shown="not measured: the model's actuators have no torque limit (a motor file, --motors, "
                          "gives limits)")
     worst = max(uses, key=lambda use: use[0])
     figure = worst[0]
-    passed = figure < ACTUATOR_LIMIT - SATURATION_TOL
+    passed = figure <= ACTUATOR_LIMIT + SATURATION_TOL
     near = sorted((use for use in uses if use[0] >= ACTUATOR_WARNING), key=lambda use: -use[0])
     note = "; ".join(f"{text} ({share * 100:.0f} %{', saturated' if share >= ACTUATOR_LIMIT - SATURATION_TOL else ''})"
                      for share, text in near) or worst[1]
     return Criterion("the joints stay within their actuators' limits", figure, ACTUATOR_LIMIT, "fraction", passed,
-                     rule + f"; amber from {ACTUATOR_WARNING * 100:g} %", "below",
+                     rule + f"; amber from {ACTUATOR_WARNING * 100:g} % (100 %: saturated)", "at most",
                      warning=passed and figure >= ACTUATOR_WARNING, note=note)
 
 
