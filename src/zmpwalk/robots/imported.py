@@ -479,20 +479,58 @@ def rigid_bodies(model: object, body: int) -> list[int]:
     return bodies
 
 
+def _unit_sphere_grid(polar: int = 49, around: int = 48) -> Array:
+    """Points on the unit sphere: ``polar`` latitudes from pole to pole, ``around`` longitudes each."""
+    theta = np.linspace(0.0, np.pi, polar)[:, None]
+    phi = np.linspace(0.0, 2 * np.pi, around, endpoint=False)[None, :]
+    grid = np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta) + 0 * phi], axis=-1)
+    return np.asarray(grid.reshape(-1, 3), dtype=np.float64)
+
+
+_ELLIPSOID_SURFACE = _unit_sphere_grid()  # an ellipsoid's surface, scaled by its semi-axes
+
+
+def _round_bar_bottom(centre: Array, rotation: Array, size: Array, capsule: bool) -> Array:
+    """World points of a capsule's or cylinder's lowest line (its contact with a level floor): the lowest point
+    of each end's hemisphere (a capsule) or rim (a cylinder); a standing cylinder's lower disc rim."""
+    radius, half = float(size[0]), float(size[1])
+    axis = rotation[:, 2]
+    ends = centre + np.outer((-half, half), axis)
+    if capsule:
+        return np.asarray(ends - np.array([0.0, 0.0, radius]), dtype=np.float64)
+    down = np.array([0.0, 0.0, -1.0]) - axis * -axis[2]  # -z off the axis: towards the rim's lowest point
+    if float(np.linalg.norm(down)) < 1e-9:  # standing upright: the whole lower disc is on the floor
+        angles = np.linspace(0, 2 * np.pi, 16, endpoint=False)
+        ring = np.column_stack([np.cos(angles), np.sin(angles), np.zeros(16)]) * radius @ rotation.T
+        return np.asarray(np.vstack([end + ring for end in ends]), dtype=np.float64)
+    return np.asarray(ends + radius * down / np.linalg.norm(down), dtype=np.float64)
+
+
+def colliding_geoms(model: object) -> set[int]:
+    """The geoms that can touch anything: by their contact type and affinity, or named in an explicit contact
+    pair (``<contact><pair>``, whose geoms often have ``contype = conaffinity = 0``)."""
+    m = model
+    geoms = {g for g in range(m.ngeom)  # type: ignore[attr-defined]
+             if m.geom_contype[g] != 0 or m.geom_conaffinity[g] != 0}  # type: ignore[attr-defined]
+    for pair in range(m.npair):  # type: ignore[attr-defined]
+        geoms.update((int(m.pair_geom1[pair]), int(m.pair_geom2[pair])))  # type: ignore[attr-defined]
+    return geoms
+
+
 def collision_points(model: object, data: object, bodies: list[int]) -> Array:
-    """World points spanning the collision geoms of ``bodies`` (box corners, mesh vertices, sphere and
-    capsule extremes), (m, 3)."""
+    """World points spanning the collision geoms of ``bodies``, (m, 3): box corners, mesh vertices, an
+    ellipsoid's surface, a sphere's lowest point, a capsule's or cylinder's lowest line (see
+    :func:`_round_bar_bottom`). The geoms are those that can touch the floor (:func:`colliding_geoms`)."""
     import mujoco
 
     m, d = model, data
     points: list[Array] = []
     geom_type = mujoco.mjtGeom
+    colliding = colliding_geoms(m)
     for g in range(m.ngeom):  # type: ignore[attr-defined]
-        if int(m.geom_bodyid[g]) not in bodies:  # type: ignore[attr-defined]
+        if int(m.geom_bodyid[g]) not in bodies or g not in colliding:  # type: ignore[attr-defined]
             continue
-        if m.geom_contype[g] == 0 and m.geom_conaffinity[g] == 0:  # type: ignore[attr-defined]
-            continue
-        kind = m.geom_type[g]  # type: ignore[attr-defined]
+        kind = int(m.geom_type[g])  # type: ignore[attr-defined]  # a numpy integer is never `in` a tuple of enums
         size = m.geom_size[g]  # type: ignore[attr-defined]
         rotation = d.geom_xmat[g].reshape(3, 3)  # type: ignore[attr-defined]
         centre = d.geom_xpos[g]  # type: ignore[attr-defined]
@@ -503,19 +541,13 @@ def collision_points(model: object, data: object, bodies: list[int]) -> Array:
             start, count = int(m.mesh_vertadr[mesh]), int(m.mesh_vertnum[mesh])  # type: ignore[attr-defined]
             local = np.asarray(m.mesh_vert[start:start + count], dtype=float)  # type: ignore[attr-defined]
         elif kind == geom_type.mjGEOM_SPHERE:
-            local = np.array([[0.0, 0.0, -size[0]]])
-            points.append(centre + local[0])
+            points.append(centre - np.array([[0.0, 0.0, size[0]]]))  # its lowest point
             continue
         elif kind in (geom_type.mjGEOM_CAPSULE, geom_type.mjGEOM_CYLINDER):
-            ends = np.array([[0.0, 0.0, -size[1]], [0.0, 0.0, size[1]]])
-            angles = np.linspace(0, 2 * np.pi, 16, endpoint=False)
-            ring = np.column_stack([np.cos(angles), np.sin(angles), np.zeros(16)]) * size[0]
-            local = (ends[:, None, :] + ring[None, :, :]).reshape(-1, 3)
-            world = centre + local @ rotation.T
-            if kind == geom_type.mjGEOM_CAPSULE:
-                world = np.vstack([world, centre + ends @ rotation.T - np.array([0.0, 0.0, size[0]])])
-            points.append(world)
+            points.append(_round_bar_bottom(centre, rotation, size, kind == geom_type.mjGEOM_CAPSULE))
             continue
+        elif kind == geom_type.mjGEOM_ELLIPSOID:
+            local = _ELLIPSOID_SURFACE * size[:3]
         else:
             continue
         points.append(centre + local @ rotation.T)
