@@ -61,7 +61,7 @@ def test_stride_beyond_reach_names_the_stride_the_largest_that_fits_leg_time_and
         generate(hubo, [StepCommand(0.8, 0.2), StepCommand(0.8, 0.9)])
     error = info.value
     assert error.parameter == "forward" and error.value == 0.9
-    assert "step 2: forward = 0.9 is not allowed" in str(error) and "at most forward = " in str(error)
+    assert "step 2: forward = 0.9 is not allowed" in str(error) and " m forward (forward = 0." in str(error)
     cause = error.cause
     assert isinstance(cause, UnreachableError) and cause.excess > 0 and cause.leg in ("left", "right")
     assert "out of reach from t =" in str(error) and "by up to" in str(error) and cause.time > 0

@@ -42,27 +42,55 @@ class InfeasibleCommandError(InvalidParameterError):
     """A step command the robot's legs cannot follow (reach or joint range), or whose pattern would need the ZMP
     outside the feet (hyperbolic generator), named by its stride.
 
+    The message states the largest stride that fits in the user's own directions (``0.403 m backward``,
+    ``0.200 m to the right``, ``0.350 rad clockwise``), then as the fields to write (``forward = -0.403 m``).
+
     Attributes:
         parameter, value, allowed: As :class:`InvalidParameterError`; ``parameter`` is the command's
             largest stride field (``forward``, ``side`` or ``turn``), or ``foot_lift`` for a step in place.
-        largest: The largest stride that fits in the same direction, as ``{field: value}`` (SI), or
+        largest: The largest stride that fits in the same direction, as ``{field: value}`` (signed, SI), or
             empty when no stride in that direction fits (the cause is then another field).
         cause: The reach, joint-range or ZMP error behind it.
+        step_time: The step time [s] at which ``largest`` fits, where it is not the command's (no stride in
+            this direction fits at the command's own), else None.
+        every_step_time: The command's stride fits at no step time (it was rejected first for its step time or
+            another parameter, which would not have made it fit).
     """
 
-    def __init__(self, parameter: str, value: object, largest: dict[str, float], cause: ZmpwalkError) -> None:
+    def __init__(self, parameter: str, value: object, largest: dict[str, float], cause: ZmpwalkError,
+                 step_time: float | None = None, every_step_time: bool = False) -> None:
         self.largest = largest
         self.cause = cause
+        self.step_time = step_time
+        self.every_step_time = every_step_time
         balance = isinstance(cause, InfeasiblePatternError)
         fitting = "that keeps the ZMP in the feet" if balance else "the legs can follow"
+        where = "from here at any step time" if every_step_time else "from here"
         if largest:
-            units = {"turn": "rad"}
-            fits = ", ".join(f"{name} = {amount:.3f} {units.get(name, 'm')}" for name, amount in largest.items())
-            allowed = f"a stride {fitting} from here, at most {fits} ({cause})"
+            at = f" at a step time of {step_time:.3f} s" if step_time is not None else ""
+            allowed = f"a stride {fitting} {where}, at most {self.stride_text(largest)}{at}; {cause}"
         else:
-            allowed = (f"a step {fitting} from here; no stride in this direction fits, whatever its length "
-                       f"({cause})")
+            allowed = f"a step {fitting} {where}; no stride in this direction fits, whatever its length; {cause}"
         super().__init__(parameter, value, allowed)
+
+    @staticmethod
+    def stride_text(stride: dict[str, float]) -> str:
+        """A stride in the user's directions, then as fields: ``0.403 m backward (forward = -0.403 m)``."""
+        # each field's unit and the words for its positive and negative directions (docs/frames-and-units.md)
+        directions = {"forward": ("m", "forward", "backward"), "side": ("m", "to the left", "to the right"),
+                      "turn": ("rad", "counter-clockwise", "clockwise")}
+        words, fields = [], []
+        for name, amount in stride.items():
+            unit, positive, negative = directions[name]
+            words.append(f"{abs(amount):.3f} {unit} {positive if amount >= 0 else negative}")
+            fields.append(f"{name} = {amount:.3f} {unit}")
+        spoken = words[0] if len(words) == 1 else f"{', '.join(words[:-1])} and {words[-1]}"
+        return f"{spoken} ({', '.join(fields)})"
+
+    def with_largest(self, largest: dict[str, float]) -> InfeasibleCommandError:
+        """The same rejection naming another largest stride (the same step time)."""
+        return InfeasibleCommandError(self.parameter, self.value, largest, self.cause, self.step_time,
+                                      self.every_step_time)
 
 
 class UnknownNameError(ZmpwalkError, KeyError):

@@ -54,7 +54,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -62,14 +62,11 @@ from numpy.typing import NDArray
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import (
     InfeasibleCommandError,
-    InfeasiblePatternError,
     InvalidParameterError,
-    UnreachableError,
     ZmpwalkError,
 )
 from zmpwalk.footsteps import Stance
 from zmpwalk.kinematics import (
-    JointLimitError,
     Leg,
     check_joint_limits,
     check_leg_reach,
@@ -78,6 +75,7 @@ from zmpwalk.kinematics import (
     leg_ik_scalar,
 )
 from zmpwalk.patterns.polynomial import (
+    STRIDE_CAUSES,
     Boundary,
     Samples,
     Stage,
@@ -88,7 +86,9 @@ from zmpwalk.patterns.polynomial import (
     first_sample_at,
     hyperbolic_stages,
     infeasible_command,
+    largest_command,
     plan_next_in_parts,
+    step_time_rejection,
 )
 from zmpwalk.patterns.result import SUPPORT_NAMES, check_rate
 from zmpwalk.robots.model import RobotModel
@@ -212,8 +212,17 @@ _UNFINISHED = object()
 WORK_FRACTION = 0.02  # [-] a tick runs parts of a command's check for this fraction of the control period
 PARTS_PER_BLOCK = 40  # parts of a block of SLICE_ROWS samples (a first guess of a check's length, before one has run)
 FINISH_EARLY = 0.95  # [-] a check is paced to end within this fraction of the ticks before its step begins
-# the rejections that name the largest stride that fits: the legs, or (hyperbolic) the ZMP leaving the feet
-_TOO_LARGE = (UnreachableError, JointLimitError, InfeasiblePatternError)
+
+
+@dataclass
+class _Rejection:
+    """A command refused by its check, where it was to start, and whether the error is the one to give."""
+
+    command: StepCommand
+    error: ZmpwalkError
+    stance: Stance
+    boundary: Boundary
+    named: bool = False  # the parameter to fix is named (:meth:`OnlineWalker._rejected` has run)
 
 
 def _step(planning: Parts[_Plan | None]) -> object:
@@ -278,7 +287,7 @@ class OnlineWalker:
         self._current: _Plan | None = None
         self._pending: _Plan | None = None
         self._job: _Job | None = None
-        self._rejection: tuple[StepCommand, ZmpwalkError, Stance, Boundary] | None = None
+        self._rejection: _Rejection | None = None
         self._check_parts = 0  # parts the last completed check took
         self._set_standing(self._standing_row(self._stance))
 
@@ -330,8 +339,8 @@ class OnlineWalker:
         if wait:
             try:
                 plan = run_to_end(self._checked(command, stance, boundary, self.rate))
-            except _TOO_LARGE as error:
-                raise self._infeasible(command, stance, boundary, error) from None
+            except ZmpwalkError as error:
+                raise self._rejected(command, stance, boundary, error) from None
             self._job = None  # a command given now supersedes one still being checked
             self._rejection = None
             self._pending = plan  # None: a stop while standing
@@ -364,17 +373,21 @@ class OnlineWalker:
     def rejection(self) -> ZmpwalkError | None:
         """Why the last command was rejected (None: none since the last :meth:`command`).
 
-        Where the legs are the cause, the error names the largest stride that fits, searched by bisection
-        the first time this is read (tens of milliseconds): read it outside the hard real-time part of the
-        loop, e.g. when :attr:`checking` has become None without the command being :attr:`queued`.
+        It names first the parameter that cannot be met at any setting of the others, reach before step time:
+        where the legs are the cause, or the check refused the step time (or another parameter) but the stride
+        fits at no step time (:func:`~zmpwalk.patterns.polynomial.step_time_rejection`), the stride, with the
+        largest that fits, searched by bisection the first time this is read (tens of milliseconds): read it
+        outside the hard real-time part of the loop, e.g. when :attr:`checking` has become None without the
+        command being :attr:`queued`.
         """
         if self._rejection is None:
             return None
-        command, error, stance, boundary = self._rejection
-        if isinstance(error, _TOO_LARGE):
-            error = self._infeasible(command, stance, boundary, error)
-            self._rejection = (command, error, stance, boundary)
-        return error
+        rejection = self._rejection
+        if not rejection.named:
+            rejection.error = self._rejected(rejection.command, rejection.stance, rejection.boundary,
+                                             rejection.error)
+            rejection.named = True
+        return rejection.error
 
     def _work(self, finish: bool) -> None:
         """One slice of the given command's check (all of it when ``finish``)."""
@@ -399,7 +412,7 @@ class OnlineWalker:
                 plan = _slices(job, WORK_FRACTION / self.rate, quota)
         except ZmpwalkError as error:
             self._job = None
-            self._rejection = (job.command, error, job.stance, job.boundary)
+            self._rejection = _Rejection(job.command, error, job.stance, job.boundary)
             return
         if plan is _UNFINISHED:
             return
@@ -423,23 +436,29 @@ class OnlineWalker:
                     from None
         return plan
 
-    def _infeasible(self, command: StepCommand, stance: Stance, boundary: Boundary,
-                    cause: ZmpwalkError) -> ZmpwalkError:
-        """The rejection of a command the legs cannot follow, naming the largest stride that fits: searched
-        at :data:`HINT_RATE` at most, then confirmed (or reduced) at the control rate."""
+    def _rejected(self, command: StepCommand, stance: Stance, boundary: Boundary,
+                  cause: ZmpwalkError) -> ZmpwalkError:
+        """The rejection of a command its check refused with ``cause``, naming first the parameter that cannot
+        be met at any setting of the others (reach before step time): the largest stride that fits where the
+        stride is the cause, or fits at no step time (searched at :data:`HINT_RATE` at most, then confirmed, or
+        reduced, at the control rate); else ``cause``."""
         coarse = min(self.rate, HINT_RATE)
-        error = infeasible_command(command, cause, lambda c: run_to_end(self._checked(c, stance, boundary, coarse)))
+
+        def feasible(candidate: StepCommand) -> object:
+            return run_to_end(self._checked(candidate, stance, boundary, coarse))
+
+        if isinstance(cause, STRIDE_CAUSES):
+            error: ZmpwalkError = infeasible_command(command, cause, feasible)
+        else:
+            error = step_time_rejection(command, cause, feasible)
         for _ in range(HINT_CONFIRMATIONS):
-            if not error.largest or coarse == self.rate:
+            if not isinstance(error, InfeasibleCommandError) or not error.largest or coarse == self.rate:
                 break
             try:
-                run_to_end(self._checked(replace(command, forward=error.largest.get("forward", 0.0),
-                                              side=error.largest.get("side", 0.0),
-                                              turn=error.largest.get("turn", 0.0)), stance, boundary, self.rate))
+                run_to_end(self._checked(largest_command(command, error), stance, boundary, self.rate))
                 break
             except ZmpwalkError:
-                error = InfeasibleCommandError(error.parameter, error.value,
-                                               {k: v * HINT_SHRINK for k, v in error.largest.items()}, cause)
+                error = error.with_largest({k: v * HINT_SHRINK for k, v in error.largest.items()})
         return error
 
     def _plan(self, command: StepCommand, stance: Stance, boundary: Boundary, rate: float,

@@ -46,9 +46,15 @@ from numpy.typing import NDArray
 
 from zmpwalk import curves
 from zmpwalk.commands import MAX_STRIDE, MAX_TURN, StepCommand
-from zmpwalk.errors import InfeasibleCommandError, InvalidParameterError, UnreachableError, ZmpwalkError
+from zmpwalk.errors import (
+    InfeasibleCommandError,
+    InfeasiblePatternError,
+    InvalidParameterError,
+    UnreachableError,
+    ZmpwalkError,
+)
 from zmpwalk.footsteps import GROUNDED_STRETCH, LEFT, Pose2D, StagePlan, Stance, grounded_stage, plan_command
-from zmpwalk.kinematics import check_leg_reach
+from zmpwalk.kinematics import JointLimitError, check_leg_reach
 from zmpwalk.patterns.lipm_stage import PIECES, LipmPelvis, axis_at_in_parts, lipm_pelvis_in_parts
 from zmpwalk.patterns.result import (
     SUPPORT_DOUBLE,
@@ -671,19 +677,72 @@ def hyperbolic_stage(stage: Stage, boundary: Boundary, robot: RobotModel, next_p
 
 STRIDE_FIELDS = ("forward", "side", "turn")
 STRIDE_BISECTIONS = 10  # halvings of the stride scale when looking for the largest that fits (0.1 %)
+# the rejections that name the largest stride that fits: the legs, or (hyperbolic) the ZMP leaving the feet
+STRIDE_CAUSES = (UnreachableError, JointLimitError, InfeasiblePatternError)
+# [s] the step times at which a command rejected for its step time (or another parameter) is tried, to tell
+# whether its stride fits at any: MIN_DURATION to MAX_DURATION of StepCommand, denser where robots walk
+STEP_TIME_PROBES = (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.95, 1.2, 1.6, 2.2, 3.0, 5.0)
 
 
-def infeasible_command(command: StepCommand, cause: ZmpwalkError,
-                       feasible: Callable[[StepCommand], object]) -> InfeasibleCommandError:
+def names_stride(error: ZmpwalkError) -> bool:
+    """Whether ``error`` is about a command's stride: the legs or the ZMP (:data:`STRIDE_CAUSES`), or a stride
+    field named (feet that would overlap, the largest stride that fits)."""
+    return isinstance(error, STRIDE_CAUSES) or (
+        isinstance(error, InvalidParameterError) and error.parameter in STRIDE_FIELDS)
+
+
+def step_time_rejection(command: StepCommand, error: ZmpwalkError,
+                        feasible: Callable[[StepCommand], object]) -> ZmpwalkError:
+    """The rejection of ``command``, refused with ``error`` for its step time or another parameter than its
+    stride: it names first the parameter that cannot be met at any setting of the others, reach before step time.
+
+    When the stride fits at none of :data:`STEP_TIME_PROBES` (with the command's shape factors, and with the
+    schedule's), no step time (or shape factor) would make it fit: the rejection names the stride, with the
+    largest that fits (:func:`infeasible_command`, ``every_step_time``). Else (or for a command without a stride,
+    or an error about the stride already) ``error`` itself. ``feasible`` raises
+    :class:`~zmpwalk.errors.ZmpwalkError` for a command that does not fit from the same place.
+    """
+    if names_stride(error) or not any(getattr(command, name) for name in STRIDE_FIELDS):
+        return error
+    cause: ZmpwalkError | None = None
+    for candidate in _step_time_probes(command):
+        try:
+            feasible(candidate)
+        except ZmpwalkError as failure:
+            if cause is None and names_stride(failure):
+                cause = failure  # at the step time nearest the command's
+            continue
+        return error  # the stride fits at this step time: the step time (or the other parameter) is the fix
+    if cause is None:  # no step time tried is for the stride: nothing to say of it
+        return error
+    return infeasible_command(command, cause, feasible, every_step_time=True)
+
+
+def _step_time_probes(command: StepCommand) -> Iterator[StepCommand]:
+    """``command`` at each of :data:`STEP_TIME_PROBES`, nearest its own step time first, with its shape factors
+    and (where it overrides any) with the schedule's."""
+    plain = StepCommand(command.duration, command.forward, command.side, command.turn)
+    for duration in sorted(STEP_TIME_PROBES, key=lambda probe: abs(probe - command.duration)):
+        for base in dict.fromkeys((command, plain)):
+            try:
+                yield replace(base, duration=duration)
+            except InvalidParameterError:  # an override that does not fit this step time (dsp_time)
+                continue
+
+
+def infeasible_command(command: StepCommand, cause: ZmpwalkError, feasible: Callable[[StepCommand], object],
+                       every_step_time: bool = False) -> InfeasibleCommandError:
     """The error for a command whose legs cannot follow it, with the largest stride that fits.
 
     The stride (``forward``, ``side``, ``turn`` together, so the direction is kept) is scaled by
     bisection on ``feasible``, which raises :class:`~zmpwalk.errors.ZmpwalkError` for a command
-    that does not fit from the same place.
+    that does not fit from the same place. ``every_step_time``: the stride fits at no step time (the
+    command was refused first for its step time); where not even a step in place fits at the command's own
+    step time, the largest stride is searched at the nearest of :data:`STEP_TIME_PROBES` where one does.
     """
-    def fits(scale: float) -> bool:
+    def fits(candidate: StepCommand, scale: float) -> bool:
         try:
-            feasible(_scaled(command, scale))
+            feasible(_scaled(candidate, scale))
         except ZmpwalkError:
             return False
         return True
@@ -694,19 +753,30 @@ def infeasible_command(command: StepCommand, cause: ZmpwalkError,
     # the field that is largest against its own limit names the error
     limits = {"forward": MAX_STRIDE, "side": MAX_STRIDE, "turn": MAX_TURN}
     name = max(moving, key=lambda n: abs(getattr(command, n)) / limits[n])
-    if not fits(0.0):
-        return InfeasibleCommandError(name, getattr(command, name), {}, cause)
+    base = command
+    if every_step_time and not fits(command, 0.0):
+        base = next((probe for probe in _step_time_probes(command) if fits(probe, 0.0)), command)
+    step_time = base.duration if base is not command else None
+    if not fits(base, 0.0):
+        return InfeasibleCommandError(name, getattr(command, name), {}, cause, None, every_step_time)
     low, high = 0.0, 1.0
     for _ in range(STRIDE_BISECTIONS):
         middle = 0.5 * (low + high)
-        if fits(middle):
+        if fits(base, middle):
             low = middle
         else:
             high = middle
     if low == 0.0:  # only the step in place fits: the stride's direction is not the cause
-        return InfeasibleCommandError(name, getattr(command, name), {}, cause)
-    largest = _scaled(command, low)
-    return InfeasibleCommandError(name, getattr(command, name), {n: getattr(largest, n) for n in moving}, cause)
+        return InfeasibleCommandError(name, getattr(command, name), {}, cause, None, every_step_time)
+    largest = _scaled(base, low)
+    return InfeasibleCommandError(name, getattr(command, name), {n: getattr(largest, n) for n in moving}, cause,
+                                  step_time, every_step_time)
+
+
+def largest_command(command: StepCommand, error: InfeasibleCommandError) -> StepCommand:
+    """``command`` with the largest stride that fits of ``error`` (and its step time, where it names one)."""
+    duration = command.duration if error.step_time is None else error.step_time
+    return replace(command, duration=duration, **{name: error.largest.get(name, 0.0) for name in STRIDE_FIELDS})
 
 
 def _scaled(command: StepCommand, scale: float) -> StepCommand:
@@ -761,41 +831,69 @@ def plan_walk(
     sequence = list(commands)
     if sequence and not sequence[-1].stop:
         sequence.append(closing_command(sequence[-1]))
-    numbers: list[int] = []
-    starts: list[tuple[Stance, Boundary]] = []  # where each command starts from
+    walk = _Walk(robot, schedule, pelvis, sequence, labels, len(commands))
     for number, command in enumerate(sequence, start=1):
-        starts.append((stance, boundary))
+        walk.starts.append((stance, boundary))
         try:
             new, stance, boundary = plan_next(robot, schedule, stance, boundary, command, reach=False,
                                               pelvis=pelvis)
         except ZmpwalkError as error:
-            raise error.in_context(_label(labels, number)) from None
+            walk.check_reach(stages)  # a step before it beyond the legs' reach is named first
+            if not isinstance(error, STRIDE_CAUSES):  # the stride before the step time (the ZMP: the step)
+                error = step_time_rejection(command, error, walk.feasible(number))
+            raise error.in_context(walk.label(number)) from None
         stages.extend(new)
-        numbers.extend([number] * len(new))
-    try:
-        check_reach(stages, robot)
-    except UnreachableError as error:
-        number = numbers[error.stage]
-        if number > 1 and sequence[number - 1].stop:
-            number -= 1  # a stop fails for the stride before it
-        command, (start_stance, start_boundary) = sequence[number - 1], starts[number - 1]
-
-        def feasible(candidate: StepCommand) -> None:  # the command, and the stop after it
-            _, after, after_boundary = plan_next(robot, schedule, start_stance, start_boundary, candidate,
-                                                 pelvis=pelvis)
-            if not candidate.stop:
-                plan_next(robot, schedule, after, after_boundary, closing_command(candidate), pelvis=pelvis)
-
-        raise infeasible_command(command, error, feasible).in_context(_label(labels, number)) from None
+        walk.numbers.extend([number] * len(new))
+    walk.check_reach(stages)
     stages.append(standing_stage(_standing_plan(stance, robot, schedule), boundary.time))
     return stages, stance
 
 
-def _label(labels: Sequence[str] | None, number: int) -> str:
-    """The name of command ``number`` (1-based) in error messages; the closing stop is the last step."""
-    if labels is None or number > len(labels):
-        return f"step {number}"
-    return labels[number - 1]
+@dataclass
+class _Walk:
+    """What :func:`plan_walk` knows of a walk to name a rejection: the commands, their labels, where each starts."""
+
+    robot: RobotModel
+    schedule: Schedule
+    pelvis: str
+    sequence: list[StepCommand]  # the commands and the closing stop
+    labels: Sequence[str] | None
+    given: int  # commands given (the closing stop follows them)
+    starts: list[tuple[Stance, Boundary]] = field(default_factory=list)  # where each command starts from
+    numbers: list[int] = field(default_factory=list)  # each stage's command, 1-based
+
+    def check_reach(self, stages: list[Stage]) -> None:
+        """Raise for the first stage of ``stages`` beyond the legs' reach, naming its command's stride."""
+        try:
+            check_reach(stages, self.robot)
+        except UnreachableError as error:
+            number = self.numbers[error.stage]
+            if number > 1 and self.sequence[number - 1].stop:
+                number -= 1  # a stop fails for the stride before it
+            raise infeasible_command(self.sequence[number - 1], error, self.feasible(number)).in_context(
+                self.label(number)) from None
+
+    def feasible(self, number: int) -> Callable[[StepCommand], None]:
+        """Raises for a command that does not fit in place of command ``number`` (1-based), or its stop."""
+        stance, boundary = self.starts[number - 1]
+
+        def feasible(candidate: StepCommand) -> None:  # the command, and the stop after it
+            _, after, after_boundary = plan_next(self.robot, self.schedule, stance, boundary, candidate,
+                                                 pelvis=self.pelvis)
+            if not candidate.stop:
+                plan_next(self.robot, self.schedule, after, after_boundary, closing_command(candidate),
+                          pelvis=self.pelvis)
+
+        return feasible
+
+    def label(self, number: int) -> str:
+        """How error messages name command ``number`` (1-based): its label (default ``step N``, N counted from 1),
+        or for the closing stop added after the last, ``the closing stop after`` the last one's."""
+        if number > self.given:
+            return f"the closing stop after {self.label(self.given)}"
+        if self.labels is None or number > len(self.labels):
+            return f"step {number}"
+        return self.labels[number - 1]
 
 
 def _standing_plan(stance: Stance, robot: RobotModel, schedule: Schedule) -> StagePlan:
