@@ -775,8 +775,9 @@ def infeasible_command(command: StepCommand, cause: ZmpwalkError, feasible: Call
 
 def largest_command(command: StepCommand, error: InfeasibleCommandError) -> StepCommand:
     """``command`` with the largest stride that fits of ``error`` (and its step time, where it names one)."""
-    duration = command.duration if error.step_time is None else error.step_time
-    return replace(command, duration=duration, **{name: error.largest.get(name, 0.0) for name in STRIDE_FIELDS})
+    largest = error.largest
+    return replace(command, duration=command.duration if error.step_time is None else error.step_time,
+                   forward=largest.get("forward", 0.0), side=largest.get("side", 0.0), turn=largest.get("turn", 0.0))
 
 
 def _scaled(command: StepCommand, scale: float) -> StepCommand:
