@@ -439,16 +439,16 @@ def _stopping(hubo, rate, generator, steps, stop_at):
 
 
 def _walk_commanded_at(hubo, setup, delay, wait):
-    """The walk ``command`` given ``delay`` of the way from the start of the settle to 1 s after its end (None:
-    at its first tick of standing still): every tick's pose from the tick the walk starts on (the rule of the
-    module docstring), and the poses between the end of the settle and that tick."""
+    """The walk ``command`` given ``delay`` of the way from the first tick of the stop (its closing step, then
+    the settle) to 1 s after its end (None: at its first tick of standing still): every tick's pose from the
+    tick the walk starts on (the rule of the module docstring), and the poses between the end of the settle
+    and that tick."""
     from zmpwalk.online import START_DELAY
 
     rate, generator, steps, stop_at, command = setup
     walker, stop = _stopping(hubo, rate, generator, steps, stop_at)
-    settle = math.floor(stop.stages[-1].start * rate)  # about where the settle begins
     rest = stop.first_index + len(stop.rows)  # the first tick of standing still
-    given = rest if delay is None else settle + int(delay * (rest + rate - settle))
+    given = rest if delay is None else stop.first_index + int(delay * (rest + rate - stop.first_index))
     while walker._index < given:
         walker.tick()
     walker.command(command, wait=wait)
@@ -474,7 +474,7 @@ def _walk_commanded_at(hubo, setup, delay, wait):
        st.floats(0.0, 1.0), st.booleans())
 def test_a_walk_after_a_stop_is_the_same_whenever_in_the_settle_it_is_commanded(
         hubo, rate, generator, steps, stop_at, command, delay, wait):
-    """A command given at any tick of the settle that ends a stop, or after it: the walk starts from the
+    """A command given at any tick of a stop (its closing step and settle), or after it: the walk starts from the
     standing state on the tick the rule gives (the first at or after the end of the settle and START_DELAY
     after the command, without the delay with wait), and from there its pelvis and feet are those of the
     same command given with wait at the first tick of standing still, to 1e-9 m, sample for sample (before
