@@ -323,7 +323,8 @@ class OnlineWalker:
         Raises:
             InvalidParameterError: ``command`` is not a :class:`StepCommand`.
             ZmpwalkError: With ``wait``: the command is not feasible from where the walk will be when it
-                starts; the walker is unchanged.
+                starts; the walker is unchanged. As :attr:`rejection`: it names first the parameter that no
+                setting of the others makes fit (a stride out of reach at every step time, not the step time).
         """
         if not isinstance(command, StepCommand):
             raise InvalidParameterError("command", command, "a StepCommand")
