@@ -496,10 +496,10 @@ def _number(name: str, value: object) -> float:
 
 
 def servo_stiffness(robot: RobotModel) -> Array | None:
-    """Stiffness of each leg joint's position servo [N m/rad], (12,) in the joint-column order; None where the
-    robot gives none (a robot file without ``[servos]``)."""
+    """Stiffness of each leg joint's position servo or joint PD layer [N m/rad], (12,) in the joint-column order;
+    None where the robot gives none (a robot file without ``[servos]``)."""
     if robot.plant is not None:
-        return np.array([j.actuator.kp if j.actuator is not None and j.actuator.kind == "position" else np.inf
+        return np.array([j.actuator.kp if j.actuator is not None and j.actuator.servo else np.inf
                          for j in robot.plant.joints])
     if robot.servos is not None:
         return np.full(12, robot.servos.kp)

@@ -31,6 +31,10 @@ zmpwalk needs (the builder's model is the single source of truth):
   CoM's height.
 * **Limits, actuators, mass**: joint ranges per joint and side; each leg joint's
   actuator (type, ``kp``, ``kv``, force range); total mass.
+* **Joint PD layer**: a torque motor (``<motor>``), a leg joint without an actuator, and every joint of a
+  model without actuators (a URDF) is driven as a humanoid's firmware drives it, by a joint PD loop
+  ``tau = kp (q_ref - q) - kv q'`` clipped at the joint's torque limit (:func:`pd_gains`'s rule, or the
+  robot file's ``[pd]``); the simulation runs it as a position servo (:mod:`zmpwalk.sim.plant`).
 """
 
 from __future__ import annotations
@@ -44,7 +48,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from zmpwalk.errors import FileFormatError
+from zmpwalk.errors import FileFormatError, InvalidParameterError
 from zmpwalk.leg_chain import LegChain
 from zmpwalk.robots.model import RobotModel, schedule_scale
 from zmpwalk.zmp import convex_hull
@@ -55,18 +59,34 @@ ROLES = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll"
 FOOT_TIE = 0.005  # [m] two foot candidates this close in height on one side are ambiguous
 SOLE_BAND = 0.002  # [m] collision points this close to the lowest form the sole
 READY_STRETCH = 0.92  # [-] hip-to-ankle distance of the ready posture, at most this fraction of the straight leg
+PHYSICS_STEP = 0.001  # [s] the simulation's physics step at most (zmpwalk.sim.plant), the PD layer's period
+PD_BANDWIDTH = 2 * math.pi * 4.0  # [rad/s] omega: a PD joint's natural frequency on its own inertia, at least
+PD_DAMPING_RATIO = 1.0  # [-] zeta: damping of a PD joint on its own inertia (critical)
+PD_LOAD_STIFFNESS = 2.0  # [-] kappa: a PD joint is at least this many times the weight moment it holds per rad
+PD_STEP_LIMIT = 0.5  # [-] beta: sqrt(kp / I) times the physics step at most (discrete stability below 2)
+PD_PREFIX = "zmpwalk_pd_"  # name of the actuator the simulation adds to a joint the model leaves unactuated
+
+ACTUATOR_LABELS = {"position": "position servo", "motor": "torque motor + PD", "none": "PD (no actuator)",
+                   "general": "general"}
 
 
 @dataclass(frozen=True)
 class Actuator:
-    """The actuator driving one leg joint in the model.
+    """The actuator driving one joint, as the simulation runs it.
 
     Attributes:
-        name: Actuator name in the model.
-        kind: ``"position"`` (``kp (u - q) - kv q'``), ``"motor"`` (torque) or ``"general"``.
-        kp: Position gain [N m/rad] (0 for a motor).
-        kv: Velocity gain [N m s/rad] (0 for a motor).
-        force_limit: Largest |torque| the actuator or the joint allows [N m] (inf where unlimited).
+        name: Actuator name in the model (``zmpwalk_pd_JOINT`` where the model has none and the simulation adds one).
+        kind: The model's actuator: ``"position"`` (a servo ``kp (u - q) - kv q'``), ``"motor"`` (torque),
+            ``"general"`` (anything else), or ``"none"`` (the joint has no actuator in the model).
+        kp: Position gain [N m/rad]: the servo's, or the PD layer's (0 for a motor or general actuator without one).
+        kv: Velocity gain [N m s/rad], likewise.
+        force_limit: Largest |torque| the actuator or the joint allows [N m] (inf where unlimited): a motor's
+            ``ctrlrange`` times its gain and gear, the actuator's ``forcerange`` times its gear, the joint's
+            ``actuatorfrcrange`` (a URDF's ``<limit effort>``), the smallest that applies.
+        pd_layer: The joint is driven by a joint PD loop (a humanoid's firmware): ``kp``, ``kv`` from
+            :func:`pd_gains` or the robot file's ``[pd]``, the torque clipped at ``force_limit``.
+        inertia: The joint's reflected inertia ``I`` at the ready posture, from which the PD layer's gains are
+            derived [kg m^2] (nan without the PD layer).
     """
 
     name: str
@@ -74,6 +94,18 @@ class Actuator:
     kp: float  # [N m/rad]
     kv: float  # [N m s/rad]
     force_limit: float  # [N m]
+    pd_layer: bool = False
+    inertia: float = math.nan  # [kg m^2]
+
+    @property
+    def servo(self) -> bool:
+        """Whether the simulation drives the joint with angles: a position servo or the PD layer."""
+        return self.kind == "position" or self.pd_layer
+
+    @property
+    def label(self) -> str:
+        """What drives the joint, in words: ``position servo``, ``torque motor + PD``, ``PD (no actuator)``."""
+        return ACTUATOR_LABELS.get(self.kind, self.kind)
 
 
 @dataclass(frozen=True)
@@ -116,6 +148,7 @@ class ModelPlant:
         keyframe: The keyframe of the reference pose, or None (the zero pose).
         rest_mass: Mass of everything but the leg segments (rigid with the base) [kg].
         rest_com: Its centre of mass in the pelvis frame [m].
+        pd_joints: Every joint driven by the joint PD layer, leg joints included: (joint name, its actuator).
     """
 
     path: Path
@@ -130,6 +163,7 @@ class ModelPlant:
     keyframe: str | None = None
     rest_mass: float = 0.0  # [kg]
     rest_com: tuple[float, float, float] = (0.0, 0.0, 0.0)  # [m]
+    pd_joints: tuple[tuple[str, Actuator], ...] = ()
 
 
 def load_model(path: Path, package_paths: tuple[Path, ...] = ()) -> Any:
@@ -202,7 +236,8 @@ def _resolve_packages(path: Path, package_paths: tuple[Path, ...]) -> str:
 
 def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyframe: str | None = None,
                  package_paths: tuple[Path, ...] = (), name: str | None = None,
-                 overrides: dict[str, float] | None = None) -> RobotModel:
+                 overrides: dict[str, float] | None = None,
+                 pd_gains: dict[str, tuple[float, float | None]] | None = None) -> RobotModel:
     """The :class:`~zmpwalk.robots.model.RobotModel` of an MJCF or URDF model (see the module docstring).
 
     Args:
@@ -212,10 +247,13 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
         package_paths: Folders holding the packages of a URDF's ``package://`` paths.
         name: Short name (default: the model's).
         overrides: Robot-file values replacing derived ones (``pelvis_height``, ``dsp_time``, ...).
+        pd_gains: The PD layer's gains of some joints (model joint name -> (kp [N m/rad], kv [N m s/rad] or
+            None: critical damping)) replacing :func:`pd_gains`'s (a robot file's ``[pd]``).
 
     Raises:
         FileFormatError: What the model lacks for walking, named (no floating base, no legs, a leg of
             other than six hinge joints, ambiguous feet, ...).
+        InvalidParameterError: ``pd_gains`` names a joint the PD layer does not drive.
     """
     import mujoco
 
@@ -396,6 +434,12 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
             com_offset = new_offset
             break
         com_offset = new_offset
+    # The joint PD layer: gains from the ready posture's inertia; a leg joint holds the robot, m g l.
+    pd_joints = _pd_layer(model, data, qpos, leg_joint_ids, mass * float(np.linalg.norm(model.opt.gravity)) * pendulum,
+                          pd_gains or {})
+    driven = dict(pd_joints)
+    leg_joints = [replace(joint, actuator=driven.get(joint.name, joint.actuator)) for joint in leg_joints]
+    plant = replace(plant, joints=tuple(leg_joints), pd_joints=pd_joints)
     # The HUBO tables scaled to this robot (docs/robot-import.md): times with sqrt(l/g), strides and foot lift
     # with the leg length, sway and V_y with the hip spacing.
     time_scale, length_scale, lateral_scale = schedule_scale(pendulum, thigh + shank, hip_spacing)
@@ -445,6 +489,9 @@ def _keyframe(model: object, keyframe: str | None, source: str) -> int:
     if keyframe is None:
         return 0 if model.nkey else -1  # type: ignore[attr-defined]
     key = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, keyframe)
+    unnamed = re.fullmatch(r"#(\d+)", keyframe)  # an unnamed keyframe, by its index (as _name writes it)
+    if key < 0 and unnamed and int(unnamed.group(1)) < model.nkey:  # type: ignore[attr-defined]
+        key = int(unnamed.group(1))
     if key < 0:
         known = [_name(model, mujoco.mjtObj.mjOBJ_KEY, k) for k in range(model.nkey)]  # type: ignore[attr-defined]
         raise FileFormatError(source, f"no keyframe {keyframe!r}; the model has: {', '.join(known) or 'none'}")
@@ -650,6 +697,8 @@ def is_position_servo(model: Any, actuator: int) -> bool:
 
 
 def _actuator(model: object, joint: int) -> Actuator | None:
+    """The model's actuator of ``joint`` (the first with a joint transmission to it), or None; its ``kp``, ``kv``
+    are the model's (0 for a motor: see :func:`_pd_layer`)."""
     import mujoco
 
     m = model
@@ -660,14 +709,129 @@ def _actuator(model: object, joint: int) -> Actuator | None:
         gain, bias = m.actuator_gainprm[a], m.actuator_biasprm[a]  # type: ignore[attr-defined]
         if is_position_servo(m, a):
             kind, kp, kv = "position", float(gain[0]) * gear, float(-bias[2]) * gear
-        elif m.actuator_biastype[a] == mujoco.mjtBias.mjBIAS_NONE:  # type: ignore[attr-defined]
+        elif _is_motor(m, a):
             kind, kp, kv = "motor", 0.0, 0.0
         else:
             kind, kp, kv = "general", float(gain[0]), float(-bias[2])
-        limit = math.inf
+        limit = _joint_torque_limit(m, joint)
         if m.actuator_forcelimited[a]:  # type: ignore[attr-defined]
             limit = min(limit, float(np.max(np.abs(m.actuator_forcerange[a]))) * abs(gear))  # type: ignore[attr-defined]
-        if m.jnt_actfrclimited[joint]:  # type: ignore[attr-defined]
-            limit = min(limit, float(np.max(np.abs(m.jnt_actfrcrange[joint]))))  # type: ignore[attr-defined]
+        if kind == "motor" and m.actuator_ctrllimited[a]:  # type: ignore[attr-defined]
+            limit = min(limit, float(np.max(np.abs(m.actuator_ctrlrange[a]))) * abs(float(gain[0]) * gear))  # type: ignore[attr-defined]
         return Actuator(_name(m, mujoco.mjtObj.mjOBJ_ACTUATOR, a), kind, kp, kv, limit)
     return None
+
+
+def _is_motor(model: Any, actuator: int) -> bool:
+    """Whether an actuator is a torque motor on a joint: ``gain ctrl`` (MuJoCo ``<motor>``: fixed gain, no bias,
+    no activation dynamics)."""
+    import mujoco
+
+    return bool(model.actuator_trntype[actuator] == mujoco.mjtTrn.mjTRN_JOINT
+                and model.actuator_biastype[actuator] == mujoco.mjtBias.mjBIAS_NONE
+                and model.actuator_gaintype[actuator] == mujoco.mjtGain.mjGAIN_FIXED
+                and model.actuator_dyntype[actuator] == mujoco.mjtDyn.mjDYN_NONE)
+
+
+def _joint_torque_limit(model: Any, joint: int) -> float:
+    """The joint's own limit on its actuators' total torque, ``actuatorfrcrange`` (a URDF's ``<limit effort>``)
+    [N m]; inf where it has none."""
+    if not model.jnt_actfrclimited[joint]:
+        return math.inf
+    return float(np.max(np.abs(model.jnt_actfrcrange[joint])))
+
+
+def pd_gains(inertia: float, moment: float, timestep: float = PHYSICS_STEP) -> tuple[float, float]:
+    r"""The joint PD layer's gains of one joint: stiffness ``kp`` [N m/rad] and damping ``kv`` [N m s/rad].
+
+    .. math::
+
+        k_p = \min\left(\max(I \omega^2,\ \kappa W),\ I (\beta / \Delta t)^2\right), \qquad
+        k_v = 2 \zeta \sqrt{k_p I}
+
+    with :data:`PD_BANDWIDTH` ``omega`` (the joint swings on its own inertia at least this fast),
+    :data:`PD_LOAD_STIFFNESS` ``kappa`` times the weight moment ``W`` it holds (a leg joint holds the robot on
+    one foot, ``W = m g l``, whose toppling moment grows by ``m g l`` per radian of lean: at ``kappa = 2`` the
+    joint's net stiffness against it is still ``m g l``, above the 1.7 ``m g l`` below which the stabilizer
+    stiffens servos with its encoder loop), the discrete bound :data:`PD_STEP_LIMIT` ``beta``
+    (``sqrt(kp / I) dt <= beta``, and so ``kv dt / I <= 2 zeta beta``: stable at the physics step even where the
+    damping is integrated explicitly, the bound being 2) and :data:`PD_DAMPING_RATIO` ``zeta`` (critical damping
+    of the joint swinging on its own inertia).
+
+    Args:
+        inertia: ``I``, the joint's reflected inertia: the diagonal of the joint-space mass matrix at the ready
+            posture, the rotor's armature included [kg m^2].
+        moment: ``W``, the weight moment the joint holds [N m] (0: the bandwidth alone).
+        timestep: ``dt``, the period of the PD loop, the physics step [s].
+
+    Raises:
+        InvalidParameterError: A non-positive inertia or time step, or a negative moment.
+    """
+    if not inertia > 0 or not math.isfinite(inertia):
+        raise InvalidParameterError("inertia", inertia, "a finite reflected inertia > 0 kg m^2")
+    if not timestep > 0:
+        raise InvalidParameterError("timestep", timestep, "a physics step > 0 s")
+    if not moment >= 0:
+        raise InvalidParameterError("moment", moment, "a weight moment >= 0 N m")
+    kp = max(inertia * PD_BANDWIDTH ** 2, PD_LOAD_STIFFNESS * moment)
+    kp = min(kp, inertia * (PD_STEP_LIMIT / timestep) ** 2)
+    return kp, 2.0 * PD_DAMPING_RATIO * math.sqrt(kp * inertia)
+
+
+def _weight_moment(model: Any, data: Any, joint: int) -> float:
+    """The largest moment of the weight of the bodies a hinge moves about its axis [N m]: their mass times g
+    times their centre of mass's distance from the axis line."""
+    body = int(model.jnt_bodyid[joint])
+    axis = data.xaxis[joint]
+    lever = data.subtree_com[body] - data.xanchor[joint]
+    distance = float(np.linalg.norm(lever - axis * float(axis @ lever)))
+    return float(model.body_subtreemass[body]) * float(np.linalg.norm(model.opt.gravity)) * distance
+
+
+def _pd_layer(model: Any, data: Any, qpos: Array, leg_joints: set[int], leg_moment: float,
+              given: dict[str, tuple[float, float | None]]) -> tuple[tuple[str, Actuator], ...]:
+    """The joints the PD layer drives, with their actuators (gains from :func:`pd_gains` at the posture ``qpos``,
+    or ``given``: joint name -> (kp, kv or None for critical damping)): every torque motor on a hinge or slide,
+    every leg joint without an actuator, and every joint of a model without actuators (a URDF). A leg joint holds
+    ``leg_moment`` [N m]; another hinge the weight of what it moves (:func:`_weight_moment`); a slide nothing.
+
+    Raises:
+        InvalidParameterError: ``given`` names a joint the layer does not drive, or a leg joint's torque
+            limit is 0.
+    """
+    import mujoco
+
+    data.qpos[:] = qpos
+    mujoco.mj_forward(model, data)
+    inertia = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, inertia)
+    timestep = min(float(model.opt.timestep), PHYSICS_STEP)
+    layer = []
+    for j in range(model.njnt):
+        hinge = int(model.jnt_type[j]) == mujoco.mjtJoint.mjJNT_HINGE  # a numpy integer is never `in` enums
+        if not hinge and int(model.jnt_type[j]) != mujoco.mjtJoint.mjJNT_SLIDE:
+            continue
+        name = _name(model, mujoco.mjtObj.mjOBJ_JOINT, j)
+        existing = _actuator(model, j)
+        if existing is None and (j in leg_joints or model.nu == 0):
+            existing = Actuator(PD_PREFIX + name, "none", 0.0, 0.0, _joint_torque_limit(model, j))
+        if existing is None or existing.kind not in ("motor", "none"):
+            continue
+        if existing.force_limit == 0.0:
+            if j in leg_joints:
+                raise InvalidParameterError(f"{name} torque limit", 0.0, "a leg joint's torque limit > 0 N m "
+                                            "(actuatorfrcrange, a URDF's <limit effort>, the motor's ctrlrange)")
+            continue  # the model holds it passive
+        dof = int(model.jnt_dofadr[j])
+        moment = leg_moment if j in leg_joints else _weight_moment(model, data, j) if hinge else 0.0
+        reflected = float(inertia[dof, dof])
+        kp, kv = pd_gains(reflected, moment, timestep)
+        if name in given:
+            kp, wanted = given[name]
+            kv = 2.0 * PD_DAMPING_RATIO * math.sqrt(kp * reflected) if wanted is None else wanted
+        layer.append((name, replace(existing, kp=kp, kv=kv, pd_layer=True, inertia=reflected)))
+    unknown = sorted(set(given) - {name for name, _ in layer})
+    if unknown:
+        raise InvalidParameterError("pd joint", unknown[0], "a joint the PD layer drives (a torque motor's or an "
+                                    "unactuated leg joint): " + ", ".join(name for name, _ in layer))
+    return tuple(layer)

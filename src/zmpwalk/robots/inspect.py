@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from zmpwalk.kinematics import JOINT_COLUMNS
+from zmpwalk.robots.imported import PD_BANDWIDTH, PD_DAMPING_RATIO, PD_LOAD_STIFFNESS, Actuator
 from zmpwalk.robots.model import RobotModel
 
 if TYPE_CHECKING:
@@ -51,16 +52,25 @@ def robot_summary(robot: RobotModel, statics: StaticTorques | None = None) -> di
         summary["joints"] = [
             {"column": column, "name": joint.name, "axis": list(joint.axis), "sign": joint.sign,
              "zero_offset": joint.zero_offset, "limits": list(joint.limits),
-             "actuator": None if joint.actuator is None else {
-                 "name": joint.actuator.name, "kind": joint.actuator.kind, "kp": joint.actuator.kp,
-                 "kv": joint.actuator.kv, "force_limit": joint.actuator.force_limit}}
+             "actuator": None if joint.actuator is None else _actuator_summary(joint.actuator)}
             for column, joint in zip(JOINT_COLUMNS, plant.joints, strict=True)]
+        legs = {joint.name for joint in plant.joints}
+        summary["pd_joints"] = {name: _actuator_summary(actuator) for name, actuator in plant.pd_joints
+                                if name not in legs}
         if statics is not None:
             for i, joint in enumerate(summary["joints"]):
                 joint["static_torque"] = {"both_feet": float(statics.both_feet[i]),
                                           "on_left": float(statics.on_left[i]), "on_right": float(statics.on_right[i])}
             summary["static_torque_over_limit"] = statics.over_limit
     return summary
+
+
+def _actuator_summary(actuator: Actuator) -> dict[str, Any]:
+    """One actuator as plain data: ``kind`` the model's (position, motor, general, none), ``drive`` in words
+    (position servo, torque motor + PD, PD (no actuator)), ``pd_layer``, gains [N m/rad, N m s/rad], the torque
+    limit [N m] and, for the PD layer, the reflected inertia its gains come from [kg m^2]."""
+    return {"name": actuator.name, "kind": actuator.kind, "drive": actuator.label, "pd_layer": actuator.pd_layer,
+            "kp": actuator.kp, "kv": actuator.kv, "force_limit": actuator.force_limit, "inertia": actuator.inertia}
 
 
 def _mm(value: float) -> str:
@@ -92,20 +102,16 @@ def robot_table(robot: RobotModel, statics: StaticTorques | None = None) -> str:
         lines.append("IK: " + ", ".join(f"{k} {v} (hip axes {s['hip_axes_offset'][k] * 1e3:.1f} mm apart, ankle "
                                         f"{s['ankle_axes_offset'][k] * 1e3:.1f} mm)" for k, v in s["ik"].items()))
         lines.append("")
-        header = (f"{'column':<18} {'model joint':<22} {'axis':<16} {'sign':>4} {'zero':>7} {'range [rad]':>17} "
-                  f"{'actuator':<9} {'kp':>8} {'kv':>7} {'max [N m]':>9}"
-                  + (f" {'2 feet':>7} {'1 foot':>7}" if statics is not None else ""))
-        lines += [header, "-" * len(header)]
-        first = len(lines)
-        for joint in s["joints"]:
-            actuator = joint["actuator"] or {"kind": "none", "kp": math.nan, "kv": math.nan, "force_limit": math.nan}
-            axis = "(" + ", ".join(f"{v:+.2f}" for v in joint["axis"]) + ")"
-            lines.append(f"{joint['column']:<18} {joint['name']:<22} {axis:<16} {joint['sign']:>+4d} "
-                         f"{joint['zero_offset']:>+7.3f} [{joint['limits'][0]:>+7.3f}, {joint['limits'][1]:>+7.3f}] "
-                         f"{actuator['kind']:<9} {actuator['kp']:>8.1f} {actuator['kv']:>7.2f} "
-                         f"{actuator['force_limit']:>9.1f}"
-                         + (f" {abs(statics.both_feet[len(lines) - first]):>7.1f} "
-                            f"{statics.one_foot[len(lines) - first]:>7.1f}" if statics is not None else ""))
+        lines += _joint_lines(s["joints"], statics)
+        if any(joint["actuator"] and joint["actuator"]["pd_layer"] for joint in s["joints"]) or s["pd_joints"]:
+            lines.append(f"PD layer (the firmware's joint loop, run at the physics step, clipped at 'max'): kp = "
+                         f"max(I w^2, {PD_LOAD_STIFFNESS:g} W) with w = 2 pi x {PD_BANDWIDTH / (2 * math.pi):g} Hz, "
+                         f"W = m g l = {robot.mass * robot.gravity * robot.pendulum_length:.1f} N m for a leg joint; "
+                         f"kv = 2 x {PD_DAMPING_RATIO:g} sqrt(kp I); I [kg m^2] its reflected inertia "
+                         "(docs/robot-import.md), or the robot file's [pd]")
+        if s["pd_joints"]:
+            lines.append("held by the PD layer (kp [N m/rad], kv [N m s/rad], max [N m]): " + ", ".join(
+                f"{name} {a['kp']:.1f}/{a['kv']:.2f}/{a['force_limit']:.3g}" for name, a in s["pd_joints"].items()))
         if statics is not None:
             lines.append("2 feet, 1 foot: static torque [N m] holding the ready posture on both feet, and on one foot "
                          "with the centre of mass over its sole (the larger of the two feet)")
@@ -114,6 +120,27 @@ def robot_table(robot: RobotModel, statics: StaticTorques | None = None) -> str:
         if s["held_joints"]:
             lines.append(f"held at the reference pose: {', '.join(s['held_joints'])}")
     return "\n".join(lines)
+
+
+def _joint_lines(joints: list[dict[str, Any]], statics: StaticTorques | None) -> list[str]:
+    """The leg joints' table: column, model joint, axis, sign, zero, range, what drives it and its gains, the
+    torque limit, and the static torques where given."""
+    header = (f"{'column':<18} {'model joint':<22} {'axis':<16} {'sign':>4} {'zero':>7} {'range [rad]':>17} "
+              f"{'actuator':<17} {'kp':>8} {'kv':>7} {'I':>7} {'max [N m]':>9}"
+              + (f" {'2 feet':>7} {'1 foot':>7}" if statics is not None else ""))
+    lines = [header, "-" * len(header)]
+    for index, joint in enumerate(joints):
+        actuator = joint["actuator"] or {"drive": "none", "kp": math.nan, "kv": math.nan, "force_limit": math.nan,
+                                         "inertia": math.nan}
+        axis = "(" + ", ".join(f"{v:+.2f}" for v in joint["axis"]) + ")"
+        inertia = "-" if math.isnan(actuator["inertia"]) else f"{actuator['inertia']:.4f}"
+        lines.append(f"{joint['column']:<18} {joint['name']:<22} {axis:<16} {joint['sign']:>+4d} "
+                     f"{joint['zero_offset']:>+7.3f} [{joint['limits'][0]:>+7.3f}, {joint['limits'][1]:>+7.3f}] "
+                     f"{actuator['drive']:<17} {actuator['kp']:>8.1f} {actuator['kv']:>7.2f} {inertia:>7} "
+                     f"{actuator['force_limit']:>9.1f}"
+                     + (f" {abs(statics.both_feet[index]):>7.1f} {statics.one_foot[index]:>7.1f}"
+                        if statics is not None else ""))
+    return lines
 
 
 def robot_toml(robot: RobotModel, folder: Path) -> str:
@@ -143,8 +170,15 @@ def robot_toml(robot: RobotModel, folder: Path) -> str:
               "", "[walking]",
               f"dsp_time = {robot.dsp_time:.6g}   # [s] double-support time d (HUBO's 0.1 s, time-scaled)",
               f"foot_lift = {robot.foot_lift:.6g}   # [m] swing apex height (HUBO's 0.04 m, length-scaled)",
-              f"lateral_velocity = {robot.lateral_velocity:.6g}   # [m] V_y of Eq. 20 (HUBO's 0.1 m, lateral-scaled)",
-              "", "# Derived from the model (for checking; edit the model, not these lines):"]
+              f"lateral_velocity = {robot.lateral_velocity:.6g}   # [m] V_y of Eq. 20 (HUBO's 0.1 m, lateral-scaled)"]
+    if robot.plant is not None and robot.plant.pd_joints:
+        lines += ["", "[pd]",
+                  "# The joint PD layer (the firmware's joint loop) of each torque motor or unactuated joint:",
+                  "# kp [N m/rad], kv [N m s/rad] (kv may be left out: critical damping). Derived by zmpwalk's rule",
+                  "# (docs/robot-import.md); put your firmware's gains here."]
+        lines += [f"{_quote(name)} = {{kp = {actuator.kp:.6g}, kv = {actuator.kv:.6g}}}"
+                  for name, actuator in robot.plant.pd_joints]
+    lines += ["", "# Derived from the model (for checking; edit the model, not these lines):"]
     lines += [f"#   {line}" if line else "#" for line in robot_table(robot).splitlines()]
     return "\n".join(lines) + "\n"
 

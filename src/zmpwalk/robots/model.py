@@ -307,13 +307,45 @@ def _robot_from_model_table(data: dict[str, Any], path: Path) -> RobotModel:
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
                 raise FileFormatError(source, f"[{section}] {key} = {value!r} must be a number > 0")
             overrides[key] = float(value)
-    unknown = set(data) - {"model", *_MODEL_OVERRIDES}
+    unknown = set(data) - {"model", "pd", *_MODEL_OVERRIDES}
     if unknown:
         raise FileFormatError(source, f"unknown table(s) {', '.join(sorted(unknown))} in a robot file with [model]")
     packages = tuple(path.parent / str(p) for p in table.get("package_paths", []))
-    return import_robot(path.parent / str(table["file"]), feet=(feet[0], feet[1]) if feet else None,
-                        keyframe=table.get("keyframe"), package_paths=packages, name=table.get("name"),
-                        overrides=overrides)
+    try:
+        return import_robot(path.parent / str(table["file"]), feet=(feet[0], feet[1]) if feet else None,
+                            keyframe=table.get("keyframe"), package_paths=packages, name=table.get("name"),
+                            overrides=overrides, pd_gains=_pd_table(data.get("pd"), source))
+    except InvalidParameterError as error:
+        raise FileFormatError(source, f"[pd] {error}") from None
+
+
+def _pd_table(table: object, source: str) -> dict[str, tuple[float, float | None]]:
+    """The ``[pd]`` table of a model robot file: the joint PD layer's gains per model joint,
+    ``JOINT = {kp = [N m/rad], kv = [N m s/rad]}`` (``kv`` may be left out: critical damping)."""
+    if table is None:
+        return {}
+    if not isinstance(table, dict):
+        raise FileFormatError(source, "[pd] must be a table: JOINT = {kp = N m/rad, kv = N m s/rad}")
+    gains: dict[str, tuple[float, float | None]] = {}
+    for joint, entry in table.items():
+        if not isinstance(entry, dict) or "kp" not in entry or set(entry) - {"kp", "kv"}:
+            raise FileFormatError(source, f"[pd] {joint} must be {{kp = N m/rad, kv = N m s/rad}} (kv may be left "
+                                  "out: critical damping)")
+        values: list[float | None] = []
+        for key in ("kp", "kv"):
+            value = entry.get(key)
+            if value is None:
+                values.append(None)
+            elif isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
+                    or not value > 0:
+                raise FileFormatError(source, f"[pd] {joint} {key} = {value!r} must be a finite number > 0")
+            else:
+                values.append(float(value))
+        kp = values[0]
+        if kp is None:  # pragma: no cover - "kp" is required above
+            raise FileFormatError(source, f"[pd] {joint} needs kp")
+        gains[str(joint)] = (kp, values[1])
+    return gains
 
 
 def _table(kind: type[Any], table: object, name: str, source: str) -> Any:

@@ -9,11 +9,13 @@ model, unmodified in its meshes, masses, inertias, contacts and actuators, with:
   (a site in the foot body, axes of the foot frame), the pose of the base and of each ankle, and each
   leg joint's angle, rate and actuator torque (``jointactuatorfrc``);
 * a time step of at most :data:`MAX_TIMESTEP` (the 1 kHz servo period of the references);
+* the joint PD layer a humanoid's firmware runs, where the model has torque motors or no actuators
+  (:func:`add_pd_layer`);
 * the leg joints' actuators driven by the joint trajectory, every other actuator holding the
-  reference pose (the keyframe's controls).
+  reference pose (the keyframe's controls; the reference angle for a joint of the PD layer).
 
-The leg actuators must be position servos (MuJoCo ``<position>`` or an equivalent ``general``):
-zmpwalk sends joint angles.
+The leg joints must be driven by position servos (MuJoCo ``<position>`` or an equivalent ``general``) or by
+the PD layer: zmpwalk sends joint angles.
 """
 
 from __future__ import annotations
@@ -27,12 +29,19 @@ from numpy.typing import NDArray
 
 from zmpwalk.errors import InvalidParameterError
 from zmpwalk.kinematics import JOINT_COLUMNS
-from zmpwalk.robots.imported import collision_points, is_position_servo, load_model_spec, rigid_bodies
+from zmpwalk.robots.imported import (
+    PHYSICS_STEP,
+    ModelPlant,
+    collision_points,
+    is_position_servo,
+    load_model_spec,
+    rigid_bodies,
+)
 from zmpwalk.robots.model import RobotModel
 
 Array = NDArray[np.float64]
 
-MAX_TIMESTEP = 0.001  # [s]
+MAX_TIMESTEP = PHYSICS_STEP  # [s]
 
 
 @dataclass
@@ -60,8 +69,8 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
     """The plant of ``robot`` (see the module docstring).
 
     Raises:
-        InvalidParameterError: A leg joint without a position actuator, or a mass scale on an imported
-            model (its masses are the builder's).
+        InvalidParameterError: A leg joint driven by neither a position servo nor the PD layer, or a mass scale
+            on an imported model (its masses are the builder's).
     """
     if robot.plant is None:
         from zmpwalk.sim.mjcf import robot_mjcf
@@ -79,6 +88,7 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
         spec.option.timestep = MAX_TIMESTEP
     if not any(g.type == mujoco.mjtGeom.mjGEOM_PLANE for g in spec.worldbody.geoms):
         spec.worldbody.add_geom(name="zmpwalk_floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 0.05])
+    add_pd_layer(spec, plant)
     # Zero pose of the legs, base at the origin: where the ankle points sit in the foot bodies.
     data = mujoco.MjData(model)
     joint_ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint.name) for joint in plant.joints]
@@ -120,14 +130,56 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
     model = spec.compile()
     actuators = []
     for column, joint in zip(JOINT_COLUMNS, plant.joints, strict=True):
-        if joint.actuator is None or joint.actuator.kind != "position":
+        if joint.actuator is None or not joint.actuator.servo:
             kind = "none" if joint.actuator is None else joint.actuator.kind
-            raise InvalidParameterError(f"{column} actuator", kind, "a position servo (MuJoCo <position>): "
-                                        "zmpwalk drives the leg joints with joint angles")
+            raise InvalidParameterError(f"{column} actuator", kind, "a position servo (MuJoCo <position>) or a "
+                                        "torque motor (<motor>, driven by the PD layer): zmpwalk drives the leg "
+                                        "joints with joint angles")
         actuators.append(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, joint.actuator.name))
     leg_qpos = np.array([model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j.name)]
                          for j in plant.joints])
-    return Plant(model, np.array(actuators), leg_qpos, np.array(plant.ctrl_reference), qpos, True)
+    return Plant(model, np.array(actuators), leg_qpos, _held_controls(model, plant), qpos, True)
+
+
+def add_pd_layer(spec: mujoco.MjSpec, plant: ModelPlant) -> None:
+    r"""Run the joint PD layer of :attr:`ModelPlant.pd_joints` in ``spec``, as a humanoid's firmware runs it.
+
+    Each joint's torque motor (or, where the joint has none, a new actuator ``zmpwalk_pd_JOINT``) becomes a
+    position servo of the layer's gains, gear 1, its force clipped at the joint's torque limit:
+
+    .. math:: \tau = \mathrm{clip}(k_p (u - q) - k_v \dot q,\ -\tau_{max},\ \tau_{max})
+
+    MuJoCo then runs the PD law at every physics step (1 kHz, as firmware does). A control ``u = q_ref +
+    tau_ff / kp`` (:func:`servo_offsets`) is the same as a feedforward torque: ``kp (q_ref + tau_ff / kp - q)
+    = kp (q_ref - q) + tau_ff``. The motor's control range (a torque) is dropped: the control is an angle.
+    """
+    for joint, actuator in plant.pd_joints:
+        if actuator.kind == "motor":
+            servo = spec.actuator(actuator.name)
+        else:
+            servo = spec.add_actuator(name=actuator.name, target=joint, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+        servo.dyntype = mujoco.mjtDyn.mjDYN_NONE
+        servo.gaintype = mujoco.mjtGain.mjGAIN_FIXED
+        servo.biastype = mujoco.mjtBias.mjBIAS_AFFINE
+        servo.gainprm = [actuator.kp] + [0.0] * 9
+        servo.biasprm = [0.0, -actuator.kp, -actuator.kv] + [0.0] * 7
+        servo.gear = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+        servo.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
+        limited = math.isfinite(actuator.force_limit)
+        servo.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE if limited else mujoco.mjtLimited.mjLIMITED_FALSE
+        if limited:
+            servo.forcerange = [-actuator.force_limit, actuator.force_limit]
+
+
+def _held_controls(model: mujoco.MjModel, plant: ModelPlant) -> Array:
+    """Controls (nu,) that hold the reference pose: the keyframe's, and for a joint of the PD layer its reference
+    angle (a motor's keyframe control is a torque; the actuators the layer adds come after the model's)."""
+    controls = np.zeros(model.nu)
+    controls[:len(plant.ctrl_reference)] = plant.ctrl_reference
+    for joint, actuator in plant.pd_joints:
+        address = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint)]
+        controls[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, actuator.name)] = plant.qpos_reference[address]
+    return controls
 
 
 def set_initial_state(plant: Plant, data: mujoco.MjData, position_base: Array, yaw: float, angles: Array,
