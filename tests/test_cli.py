@@ -153,7 +153,7 @@ def test_planning_errors_name_the_file_the_table_and_the_walked_step(tmp_path, c
     steps.write_text("[[steps]]\nduration = 0.8\nforward = 0.1\nrepeat = 3\n[[steps]]\nduration = 0.8\nforward = 0.9\n")
     assert main(["plan", str(steps)]) == 2
     err = capsys.readouterr().err
-    assert f"{steps}: step 4 ([[steps]] 2): forward = 0.9 is not allowed" in err
+    assert f"{steps}: [[steps]] 2: forward = 0.9 is not allowed" in err
     assert "at most 0.4" in err and " m forward (forward = 0.4" in err and "right ankle out of reach" in err
 
 

@@ -91,11 +91,11 @@ def test_unknown_names():
 
 
 @pytest.mark.parametrize("text, message", [
-    ("[[steps]]\nduration = 0.8\nforwrd = 0.1\n", r"step 1: unknown field 'forwrd'"),
-    ("[[steps]]\nforward = 0.1\n", r"step 1: missing field 'duration'"),
-    ("[[steps]]\nduration = 0.8\n[[steps]]\nduration = -1\n", r"step 2: duration = -1"),
-    ("[[steps]]\nduration = 0.8\nrepeat = 0\n", r"step 1: repeat = 0"),
-    ("[[steps]]\nduration = 0.8\nforward = 'far'\n", r"step 1: forward = 'far'"),
+    ("[[steps]]\nduration = 0.8\nforwrd = 0.1\n", r"\[\[steps\]\] 1: unknown field 'forwrd'"),
+    ("[[steps]]\nforward = 0.1\n", r"\[\[steps\]\] 1: missing field 'duration'"),
+    ("[[steps]]\nduration = 0.8\n[[steps]]\nduration = -1\n", r"\[\[steps\]\] 2: duration = -1"),
+    ("[[steps]]\nduration = 0.8\nrepeat = 0\n", r"\[\[steps\]\] 1: repeat = 0"),
+    ("[[steps]]\nduration = 0.8\nforward = 'far'\n", r"\[\[steps\]\] 1: forward = 'far'"),
     ("steps = 3\n", r"no \[\[steps\]\]"),
     ("[[steps]\nduration = 0.8\n", r"not valid TOML"),
     ("", r"no \[\[steps\]\]"),

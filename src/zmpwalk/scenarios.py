@@ -39,7 +39,9 @@ def parse_steps(data: dict[str, Any], source: str) -> list[StepCommand]:
 
 
 def parse_steps_with_labels(data: dict[str, Any], source: str) -> tuple[list[StepCommand], list[str]]:
-    """Step commands and, for each, how an error names it: ``step 7 ([[steps]] 3)`` after repeats."""
+    """Step commands and, for each, how an error names it: by its ``[[steps]]`` table as the user counts them
+    (from 1), ``[[steps]] 3`` or, for a table that repeats, ``[[steps]] 3, repeat 2 of 4``; an error in the
+    file itself names the table the same way."""
     unknown = set(data) - {"steps", "description"}
     if unknown:
         raise FileFormatError(source, f"unknown top-level key {sorted(unknown)[0]!r}; expected [[steps]]")
@@ -49,7 +51,7 @@ def parse_steps_with_labels(data: dict[str, Any], source: str) -> tuple[list[Ste
     commands: list[StepCommand] = []
     labels: list[str] = []
     for number, table in enumerate(steps, start=1):
-        where = f"step {number}"
+        where = f"[[steps]] {number}"
         if not isinstance(table, dict):
             raise FileFormatError(source, f"{where}: expected a table")
         values = dict(table)
@@ -68,10 +70,9 @@ def parse_steps_with_labels(data: dict[str, Any], source: str) -> tuple[list[Ste
             raise FileFormatError(source, f"{where}: {error}") from None
         except TypeError as error:
             raise FileFormatError(source, f"{where}: {error}") from None
-        for _ in range(repeat):
+        for count in range(1, repeat + 1):
             commands.append(command)
-            labels.append(f"step {len(commands)} ([[steps]] {number})" if len(commands) != number
-                          else f"step {number}")
+            labels.append(where if repeat == 1 else f"{where}, repeat {count} of {repeat}")
     return commands, labels
 
 
