@@ -12,7 +12,16 @@ from collections.abc import Iterable
 
 
 class ZmpwalkError(Exception):
-    """Base class of every error zmpwalk raises on purpose."""
+    """Base class of every error zmpwalk raises on purpose.
+
+    Every error survives pickling with its message and its fields, so that one raised in a worker process
+    (a ``multiprocessing`` pool, a Dask worker) reaches the caller as it was raised.
+    """
+
+    def __reduce__(self) -> tuple[object, ...]:
+        # Exception's own reduce calls ``cls(*args)``, which fails for a subclass whose __init__ takes other
+        # arguments than its message: rebuild from the message and the fields instead.
+        return _rebuild, (type(self), self.args, dict(self.__dict__))
 
     def in_context(self, context: str) -> ZmpwalkError:
         """Prefix the message with where the error arose (a file, a step); returns ``self``."""
@@ -140,6 +149,14 @@ class FileFormatError(ZmpwalkError, ValueError):
 
 class InfeasiblePatternError(ZmpwalkError, ValueError):
     """A pattern's own feasibility condition does not hold (names the condition)."""
+
+
+def _rebuild(kind: type[ZmpwalkError], args: tuple[object, ...], fields: dict[str, object]) -> ZmpwalkError:
+    """An error of ``kind`` with the message ``args`` and the attributes ``fields`` (the inverse of pickling)."""
+    error = kind.__new__(kind)
+    Exception.__init__(error, *args)
+    error.__dict__.update(fields)
+    return error
 
 
 def _show(value: object) -> str:
