@@ -204,3 +204,50 @@ def test_cli_robot_inspects_and_writes_a_loadable_file(tmp_path: Path, capsys: p
     assert robot.hip_spacing == pytest.approx(0.2)
     assert main(["robot", str(tmp_path / "five.xml")]) == 2
     assert "no such file" in capsys.readouterr().err
+
+
+TALOS_MOTOR = ROBOTS / "pal_talos" / "scene_motor.xml"
+N1 = ROBOTS / "fourier_n1" / "scene.xml"
+needs_motor_robots = pytest.mark.skipif(not TALOS_MOTOR.is_file() or not N1.is_file(),
+                                        reason="../shared/robots is absent")
+
+
+@needs_motor_robots
+def test_torque_driven_legs_get_the_pd_layer(capsys: pytest.CaptureFixture[str]) -> None:
+    from zmpwalk.cli import main
+
+    talos = load_robot(TALOS_MOTOR)
+    assert talos.plant is not None
+    talos_mgl = talos.mass * talos.gravity * talos.pendulum_length
+    assert talos_mgl == pytest.approx(824.83, abs=0.01)  # [N m]
+    for joint, limit in zip(talos.plant.joints, [100.0, 160.0, 160.0, 400.0, 160.0, 100.0] * 2, strict=True):
+        assert joint.actuator is not None and joint.actuator.label == "torque motor + PD"
+        assert joint.actuator.kp == pytest.approx(2 * talos_mgl, rel=1e-9)  # 1649.7 N m/rad: the load term
+        assert joint.actuator.force_limit == limit  # [N m] the motor's ctrlrange (and the joint's actuatorfrcrange)
+    assert len(talos.plant.pd_joints) == 32  # the legs, torso, head, arms and grippers: every motor
+    n1 = load_robot(N1)
+    assert n1.plant is not None
+    hip_roll, knee = n1.plant.joints[1].actuator, n1.plant.joints[3].actuator
+    assert hip_roll is not None and knee is not None
+    assert hip_roll.kp == pytest.approx(hip_roll.inertia * (2 * np.pi * 4.0) ** 2, rel=1e-12)  # the bandwidth term
+    assert hip_roll.inertia == pytest.approx(0.7884, abs=1e-4)  # [kg m^2]: 0.1676 of it the rotor's armature
+    assert hip_roll.kp == pytest.approx(498.0, abs=0.1)  # [N m/rad]
+    assert knee.kp == pytest.approx(2 * n1.mass * n1.gravity * n1.pendulum_length, rel=1e-12)  # 468.9 N m/rad
+    assert knee.kp == pytest.approx(468.86, abs=0.01) and knee.force_limit == 95.0
+    assert main(["robot", str(TALOS_MOTOR)]) == 0
+    out = capsys.readouterr().out
+    assert "torque motor + PD" in out and "static torques not computed" not in out
+    assert "over the actuator's limit standing still: none" in out
+
+
+@needs_robots
+def test_position_servo_robots_keep_their_own_gains() -> None:
+    for path in (TALOS, T1):
+        robot = load_robot(path)
+        assert robot.plant is not None and robot.plant.pd_joints == ()
+        assert all(j.actuator is not None and j.actuator.kind == "position" and not j.actuator.pd_layer
+                   for j in robot.plant.joints)
+    talos = load_robot(TALOS)
+    assert talos.plant is not None
+    assert [j.actuator.kp for j in talos.plant.joints if j.actuator] == [1000.0] * 4 + [10000.0] * 2 + [1000.0] * 4 \
+        + [10000.0] * 2

@@ -1,0 +1,297 @@
+"""The joint PD layer of torque-driven and unactuated joints (docs/robot-import.md): the gain rule's numbers, what
+drives each joint, the torque clipped at the model's limit, a motor-driven arm held at its keyframe, and a URDF
+without actuators that walks."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from zmpwalk.balance import servo_stiffness
+from zmpwalk.commands import StepCommand
+from zmpwalk.errors import FileFormatError, InvalidParameterError
+from zmpwalk.kinematics import pattern_joint_trajectory
+from zmpwalk.patterns.polynomial import generate
+from zmpwalk.robots import load_robot
+from zmpwalk.robots.imported import PD_BANDWIDTH, PD_LOAD_STIFFNESS, pd_gains
+from zmpwalk.robots.inspect import robot_summary, robot_toml
+from zmpwalk.sim.plant import build_plant, plant_qpos, servo_offsets, servo_torques, set_initial_state
+
+LEG = """
+<body name="{s}_hip" pos="0 {y} -0.1"><joint name="{s}_hy" axis="0 0 1"/><geom size="0.02" mass="1"/>
+ <body name="{s}_hr"><joint name="{s}_hr" axis="1 0 0"/><geom size="0.02" mass="1"/>
+  <body name="{s}_hp"><joint name="{s}_hp" axis="0 1 0"/><geom size="0.02" mass="1"/>
+   <body name="{s}_shank" pos="0 0 -0.3"><joint name="{s}_kn" axis="0 1 0" range="0 2.4" {knee}/>
+    <geom size="0.02" mass="1"/>
+    <body name="{s}_ank" pos="0 0 -0.3"><joint name="{s}_ap" axis="0 1 0"/>
+     <geom size="0.02" mass="0.2" contype="0" conaffinity="0"/>
+     <body name="{s}_foot"><joint name="{s}_ar" axis="1 0 0"/>
+      <geom type="box" size="0.1 0.05 0.01" pos="0 0 -0.05" mass="0.5"/>
+     </body>
+    </body>
+   </body>
+  </body>
+ </body>
+</body>"""
+
+ARMATURE = 0.01  # [kg m^2] every joint's rotor inertia in the synthetic models
+ARM_KEY = -1.2  # [rad] the arm's keyframe angle: raised forward, its weight pulling it down
+
+
+def motor_biped(actuators: str | None = None, knee_limit: str = 'actuatorfrcrange="-35 35"') -> str:
+    """A 19.4 kg biped with a 1 kg arm; every joint torque-driven (``<motor>``) unless ``actuators`` is given."""
+    legs = "".join(LEG.format(s=s, y=y, knee=knee_limit) for s, y in (("l", 0.1), ("r", -0.1)))
+    if actuators is None:
+        actuators = '<motor name="shoulder_m" joint="shoulder" ctrlrange="-5 5"/>' + "".join(
+            f'<motor name="{s}_{j}_m" joint="{s}_{j}" ctrlrange="-20 20" gear="2"/>' if j == "hp" else
+            f'<motor name="{s}_{j}_m" joint="{s}_{j}" ctrlrange="-40 40"/>'
+            for s in ("l", "r") for j in ("hy", "hr", "hp", "kn", "ap", "ar"))
+    return f"""<mujoco><compiler angle="radian"/><default><joint armature="{ARMATURE}" damping="0.1"/></default>
+<worldbody><geom type="plane" size="5 5 .1"/>
+<body name="base" pos="0 0 0.8"><freejoint/><geom type="box" size="0.1 0.15 0.1" mass="10"/>
+ <body name="arm" pos="0 0.2 0.05"><joint name="shoulder" axis="0 1 0" range="-3 3"/>
+  <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.02" mass="1" contype="0" conaffinity="0"/></body>
+{legs}</body></worldbody>
+<actuator>{actuators}</actuator>
+<keyframe><key name="ready" qpos="0 0 0.8 1 0 0 0 {ARM_KEY}{' 0' * 12}"/></keyframe></mujoco>"""
+
+
+def write(tmp_path: Path, name: str, text: str) -> Path:
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_the_rule_bandwidth_load_and_step_bound() -> None:
+    kp, kv = pd_gains(2.0, 10.0)  # heavy and lightly loaded: the bandwidth term
+    assert kp == pytest.approx(2.0 * (2 * math.pi * 4.0) ** 2, rel=1e-12)  # 1263.3 N m/rad
+    assert kp == pytest.approx(1263.309, abs=1e-3)
+    assert kv == pytest.approx(2.0 * math.sqrt(kp * 2.0), rel=1e-12)  # critical on its own inertia
+    kp, kv = pd_gains(0.01, 100.0)  # light and loaded: kappa W
+    assert kp == pytest.approx(200.0, rel=1e-12) and kv == pytest.approx(2 * math.sqrt(2.0), rel=1e-12)
+    kp, kv = pd_gains(1e-4, 1000.0, timestep=0.001)  # a light link would be stiffer than the step allows
+    assert kp == pytest.approx(1e-4 * (0.5 / 0.001) ** 2, rel=1e-12)  # 25 N m/rad: sqrt(kp / I) dt = 0.5
+    assert kv * 0.001 / 1e-4 == pytest.approx(1.0, rel=1e-12)  # kv dt / I = 2 zeta beta, half the bound 2
+    with pytest.raises(InvalidParameterError, match="inertia"):
+        pd_gains(0.0, 1.0)
+
+
+def test_motor_legs_get_the_rule_gains_and_their_limits(tmp_path: Path) -> None:
+    robot = load_robot(write(tmp_path, "motor.xml", motor_biped()))
+    assert robot.plant is not None and robot.legs is not None
+    weight_moment = robot.mass * robot.gravity * robot.pendulum_length
+    assert robot.mass == pytest.approx(20.4, abs=1e-9)
+    model = mujoco.MjModel.from_xml_path(str(tmp_path / "motor.xml"))
+    data = mujoco.MjData(model)
+    data.qpos[:] = robot.plant.qpos_reference
+    for chain in robot.legs:  # the ready posture
+        for name, angle in zip(chain.joint_names, chain.reference, strict=True):
+            data.qpos[model.joint(name).qposadr[0]] = angle
+    mujoco.mj_kinematics(model, data)
+    joints = {joint.name: joint for joint in robot.plant.joints}
+    # the ankle roll carries the foot only: a 0.5 kg box 0.2 x 0.1 x 0.02 m, 0.05 m below the axis
+    foot = 0.5 / 12 * (0.1 ** 2 + 0.02 ** 2) + 0.5 * 0.05 ** 2
+    ankle_roll = joints["l_ar"].actuator
+    assert ankle_roll is not None and ankle_roll.inertia == pytest.approx(ARMATURE + foot, rel=1e-9)
+    # the knee: the shank and ankle spheres and the foot box about the knee axis (parallel axes at the posture)
+    axis, anchor = data.xaxis[model.joint("l_kn").id], data.xanchor[model.joint("l_kn").id]
+    knee = ARMATURE
+    box_foot = 0.5 / 12 * np.array([0.1 ** 2 + 0.02 ** 2, 0.2 ** 2 + 0.02 ** 2, 0.2 ** 2 + 0.1 ** 2])
+    for body, own in (("l_shank", np.full(3, 0.4 * 1.0 * 0.02 ** 2)), ("l_ank", np.full(3, 0.4 * 0.2 * 0.02 ** 2)),
+                      ("l_foot", box_foot)):
+        lever = data.xipos[model.body(body).id] - anchor
+        local = data.ximat[model.body(body).id].reshape(3, 3).T @ axis  # the axis in the body's frame
+        knee += float(own @ local ** 2) + float(model.body(body).mass[0]) * float(
+            np.sum((lever - axis * (axis @ lever)) ** 2))
+    knee_actuator = joints["l_kn"].actuator
+    assert knee_actuator is not None and knee_actuator.inertia == pytest.approx(knee, rel=1e-6)
+    for joint in robot.plant.joints:
+        actuator = joint.actuator
+        assert actuator is not None and actuator.kind == "motor" and actuator.pd_layer and actuator.servo
+        assert actuator.label == "torque motor + PD"
+        expected = max(actuator.inertia * PD_BANDWIDTH ** 2, PD_LOAD_STIFFNESS * weight_moment)
+        assert actuator.kp == pytest.approx(expected, rel=1e-12)
+        assert actuator.kv == pytest.approx(2 * math.sqrt(actuator.kp * actuator.inertia), rel=1e-12)
+    assert weight_moment == pytest.approx(119.755, abs=1e-3)  # [N m]: 20.4 kg x 9.81 m/s^2 x 0.5984 m
+    assert ankle_roll.kp == pytest.approx(239.510, abs=1e-3)  # [N m/rad]: 2 m g l, the load term (every leg joint)
+    assert ankle_roll.kv == pytest.approx(3.346, abs=1e-3)  # [N m s/rad]: 2 sqrt(239.5 x 0.01168)
+    limits = {joint.name[2:]: joint.actuator.force_limit for joint in robot.plant.joints if joint.actuator}
+    assert limits == {"hy": 40.0, "hr": 40.0, "hp": 40.0, "kn": 35.0, "ap": 40.0, "ar": 40.0}  # gear 2 x 20; 35
+    stiffness = servo_stiffness(robot)  # the stabilizer sees the layer's gains
+    assert stiffness is not None and stiffness == pytest.approx([j.actuator.kp for j in robot.plant.joints])
+    summary = robot_summary(robot)["joints"]
+    assert [j["actuator"]["kp"] for j in summary] == pytest.approx(list(stiffness), rel=1e-12)
+    assert {j["actuator"]["drive"] for j in summary} == {"torque motor + PD"}
+
+
+def test_each_joint_says_what_drives_it(tmp_path: Path) -> None:
+    actuators = ('<position name="l_hy_p" joint="l_hy" kp="300" kv="5"/><motor name="l_kn_m" joint="l_kn" '
+                 'ctrlrange="-40 40"/><position name="r_hy_p" joint="r_hy" kp="300" kv="5"/>'
+                 '<motor name="r_kn_m" joint="r_kn" ctrlrange="-40 40"/>'
+                 + "".join(f'<position name="{s}_{j}_p" joint="{s}_{j}" kp="400"/>'
+                           for s in ("l", "r") for j in ("hr", "hp")))
+    robot = load_robot(write(tmp_path, "mixed.xml", motor_biped(actuators, knee_limit="")))
+    assert robot.plant is not None
+    kinds = {j.name[2:]: (j.actuator.kind, j.actuator.pd_layer, j.actuator.label)
+             for j in robot.plant.joints if j.actuator is not None}
+    assert kinds == {"hy": ("position", False, "position servo"), "hr": ("position", False, "position servo"),
+                     "hp": ("position", False, "position servo"), "kn": ("motor", True, "torque motor + PD"),
+                     "ap": ("none", True, "PD (no actuator)"), "ar": ("none", True, "PD (no actuator)")}
+    hip_yaw = robot.plant.joints[0].actuator
+    assert hip_yaw is not None and (hip_yaw.kp, hip_yaw.kv) == (300.0, 5.0)  # the model's own servo, unchanged
+    assert "shoulder" not in dict(robot.plant.pd_joints)  # an unactuated arm in a model with actuators: passive
+    plant = build_plant(robot)
+    model = plant.model
+    for column, joint in enumerate(robot.plant.joints):
+        actuator = int(plant.leg_actuators[column])
+        assert joint.actuator is not None and model.actuator(actuator).name == joint.actuator.name
+        assert model.actuator_gainprm[actuator, 0] == pytest.approx(joint.actuator.kp, rel=1e-12)
+        assert model.actuator_biasprm[actuator, 1:3] == pytest.approx([-joint.actuator.kp, -joint.actuator.kv])
+    assert model.actuator("zmpwalk_pd_l_ap").forcelimited == 0  # no limit in the model: none added
+    assert model.actuator("l_kn_m").forcerange == pytest.approx([-40.0, 40.0])
+    knee = model.actuator("l_kn_m").id  # its keyframe control was a torque; now the reference angle
+    assert plant.ctrl_hold[knee] == pytest.approx(robot.plant.qpos_reference[model.joint("l_kn").qposadr[0]])
+    velocity = write(tmp_path, "velocity.xml", motor_biped(actuators.replace(
+        '<motor name="l_kn_m" joint="l_kn" ctrlrange="-40 40"/>', '<velocity name="l_kn_v" joint="l_kn" kv="5"/>'),
+        knee_limit=""))
+    with pytest.raises(InvalidParameterError, match="left_knee actuator = 'general'"):
+        build_plant(load_robot(velocity))
+
+
+def test_the_pd_torque_is_clipped_at_the_limit(tmp_path: Path) -> None:
+    robot = load_robot(write(tmp_path, "motor.xml", motor_biped()))
+    plant = build_plant(robot)
+    model, data = plant.model, mujoco.MjData(plant.model)
+    assert robot.legs is not None and robot.plant is not None
+    angles = np.concatenate([chain.reference[list(chain.role_order)] for chain in robot.legs])
+    set_initial_state(plant, data, np.array([0.0, 0.0, robot.pelvis_height]), 0.0, angles)
+    knee = int(plant.leg_actuators[3])
+    limit = robot.plant.joints[3].actuator.force_limit if robot.plant.joints[3].actuator else math.inf
+    assert limit == 35.0  # the joint's actuatorfrcrange, below the motor's 40 N m
+    mujoco.mj_forward(model, data)
+    q, qd = data.qpos[plant.leg_qpos[3]], data.qvel[model.jnt_dofadr[model.joint("l_kn").id]]
+    expected = model.actuator_gainprm[knee, 0] * (data.ctrl[knee] - q) + model.actuator_biasprm[knee, 2] * qd
+    assert data.actuator_force[knee] == pytest.approx(expected, abs=1e-9)  # the PD law below the limit
+    data.ctrl[knee] += 1.0  # a 1 rad step: 236 N m wanted
+    forces = []
+    for _ in range(300):
+        mujoco.mj_step(model, data)
+        forces.append(abs(float(data.actuator_force[knee])))
+        assert abs(data.qfrc_actuator[model.jnt_dofadr[model.joint("l_kn").id]]) <= limit + 1e-9
+    assert max(forces) == pytest.approx(limit, abs=1e-9)  # held at the limit, never past it
+    assert sum(f > limit - 1e-9 for f in forces) > 10
+
+
+def test_a_motor_driven_arm_is_held_at_its_keyframe(tmp_path: Path) -> None:
+    robot = load_robot(write(tmp_path, "motor.xml", motor_biped()))
+    assert robot.plant is not None
+    arm = dict(robot.plant.pd_joints)["shoulder"]
+    # a 1 kg, 0.3 m arm about a 0.4 m wide base: its weight moment and bandwidth term
+    assert arm.kind == "motor" and arm.force_limit == 5.0
+    assert arm.inertia == pytest.approx(ARMATURE + 1.0 * (0.3 ** 2 / 3 + 0.02 ** 2 / 4) + 0.0, rel=0.05)
+    assert arm.kp == pytest.approx(max(arm.inertia * PD_BANDWIDTH ** 2, 2 * 1.0 * 9.81 * 0.15), rel=1e-3)
+    plant = build_plant(robot)
+    pattern = generate(robot, [StepCommand(duration=1.0, forward=0.0)], rate=1000.0)
+    joints = pattern_joint_trajectory(pattern)
+    assert joints.position_base_in_world is not None
+    base, angles = joints.position_base_in_world[:1], joints.angles[:1]
+    qpos = plant_qpos(plant, base, np.zeros(1), angles)
+    ankles = (pattern.position_left_ankle_in_world[:1], pattern.position_right_ankle_in_world[:1])
+    offsets = servo_offsets(plant, servo_torques(plant, qpos, pattern.zmp_in_world[:1], np.zeros(1, dtype=int),
+                                                 ankles, dynamic=False))[0]
+    address = plant.model.joint("shoulder").qposadr[0]
+    sag = {}
+    for label, feedforward in (("without", 0.0), ("with", 1.0)):
+        data = mujoco.MjData(plant.model)
+        set_initial_state(plant, data, base[0], 0.0, angles[0])
+        data.ctrl[:] = plant.ctrl_hold + feedforward * offsets
+        data.ctrl[plant.leg_actuators] = angles[0] + feedforward * offsets[plant.leg_actuators]
+        error = []
+        for _ in range(1500):  # 1.5 s standing
+            mujoco.mj_step(plant.model, data)
+            error.append(float(data.qpos[address] - ARM_KEY))
+        sag[label] = np.abs(error[-200:]).max()
+        assert np.abs(error).max() < 0.08  # [rad]
+    weight = 1.0 * 9.81 * 0.15 * math.sin(-ARM_KEY)  # its gravity torque at the keyframe [N m]
+    assert sag["without"] == pytest.approx(weight / arm.kp, rel=0.1)  # the PD alone sags by tau / kp
+    assert sag["with"] < 0.005  # the feedforward (tau / kp in its target) holds it within 5 mrad
+
+
+def test_pd_gains_from_the_robot_file(tmp_path: Path) -> None:
+    model = write(tmp_path, "motor.xml", motor_biped())
+    robot = load_robot(model)
+    text = robot_toml(robot, tmp_path)
+    assert '"l_kn" = {kp = ' in text and '"shoulder" = {kp = ' in text
+    text = text.replace('"l_kn" = {kp = ', '"l_kn" = {kp = 500, kv = 7} # ').replace(
+        '"r_kn" = {kp = ', '"r_kn" = {kp = 500} # ')
+    written = load_robot(write(tmp_path, "motor.toml", text))
+    assert written.plant is not None
+    gains = {j.name: (j.actuator.kp, j.actuator.kv) for j in written.plant.joints if j.actuator}
+    inertia = next(j.actuator.inertia for j in written.plant.joints if j.name == "r_kn" and j.actuator)
+    assert gains["l_kn"] == (500.0, 7.0)
+    assert gains["r_kn"] == pytest.approx((500.0, 2 * math.sqrt(500.0 * inertia)), rel=1e-12)  # critical
+    assert gains["l_hy"] == pytest.approx((robot.plant.joints[0].actuator.kp, robot.plant.joints[0].actuator.kv),
+                                          rel=1e-5)  # as written, 6 digits
+    with pytest.raises(FileFormatError, match=r"\[pd\] pd joint = 'nope'"):
+        load_robot(write(tmp_path, "bad.toml", text.replace('"l_kn" = {kp = 500', '"nope" = {kp = 500')))
+    with pytest.raises(FileFormatError, match=r"\[pd\] l_kn kp = -1"):
+        load_robot(write(tmp_path, "neg.toml", text.replace('"l_kn" = {kp = 500', '"l_kn" = {kp = -1')))
+
+
+def inertial(mass: float, com: str, inertia: tuple[float, float, float]) -> str:
+    return (f'<inertial><origin xyz="{com}"/><mass value="{mass}"/><inertia ixx="{inertia[0]}" iyy="{inertia[1]}" '
+            f'izz="{inertia[2]}" ixy="0" ixz="0" iyz="0"/></inertial>')
+
+
+def box(mass: float, x: float, y: float, z: float) -> tuple[float, float, float]:
+    return mass / 12 * (y * y + z * z), mass / 12 * (x * x + z * z), mass / 12 * (x * x + y * y)
+
+
+EFFORT = 60.0  # [N m] every joint's <limit effort> in the URDF
+
+
+def urdf_biped() -> str:
+    """An 18.6 kg URDF biped with no actuators: a torso, 6-joint legs with masses and inertias, box feet."""
+    parts = ['<robot name="urdf_biped">', f'<link name="torso">{inertial(10.0, "0 0 0.1", box(10.0, 0.2, 0.3, 0.3))}'
+             "</link>"]
+    for side, y in (("l", 0.1), ("r", -0.1)):
+        parent = "torso"
+        for name, axis, origin, lower, upper, mass, com, inertia in (
+                ("hip_yaw", "0 0 1", f"0 {y} -0.1", -0.8, 0.8, 0.5, "0 0 0", (1e-3, 1e-3, 1e-3)),
+                ("hip_roll", "1 0 0", "0 0 0", -0.6, 0.6, 0.5, "0 0 0", (1e-3, 1e-3, 1e-3)),
+                ("hip_pitch", "0 1 0", "0 0 0", -1.6, 1.0, 1.5, "0 0 -0.15", box(1.5, 0.06, 0.06, 0.3)),
+                ("knee", "0 1 0", "0 0 -0.3", 0.0, 2.4, 1.0, "0 0 -0.15", box(1.0, 0.05, 0.05, 0.3)),
+                ("ankle_pitch", "0 1 0", "0 0 -0.3", -1.0, 1.0, 0.2, "0 0 0", (2e-4, 2e-4, 2e-4)),
+                ("ankle_roll", "1 0 0", "0 0 0", -0.5, 0.5, 0.6, "0.02 0 -0.05", box(0.6, 0.22, 0.14, 0.02))):
+            link = f"{side}_{name}_link"
+            sole = ('<collision><origin xyz="0.02 0 -0.05"/><geometry><box size="0.22 0.14 0.02"/></geometry>'
+                    "</collision>") if name == "ankle_roll" else ""
+            parts += [f'<link name="{link}">{inertial(mass, com, inertia)}{sole}</link>',
+                      f'<joint name="{side}_{name}" type="revolute"><parent link="{parent}"/><child link="{link}"/>'
+                      f'<origin xyz="{origin}"/><axis xyz="{axis}"/><limit lower="{lower}" upper="{upper}" '
+                      f'effort="{EFFORT}" velocity="10"/><dynamics damping="0.1"/></joint>']
+            parent = link
+    return "\n".join([*parts, "</robot>"])
+
+
+def test_a_urdf_without_actuators_walks_six_steps(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from zmpwalk.cli import main
+
+    urdf = write(tmp_path, "biped.urdf", urdf_biped())
+    robot = load_robot(urdf)
+    assert robot.plant is not None and robot.mass == pytest.approx(18.6, abs=1e-9)
+    for joint in robot.plant.joints:  # the effort limit arrives as the joint's actuatorfrcrange
+        assert joint.actuator is not None and joint.actuator.kind == "none" and joint.actuator.pd_layer
+        assert joint.actuator.force_limit == EFFORT
+    steps = write(tmp_path, "steps.toml", "[[steps]]\nduration = 0.8\nforward = 0.05\nrepeat = 6\n")
+    code = main(["simulate", "--robot", str(urdf), str(steps), "--json"])
+    summary = json.loads(capsys.readouterr().out)
+    assert code == 0 and summary["verdict"]["state"] == "PASS" and not summary["fell"]
+    assert summary["final_feet_error"] < 0.02  # [m]
+    assert summary["distance"] == pytest.approx(0.30, abs=0.03)  # [m]: six 5 cm steps and the closing one
+    assert max(row["impact_torque"] for row in summary["actuators"]) <= EFFORT + 1e-9  # [N m]
