@@ -17,12 +17,12 @@ from zmpwalk.cli import main
 from zmpwalk.patterns.hyperbolic import (
     HyperbolicGait,
     HyperbolicWalk,
-    generate_hyperbolic,
     paper_walk,
     solve_step,
     steady_step,
     transient_zmps,
 )
+from zmpwalk.patterns.lipm import generate_hyperbolic
 
 TIME_TOL = 0.5e-3  # [s] on the printed times
 ZMP_TOL = 0.5e-3  # [m] on the printed ZMPs

@@ -11,7 +11,7 @@ from zmpwalk import (
     load_robot,
 )
 from zmpwalk.kinematics import pattern_joint_trajectory
-from zmpwalk.patterns.hyperbolic import generate_hyperbolic
+from zmpwalk.patterns.lipm import generate_hyperbolic
 from zmpwalk.scenarios import load_scenario
 
 OK = None

@@ -21,7 +21,7 @@ from zmpwalk.errors import (
 from zmpwalk.kinematics import JointLimitError, JointTrajectory, pattern_joint_trajectory
 from zmpwalk.leg_chain import LegChain
 from zmpwalk.online import OnlineWalker, WalkingSample
-from zmpwalk.patterns.hyperbolic import generate_hyperbolic
+from zmpwalk.patterns.lipm import generate_hyperbolic
 from zmpwalk.patterns.polynomial import generate
 from zmpwalk.patterns.preview import generate_preview
 from zmpwalk.patterns.result import WalkingPattern

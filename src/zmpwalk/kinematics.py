@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -44,10 +44,28 @@ from zmpwalk.leg_chain import LegChain
 from zmpwalk.robots.model import JOINT_NAMES, RobotModel
 from zmpwalk.slices import Parts, whole
 
-if TYPE_CHECKING:
-    from zmpwalk.patterns.result import WalkingPattern
-
 Array = NDArray[np.float64]
+
+
+class SampledMotion(Protocol):
+    """What the IK needs of a pattern (:class:`zmpwalk.patterns.result.WalkingPattern` is one), in world, SI:
+    times [s] (n,), the pelvis and both ankles' positions [m] (n, 3) and velocities [m/s] (n, 3), the pelvis'
+    and feet's yaws [rad] (n,) and yaw rates [rad/s] (n,), and the robot."""
+
+    time: Array
+    position_pelvis_in_world: Array
+    velocity_pelvis_in_world: Array
+    yaw_pelvis_in_world: Array
+    yaw_rate_pelvis: Array
+    position_left_ankle_in_world: Array
+    velocity_left_ankle_in_world: Array
+    yaw_left_foot_in_world: Array
+    yaw_rate_left_foot: Array
+    position_right_ankle_in_world: Array
+    velocity_right_ankle_in_world: Array
+    yaw_right_foot_in_world: Array
+    yaw_rate_right_foot: Array
+    robot: RobotModel
 
 LEG_JOINTS = JOINT_NAMES  # hip_yaw, hip_roll, hip_pitch, knee, ankle_pitch, ankle_roll
 JOINT_COLUMNS = tuple(f"{side}_{joint}" for side in ("left", "right") for joint in LEG_JOINTS)
@@ -602,7 +620,7 @@ def check_joint_limits(time: Array, angles: Array, robot: RobotModel) -> None:
                               (float(lower[column]), float(upper[column])))
 
 
-def pattern_joint_trajectory(pattern: WalkingPattern, knee_forward: bool = True,
+def pattern_joint_trajectory(pattern: SampledMotion, knee_forward: bool = True,
                              check_limits: bool = True) -> JointTrajectory:
     """Joint angles and velocities of a :class:`~zmpwalk.patterns.result.WalkingPattern` (any generator)."""
     return joint_trajectory(

@@ -17,7 +17,7 @@ def generator(name: str) -> Generator:
     Raises:
         UnknownNameError: Lists the known generators.
     """
-    from zmpwalk.patterns.hyperbolic import generate_hyperbolic
+    from zmpwalk.patterns.lipm import generate_hyperbolic
     from zmpwalk.patterns.polynomial import generate
     from zmpwalk.patterns.preview import generate_preview
 

@@ -51,7 +51,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk import curves
-from zmpwalk.commands import StepCommand
 from zmpwalk.errors import InfeasiblePatternError
 from zmpwalk.footsteps import LEFT, RIGHT, Pose2D, foot_corners
 from zmpwalk.patterns.result import (
@@ -64,7 +63,6 @@ from zmpwalk.patterns.result import (
     sample_times,
 )
 from zmpwalk.robots.model import RobotModel
-from zmpwalk.schedule import Schedule
 from zmpwalk.zmp import convex_hull, signed_margin
 
 Array = NDArray[np.float64]
@@ -596,24 +594,3 @@ def paper_walk(robot: RobotModel, gait: HyperbolicGait | None = None, steps: int
     steady = gait.steady()
     window = (gait.t_star, gait.tau_star)
     return HyperbolicWalk(robot, [steady] * (steps + 1), window, window if stop else None, gait.gravity)
-
-
-def generate_hyperbolic(robot: RobotModel, commands: Sequence[StepCommand], rate: float = 100.0,
-                        schedule: Schedule | None = None, labels: Sequence[str] | None = None) -> WalkingPattern:
-    """The hyperbolic pattern of any step commands (forward, side, turn), sampled at ``rate`` [Hz].
-
-    Stage by stage as :class:`~zmpwalk.online.OnlineWalker` walks it with ``generator="hyperbolic"``
-    (:mod:`zmpwalk.patterns.lipm_stage`): the footsteps, swings and timing of the polynomial generator,
-    the pelvis of the linear inverted pendulum under a piecewise-constant ZMP, solved per stage from the
-    state it inherits. The paper's own straight walk with its start and stop transients (Eqs. 12-15) is
-    :func:`paper_walk`.
-
-    Raises:
-        InfeasiblePatternError: A stage would need its ZMP outside the feet (or has no steady step).
-        UnreachableError: A leg cannot follow the pattern.
-        ZmpwalkError: Any other infeasible command, as for :func:`zmpwalk.patterns.polynomial.generate`.
-    """
-    # imported here: the polynomial module's stages are built with this module's steady step
-    from zmpwalk.patterns.polynomial import generate
-
-    return generate(robot, commands, rate=rate, schedule=schedule, labels=labels, pelvis="hyperbolic")
