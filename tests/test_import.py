@@ -206,6 +206,27 @@ def test_cli_robot_inspects_and_writes_a_loadable_file(tmp_path: Path, capsys: p
     assert "no such file" in capsys.readouterr().err
 
 
+def test_a_model_robot_file_carries_tuned_stabilizer_gains(tmp_path: Path) -> None:
+    """A robot file naming its own model may carry [stabilizer], as a box model's file does."""
+    from zmpwalk.balance import Stabilizer
+    from zmpwalk.cli import main
+
+    write(tmp_path, "ok.xml", biped(leg("l", 0.1) + leg("r", -0.1)))
+    assert main(["robot", str(tmp_path / "ok.xml"), "--write", str(tmp_path / "ok.toml")]) == 0
+    plain = load_robot(tmp_path / "ok.toml")
+    assert plain.stabilizer_gains == ()
+    with (tmp_path / "ok.toml").open("a", encoding="utf-8") as handle:
+        handle.write("\n[stabilizer]\ncom_stiffness = 3.0\ntouchdown_speed = 0.2\n")
+    tuned = load_robot(tmp_path / "ok.toml")
+    assert dict(tuned.stabilizer_gains) == {"com_stiffness": 3.0, "touchdown_speed": 0.2}
+    gains = Stabilizer(tuned, 1000.0).gains
+    assert gains.com_stiffness == 3.0 and gains.touchdown_speed == 0.2 and gains.dcm == 3.0  # [1/s^2], [m/s], [1/s]
+    with (tmp_path / "ok.toml").open("a", encoding="utf-8") as handle:
+        handle.write("dcm_gain = 2.0\n")
+    with pytest.raises(FileFormatError, match="dcm_gain"):
+        load_robot(tmp_path / "ok.toml")
+
+
 TALOS_MOTOR = ROBOTS / "pal_talos" / "scene_motor.xml"
 N1 = ROBOTS / "fourier_n1" / "scene.xml"
 needs_motor_robots = pytest.mark.skipif(not TALOS_MOTOR.is_file() or not N1.is_file(),

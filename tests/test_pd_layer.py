@@ -18,8 +18,9 @@ from zmpwalk.errors import FileFormatError, InvalidParameterError
 from zmpwalk.kinematics import pattern_joint_trajectory
 from zmpwalk.patterns.polynomial import generate
 from zmpwalk.robots import load_robot
-from zmpwalk.robots.imported import PD_BANDWIDTH, PD_LOAD_STIFFNESS, pd_gains
+from zmpwalk.robots.description import PD_BANDWIDTH, PD_LOAD_STIFFNESS
 from zmpwalk.robots.inspect import robot_summary, robot_toml
+from zmpwalk.robots.pd import pd_gains
 from zmpwalk.sim.plant import build_plant, plant_qpos, servo_offsets, servo_torques, set_initial_state
 
 LEG = """

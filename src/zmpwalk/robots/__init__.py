@@ -7,7 +7,8 @@ from importlib import resources
 from pathlib import Path
 
 from zmpwalk.errors import FileFormatError, UnknownNameError
-from zmpwalk.robots.model import JOINT_NAMES, RobotModel, robot_from_dict, robot_from_toml
+from zmpwalk.robots.model import JOINT_NAMES, RobotModel, robot_from_dict
+from zmpwalk.robots.robot_file import robot_from_toml
 
 __all__ = ["JOINT_NAMES", "MODEL_SUFFIXES", "RobotModel", "list_robots", "load_robot", "loaded_robot",
            "robot_from_dict"]

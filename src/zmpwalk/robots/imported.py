@@ -41,16 +41,19 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from zmpwalk.errors import FileFormatError, InvalidParameterError
+from zmpwalk.errors import FileFormatError
 from zmpwalk.leg_chain import LegChain
+from zmpwalk.robots.collision import collision_points, rigid_bodies
+from zmpwalk.robots.description import LegJoint, ModelPlant
 from zmpwalk.robots.model import RobotModel, schedule_scale
+from zmpwalk.robots.pd import element_name, joint_actuator, pd_layer
 from zmpwalk.zmp import convex_hull
 
 Array = NDArray[np.float64]
@@ -59,111 +62,6 @@ ROLES = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll"
 FOOT_TIE = 0.005  # [m] two foot candidates this close in height on one side are ambiguous
 SOLE_BAND = 0.002  # [m] collision points this close to the lowest form the sole
 READY_STRETCH = 0.92  # [-] hip-to-ankle distance of the ready posture, at most this fraction of the straight leg
-PHYSICS_STEP = 0.001  # [s] the simulation's physics step at most (zmpwalk.sim.plant), the PD layer's period
-PD_BANDWIDTH = 2 * math.pi * 4.0  # [rad/s] omega: a PD joint's natural frequency on its own inertia, at least
-PD_DAMPING_RATIO = 1.0  # [-] zeta: damping of a PD joint on its own inertia (critical)
-PD_LOAD_STIFFNESS = 2.0  # [-] kappa: a PD joint is at least this many times the weight moment it holds per rad
-PD_STEP_LIMIT = 0.5  # [-] beta: sqrt(kp / I) times the physics step at most (discrete stability below 2)
-PD_PREFIX = "zmpwalk_pd_"  # name of the actuator the simulation adds to a joint the model leaves unactuated
-
-ACTUATOR_LABELS = {"position": "position servo", "motor": "torque motor + PD", "none": "PD (no actuator)",
-                   "general": "general"}
-
-
-@dataclass(frozen=True)
-class Actuator:
-    """The actuator driving one joint, as the simulation runs it.
-
-    Attributes:
-        name: Actuator name in the model (``zmpwalk_pd_JOINT`` where the model has none and the simulation adds one).
-        kind: The model's actuator: ``"position"`` (a servo ``kp (u - q) - kv q'``), ``"motor"`` (torque),
-            ``"general"`` (anything else), or ``"none"`` (the joint has no actuator in the model).
-        kp: Position gain [N m/rad]: the servo's, or the PD layer's (0 for a motor or general actuator without one).
-        kv: Velocity gain [N m s/rad], likewise.
-        force_limit: Largest |torque| the actuator or the joint allows [N m] (inf where unlimited): a motor's
-            ``ctrlrange`` times its gain and gear, the actuator's ``forcerange`` times its gear, the joint's
-            ``actuatorfrcrange`` (a URDF's ``<limit effort>``), the smallest that applies.
-        pd_layer: The joint is driven by a joint PD loop (a humanoid's firmware): ``kp``, ``kv`` from
-            :func:`pd_gains` or the robot file's ``[pd]``, the torque clipped at ``force_limit``.
-        inertia: The joint's reflected inertia ``I`` at the ready posture, from which the PD layer's gains are
-            derived [kg m^2] (nan without the PD layer).
-    """
-
-    name: str
-    kind: str
-    kp: float  # [N m/rad]
-    kv: float  # [N m s/rad]
-    force_limit: float  # [N m]
-    pd_layer: bool = False
-    inertia: float = math.nan  # [kg m^2]
-
-    @property
-    def servo(self) -> bool:
-        """Whether the simulation drives the joint with angles: a position servo or the PD layer."""
-        return self.kind == "position" or self.pd_layer
-
-    @property
-    def label(self) -> str:
-        """What drives the joint, in words: ``position servo``, ``torque motor + PD``, ``PD (no actuator)``."""
-        return ACTUATOR_LABELS.get(self.kind, self.kind)
-
-
-@dataclass(frozen=True)
-class LegJoint:
-    """One leg joint of the model, by role.
-
-    Attributes:
-        role: One of :data:`ROLES`.
-        name: The model's joint name.
-        axis: Unit axis in the pelvis frame at the zero pose, (3,).
-        sign: +1 where the axis points along +z (yaw), +x (roll) or +y (pitch), else -1.
-        zero_offset: The model's zero pose bend of this joint [rad] (the knee's; 0 for the others).
-        limits: (lower, upper) [rad].
-        actuator: Its actuator, or None.
-    """
-
-    role: str
-    name: str
-    axis: tuple[float, float, float]
-    sign: int
-    zero_offset: float  # [rad]
-    limits: tuple[float, float]  # [rad]
-    actuator: Actuator | None
-
-
-@dataclass(frozen=True)
-class ModelPlant:
-    """What the simulator needs to run the robot's own model (see :mod:`zmpwalk.sim.plant`).
-
-    Attributes:
-        path: The model file.
-        base_body: Name of the floating base.
-        feet: Foot body names (left, right).
-        joints: The 12 leg joints (left then right, role order).
-        qpos_reference: The reference pose (keyframe or zero pose), ``nq`` values.
-        ctrl_reference: Controls holding that pose, ``nu`` values.
-        package_paths: Folders searched for a URDF's ``package://`` paths.
-        sole_polygon: Sole corners in the left foot frame (x forward, y left) [m], counter-clockwise, (m, 2).
-        held_joints: Joints held at the reference pose (names).
-        keyframe: The keyframe of the reference pose, or None (the zero pose).
-        rest_mass: Mass of everything but the leg segments (rigid with the base) [kg].
-        rest_com: Its centre of mass in the pelvis frame [m].
-        pd_joints: Every joint driven by the joint PD layer, leg joints included: (joint name, its actuator).
-    """
-
-    path: Path
-    base_body: str
-    feet: tuple[str, str]
-    joints: tuple[LegJoint, ...]
-    qpos_reference: tuple[float, ...]
-    ctrl_reference: tuple[float, ...]
-    package_paths: tuple[Path, ...] = ()
-    sole_polygon: tuple[tuple[float, float], ...] = ()
-    held_joints: tuple[str, ...] = field(default=())
-    keyframe: str | None = None
-    rest_mass: float = 0.0  # [kg]
-    rest_com: tuple[float, float, float] = (0.0, 0.0, 0.0)  # [m]
-    pd_joints: tuple[tuple[str, Actuator], ...] = ()
 
 
 def load_model(path: Path, package_paths: tuple[Path, ...] = ()) -> Any:
@@ -274,8 +172,8 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     chains_joints = []
     for label, foot, joints in zip(("left", "right"), foot_ids, paths, strict=True):
         leg = [j for j in joints if int(model.jnt_bodyid[j]) not in shared]
-        names = [_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in leg]
-        foot_name = _name(model, mujoco.mjtObj.mjOBJ_BODY, foot)
+        names = [element_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in leg]
+        foot_name = element_name(model, mujoco.mjtObj.mjOBJ_BODY, foot)
         if len(leg) != 6:
             raise FileFormatError(source, f"the {label} leg (to foot body {foot_name!r}) has {len(leg)} joints "
                                   f"({', '.join(names) or 'none'}); zmpwalk walks legs of 6 hinge joints")
@@ -325,8 +223,8 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     for side, label, foot, leg in zip((1, -1), ("left", "right"), foot_ids, chains_joints, strict=True):
         axes = np.array([base_rotation.T @ data.xaxis[j] for j in leg])
         points = np.array([in_pelvis(data.xanchor[j]) for j in leg])
-        roles = _roles(axes, [_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in leg], label, source)
-        chain = LegChain(side, tuple(_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in leg), axes, points,
+        roles = _roles(axes, [element_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in leg], label, source)
+        chain = LegChain(side, tuple(element_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in leg), axes, points,
                          np.zeros(3))
         ankle = chain.ankle_point
         lower = np.array([model.jnt_range[j][0] if model.jnt_limited[j] else -np.inf for j in leg])
@@ -343,8 +241,8 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
                          link_coms=segment_com[index])
         sole_points = collision_points(model, data, rigid_bodies(model, foot))
         if len(sole_points) == 0:
-            raise FileFormatError(source, f"the {label} foot body {_name(model, mujoco.mjtObj.mjOBJ_BODY, foot)!r} "
-                                  "has no collision geom (its sole)")
+            foot_name = element_name(model, mujoco.mjtObj.mjOBJ_BODY, foot)
+            raise FileFormatError(source, f"the {label} foot body {foot_name!r} has no collision geom (its sole)")
         sole_points = np.array([in_pelvis(point) for point in sole_points])
         soles.append(sole_points - ankle)
         chains.append(chain)
@@ -357,7 +255,7 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
             leg_joints.append(LegJoint(
                 role=role, name=chain.joint_names[index], axis=(float(axis[0]), float(axis[1]), float(axis[2])),
                 sign=1 if axis[dominant] > 0 else -1, zero_offset=knee_offset if role == "knee" else 0.0,
-                limits=(float(lower[index]), float(upper[index])), actuator=_actuator(model, j)))
+                limits=(float(lower[index]), float(upper[index])), actuator=joint_actuator(model, j)))
     # Sole: the collision points near the lowest, in the foot frame (ankle origin, pelvis axes at zero).
     left_sole = soles[0]
     bottom = left_sole[:, 2].min()
@@ -391,15 +289,15 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     height_scale = float(np.max(data.geom_xpos[:, 2]) - key_foot_bottom)
     model_name = model.names[:model.names.find(b"\0")].decode()
     robot_name = name or re.sub(r"[^A-Za-z0-9_.-]+", "-", model_name).strip("-") or path.stem
-    held = tuple(_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in range(model.njnt)
+    held = tuple(element_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in range(model.njnt)
                  if j not in leg_joint_ids and j != base_joint)
-    plant = ModelPlant(path=path.resolve(), base_body=_name(model, mujoco.mjtObj.mjOBJ_BODY, base),
-                       feet=(_name(model, mujoco.mjtObj.mjOBJ_BODY, foot_ids[0]),
-                             _name(model, mujoco.mjtObj.mjOBJ_BODY, foot_ids[1])),
+    plant = ModelPlant(path=path.resolve(), base_body=element_name(model, mujoco.mjtObj.mjOBJ_BODY, base),
+                       feet=(element_name(model, mujoco.mjtObj.mjOBJ_BODY, foot_ids[0]),
+                             element_name(model, mujoco.mjtObj.mjOBJ_BODY, foot_ids[1])),
                        joints=tuple(leg_joints), qpos_reference=tuple(float(v) for v in qpos_reference),
                        ctrl_reference=tuple(float(v) for v in ctrl_reference), package_paths=package_paths,
                        sole_polygon=tuple((float(x), float(y)) for x, y in polygon), held_joints=held,
-                       keyframe=_name(model, mujoco.mjtObj.mjOBJ_KEY, key_id) if key_id >= 0 else None,
+                       keyframe=element_name(model, mujoco.mjtObj.mjOBJ_KEY, key_id) if key_id >= 0 else None,
                        rest_mass=rest_mass, rest_com=(float(rest_com[0]), float(rest_com[1]), float(rest_com[2])))
     pelvis_height = 0.0
     pendulum = 0.0
@@ -435,7 +333,7 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
             break
         com_offset = new_offset
     # The joint PD layer: gains from the ready posture's inertia; a leg joint holds the robot, m g l.
-    pd_joints = _pd_layer(model, data, qpos, leg_joint_ids, mass * float(np.linalg.norm(model.opt.gravity)) * pendulum,
+    pd_joints = pd_layer(model, data, qpos, leg_joint_ids, mass * float(np.linalg.norm(model.opt.gravity)) * pendulum,
                           pd_gains or {})
     driven = dict(pd_joints)
     leg_joints = [replace(joint, actuator=driven.get(joint.name, joint.actuator)) for joint in leg_joints]
@@ -466,12 +364,6 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     )
 
 
-def _name(model: object, kind: object, index: int) -> str:
-    import mujoco
-
-    return mujoco.mj_id2name(model, kind, index) or f"#{index}"
-
-
 def _floating_base(model: object, source: str) -> int:
     import mujoco
 
@@ -493,7 +385,7 @@ def _keyframe(model: object, keyframe: str | None, source: str) -> int:
     if key < 0 and unnamed and int(unnamed.group(1)) < model.nkey:  # type: ignore[attr-defined]
         key = int(unnamed.group(1))
     if key < 0:
-        known = [_name(model, mujoco.mjtObj.mjOBJ_KEY, k) for k in range(model.nkey)]  # type: ignore[attr-defined]
+        known = [element_name(model, mujoco.mjtObj.mjOBJ_KEY, k) for k in range(model.nkey)]  # type: ignore[attr-defined]
         raise FileFormatError(source, f"no keyframe {keyframe!r}; the model has: {', '.join(known) or 'none'}")
     return int(key)
 
@@ -514,91 +406,6 @@ def _joint_path(model: object, base: int, body: int) -> list[int]:
         start, count = int(model.body_jntadr[b]), int(model.body_jntnum[b])  # type: ignore[attr-defined]
         joints += list(range(start, start + count)) if count > 0 else []
     return joints
-
-
-def rigid_bodies(model: object, body: int) -> list[int]:
-    """``body`` and its descendants that are welded to it (no joint in between)."""
-    bodies = [body]
-    for child in range(body + 1, model.nbody):  # type: ignore[attr-defined]
-        parent = int(model.body_parentid[child])  # type: ignore[attr-defined]
-        if parent in bodies and model.body_jntnum[child] == 0:  # type: ignore[attr-defined]
-            bodies.append(child)
-    return bodies
-
-
-def _unit_sphere_grid(polar: int = 49, around: int = 48) -> Array:
-    """Points on the unit sphere: ``polar`` latitudes from pole to pole, ``around`` longitudes each."""
-    theta = np.linspace(0.0, np.pi, polar)[:, None]
-    phi = np.linspace(0.0, 2 * np.pi, around, endpoint=False)[None, :]
-    grid = np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta) + 0 * phi], axis=-1)
-    return np.asarray(grid.reshape(-1, 3), dtype=np.float64)
-
-
-_ELLIPSOID_SURFACE = _unit_sphere_grid()  # an ellipsoid's surface, scaled by its semi-axes
-
-
-def _round_bar_bottom(centre: Array, rotation: Array, size: Array, capsule: bool) -> Array:
-    """World points of a capsule's or cylinder's lowest line (its contact with a level floor): the lowest point
-    of each end's hemisphere (a capsule) or rim (a cylinder); a standing cylinder's lower disc rim."""
-    radius, half = float(size[0]), float(size[1])
-    axis = rotation[:, 2]
-    ends = centre + np.outer((-half, half), axis)
-    if capsule:
-        return np.asarray(ends - np.array([0.0, 0.0, radius]), dtype=np.float64)
-    down = np.array([0.0, 0.0, -1.0]) - axis * -axis[2]  # -z off the axis: towards the rim's lowest point
-    if float(np.linalg.norm(down)) < 1e-9:  # standing upright: the whole lower disc is on the floor
-        angles = np.linspace(0, 2 * np.pi, 16, endpoint=False)
-        ring = np.column_stack([np.cos(angles), np.sin(angles), np.zeros(16)]) * radius @ rotation.T
-        return np.asarray(np.vstack([end + ring for end in ends]), dtype=np.float64)
-    return np.asarray(ends + radius * down / np.linalg.norm(down), dtype=np.float64)
-
-
-def colliding_geoms(model: object) -> set[int]:
-    """The geoms that can touch anything: by their contact type and affinity, or named in an explicit contact
-    pair (``<contact><pair>``, whose geoms often have ``contype = conaffinity = 0``)."""
-    m = model
-    geoms = {g for g in range(m.ngeom)  # type: ignore[attr-defined]
-             if m.geom_contype[g] != 0 or m.geom_conaffinity[g] != 0}  # type: ignore[attr-defined]
-    for pair in range(m.npair):  # type: ignore[attr-defined]
-        geoms.update((int(m.pair_geom1[pair]), int(m.pair_geom2[pair])))  # type: ignore[attr-defined]
-    return geoms
-
-
-def collision_points(model: object, data: object, bodies: list[int]) -> Array:
-    """World points spanning the collision geoms of ``bodies``, (m, 3): box corners, mesh vertices, an
-    ellipsoid's surface, a sphere's lowest point, a capsule's or cylinder's lowest line (see
-    :func:`_round_bar_bottom`). The geoms are those that can touch the floor (:func:`colliding_geoms`)."""
-    import mujoco
-
-    m, d = model, data
-    points: list[Array] = []
-    geom_type = mujoco.mjtGeom
-    colliding = colliding_geoms(m)
-    for g in range(m.ngeom):  # type: ignore[attr-defined]
-        if int(m.geom_bodyid[g]) not in bodies or g not in colliding:  # type: ignore[attr-defined]
-            continue
-        kind = int(m.geom_type[g])  # type: ignore[attr-defined]  # a numpy integer is never `in` a tuple of enums
-        size = m.geom_size[g]  # type: ignore[attr-defined]
-        rotation = d.geom_xmat[g].reshape(3, 3)  # type: ignore[attr-defined]
-        centre = d.geom_xpos[g]  # type: ignore[attr-defined]
-        if kind == geom_type.mjGEOM_BOX:
-            local = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * size
-        elif kind == geom_type.mjGEOM_MESH:
-            mesh = int(m.geom_dataid[g])  # type: ignore[attr-defined]
-            start, count = int(m.mesh_vertadr[mesh]), int(m.mesh_vertnum[mesh])  # type: ignore[attr-defined]
-            local = np.asarray(m.mesh_vert[start:start + count], dtype=float)  # type: ignore[attr-defined]
-        elif kind == geom_type.mjGEOM_SPHERE:
-            points.append(centre - np.array([[0.0, 0.0, size[0]]]))  # its lowest point
-            continue
-        elif kind in (geom_type.mjGEOM_CAPSULE, geom_type.mjGEOM_CYLINDER):
-            points.append(_round_bar_bottom(centre, rotation, size, kind == geom_type.mjGEOM_CAPSULE))
-            continue
-        elif kind == geom_type.mjGEOM_ELLIPSOID:
-            local = _ELLIPSOID_SURFACE * size[:3]
-        else:
-            continue
-        points.append(centre + local @ rotation.T)
-    return np.vstack(points) if points else np.zeros((0, 3))
 
 
 def _find_feet(model: object, data: object, base: int, feet: tuple[str, str] | None, source: str) -> list[int]:
@@ -640,7 +447,7 @@ def _find_feet(model: object, data: object, base: int, feet: tuple[str, str] | N
                                   f"{label} of the base); give the feet: feet = [left body, right body]")
         ties = [c for c in side[1:] if c[0] < side[0][0] + FOOT_TIE and c[1] not in _ancestors(m, side[0][1])]
         if ties:
-            names = ", ".join(_name(m, mujoco.mjtObj.mjOBJ_BODY, c[1]) for c in [side[0], *ties])
+            names = ", ".join(element_name(m, mujoco.mjtObj.mjOBJ_BODY, c[1]) for c in [side[0], *ties])
             raise FileFormatError(source, f"ambiguous {label} foot: {names} reach equally low; give the feet: "
                                   "feet = [left body, right body] (--feet LEFT,RIGHT)")
         result.append(side[0][1])
@@ -685,153 +492,3 @@ def _knee_offset(chain: LegChain) -> float:
     return float(math.atan2(float(axis @ np.cross(thigh, shank)), float(thigh @ shank)))
 
 
-def is_position_servo(model: Any, actuator: int) -> bool:
-    """Whether an actuator is a position servo on a joint: ``gain (u - q) - kv q'`` (MuJoCo ``<position>``
-    or an equivalent ``<general>``)."""
-    import mujoco
-
-    gain, bias = model.actuator_gainprm[actuator], model.actuator_biasprm[actuator]
-    return bool(model.actuator_trntype[actuator] == mujoco.mjtTrn.mjTRN_JOINT and gain[0] > 0
-                and model.actuator_biastype[actuator] == mujoco.mjtBias.mjBIAS_AFFINE
-                and abs(bias[1] + gain[0]) < 1e-9 * max(1.0, gain[0]))
-
-
-def _actuator(model: object, joint: int) -> Actuator | None:
-    """The model's actuator of ``joint`` (the first with a joint transmission to it), or None; its ``kp``, ``kv``
-    are the model's (0 for a motor: see :func:`_pd_layer`)."""
-    import mujoco
-
-    m = model
-    for a in range(m.nu):  # type: ignore[attr-defined]
-        if m.actuator_trntype[a] != mujoco.mjtTrn.mjTRN_JOINT or int(m.actuator_trnid[a][0]) != joint:  # type: ignore[attr-defined]
-            continue
-        gear = float(m.actuator_gear[a][0])  # type: ignore[attr-defined]
-        gain, bias = m.actuator_gainprm[a], m.actuator_biasprm[a]  # type: ignore[attr-defined]
-        if is_position_servo(m, a):
-            kind, kp, kv = "position", float(gain[0]) * gear, float(-bias[2]) * gear
-        elif _is_motor(m, a):
-            kind, kp, kv = "motor", 0.0, 0.0
-        else:
-            kind, kp, kv = "general", float(gain[0]), float(-bias[2])
-        limit = _joint_torque_limit(m, joint)
-        if m.actuator_forcelimited[a]:  # type: ignore[attr-defined]
-            limit = min(limit, float(np.max(np.abs(m.actuator_forcerange[a]))) * abs(gear))  # type: ignore[attr-defined]
-        if kind == "motor" and m.actuator_ctrllimited[a]:  # type: ignore[attr-defined]
-            limit = min(limit, float(np.max(np.abs(m.actuator_ctrlrange[a]))) * abs(float(gain[0]) * gear))  # type: ignore[attr-defined]
-        return Actuator(_name(m, mujoco.mjtObj.mjOBJ_ACTUATOR, a), kind, kp, kv, limit)
-    return None
-
-
-def _is_motor(model: Any, actuator: int) -> bool:
-    """Whether an actuator is a torque motor on a joint: ``gain ctrl`` (MuJoCo ``<motor>``: fixed gain, no bias,
-    no activation dynamics)."""
-    import mujoco
-
-    return bool(model.actuator_trntype[actuator] == mujoco.mjtTrn.mjTRN_JOINT
-                and model.actuator_biastype[actuator] == mujoco.mjtBias.mjBIAS_NONE
-                and model.actuator_gaintype[actuator] == mujoco.mjtGain.mjGAIN_FIXED
-                and model.actuator_dyntype[actuator] == mujoco.mjtDyn.mjDYN_NONE)
-
-
-def _joint_torque_limit(model: Any, joint: int) -> float:
-    """The joint's own limit on its actuators' total torque, ``actuatorfrcrange`` (a URDF's ``<limit effort>``)
-    [N m]; inf where it has none."""
-    if not model.jnt_actfrclimited[joint]:
-        return math.inf
-    return float(np.max(np.abs(model.jnt_actfrcrange[joint])))
-
-
-def pd_gains(inertia: float, moment: float, timestep: float = PHYSICS_STEP) -> tuple[float, float]:
-    r"""The joint PD layer's gains of one joint: stiffness ``kp`` [N m/rad] and damping ``kv`` [N m s/rad].
-
-    .. math::
-
-        k_p = \min\left(\max(I \omega^2,\ \kappa W),\ I (\beta / \Delta t)^2\right), \qquad
-        k_v = 2 \zeta \sqrt{k_p I}
-
-    with :data:`PD_BANDWIDTH` ``omega`` (the joint swings on its own inertia at least this fast),
-    :data:`PD_LOAD_STIFFNESS` ``kappa`` times the weight moment ``W`` it holds (a leg joint holds the robot on
-    one foot, ``W = m g l``, whose toppling moment grows by ``m g l`` per radian of lean: at ``kappa = 2`` the
-    joint's net stiffness against it is still ``m g l``, above the 1.7 ``m g l`` below which the stabilizer
-    stiffens servos with its encoder loop), the discrete bound :data:`PD_STEP_LIMIT` ``beta``
-    (``sqrt(kp / I) dt <= beta``, and so ``kv dt / I <= 2 zeta beta``: stable at the physics step even where the
-    damping is integrated explicitly, the bound being 2) and :data:`PD_DAMPING_RATIO` ``zeta`` (critical damping
-    of the joint swinging on its own inertia).
-
-    Args:
-        inertia: ``I``, the joint's reflected inertia: the diagonal of the joint-space mass matrix at the ready
-            posture, the rotor's armature included [kg m^2].
-        moment: ``W``, the weight moment the joint holds [N m] (0: the bandwidth alone).
-        timestep: ``dt``, the period of the PD loop, the physics step [s].
-
-    Raises:
-        InvalidParameterError: A non-positive inertia or time step, or a negative moment.
-    """
-    if not inertia > 0 or not math.isfinite(inertia):
-        raise InvalidParameterError("inertia", inertia, "a finite reflected inertia > 0 kg m^2")
-    if not timestep > 0:
-        raise InvalidParameterError("timestep", timestep, "a physics step > 0 s")
-    if not moment >= 0:
-        raise InvalidParameterError("moment", moment, "a weight moment >= 0 N m")
-    kp = max(inertia * PD_BANDWIDTH ** 2, PD_LOAD_STIFFNESS * moment)
-    kp = min(kp, inertia * (PD_STEP_LIMIT / timestep) ** 2)
-    return kp, 2.0 * PD_DAMPING_RATIO * math.sqrt(kp * inertia)
-
-
-def _weight_moment(model: Any, data: Any, joint: int) -> float:
-    """The largest moment of the weight of the bodies a hinge moves about its axis [N m]: their mass times g
-    times their centre of mass's distance from the axis line."""
-    body = int(model.jnt_bodyid[joint])
-    axis = data.xaxis[joint]
-    lever = data.subtree_com[body] - data.xanchor[joint]
-    distance = float(np.linalg.norm(lever - axis * float(axis @ lever)))
-    return float(model.body_subtreemass[body]) * float(np.linalg.norm(model.opt.gravity)) * distance
-
-
-def _pd_layer(model: Any, data: Any, qpos: Array, leg_joints: set[int], leg_moment: float,
-              given: dict[str, tuple[float, float | None]]) -> tuple[tuple[str, Actuator], ...]:
-    """The joints the PD layer drives, with their actuators (gains from :func:`pd_gains` at the posture ``qpos``,
-    or ``given``: joint name -> (kp, kv or None for critical damping)): every torque motor on a hinge or slide,
-    every leg joint without an actuator, and every joint of a model without actuators (a URDF). A leg joint holds
-    ``leg_moment`` [N m]; another hinge the weight of what it moves (:func:`_weight_moment`); a slide nothing.
-
-    Raises:
-        InvalidParameterError: ``given`` names a joint the layer does not drive, or a leg joint's torque
-            limit is 0.
-    """
-    import mujoco
-
-    data.qpos[:] = qpos
-    mujoco.mj_forward(model, data)
-    inertia = np.zeros((model.nv, model.nv))
-    mujoco.mj_fullM(model, data, inertia)
-    timestep = min(float(model.opt.timestep), PHYSICS_STEP)
-    layer = []
-    for j in range(model.njnt):
-        hinge = int(model.jnt_type[j]) == mujoco.mjtJoint.mjJNT_HINGE  # a numpy integer is never `in` enums
-        if not hinge and int(model.jnt_type[j]) != mujoco.mjtJoint.mjJNT_SLIDE:
-            continue
-        name = _name(model, mujoco.mjtObj.mjOBJ_JOINT, j)
-        existing = _actuator(model, j)
-        if existing is None and (j in leg_joints or model.nu == 0):
-            existing = Actuator(PD_PREFIX + name, "none", 0.0, 0.0, _joint_torque_limit(model, j))
-        if existing is None or existing.kind not in ("motor", "none"):
-            continue
-        if existing.force_limit == 0.0:
-            if j in leg_joints:
-                raise InvalidParameterError(f"{name} torque limit", 0.0, "a leg joint's torque limit > 0 N m "
-                                            "(actuatorfrcrange, a URDF's <limit effort>, the motor's ctrlrange)")
-            continue  # the model holds it passive
-        dof = int(model.jnt_dofadr[j])
-        moment = leg_moment if j in leg_joints else _weight_moment(model, data, j) if hinge else 0.0
-        reflected = float(inertia[dof, dof])
-        kp, kv = pd_gains(reflected, moment, timestep)
-        if name in given:
-            kp, wanted = given[name]
-            kv = 2.0 * PD_DAMPING_RATIO * math.sqrt(kp * reflected) if wanted is None else wanted
-        layer.append((name, replace(existing, kp=kp, kv=kv, pd_layer=True, inertia=reflected)))
-    unknown = sorted(set(given) - {name for name, _ in layer})
-    if unknown:
-        raise InvalidParameterError("pd joint", unknown[0], "a joint the PD layer drives (a torque motor's or an "
-                                    "unactuated leg joint): " + ", ".join(name for name, _ in layer))
-    return tuple(layer)

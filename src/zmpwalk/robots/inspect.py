@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from zmpwalk.kinematics import JOINT_COLUMNS
-from zmpwalk.robots.imported import PD_BANDWIDTH, PD_DAMPING_RATIO, PD_LOAD_STIFFNESS, Actuator
+from zmpwalk.robots.description import PD_BANDWIDTH, PD_DAMPING_RATIO, PD_LOAD_STIFFNESS, Actuator
 from zmpwalk.robots.model import RobotModel
 
 if TYPE_CHECKING:

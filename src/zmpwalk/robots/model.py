@@ -16,14 +16,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from zmpwalk.errors import FileFormatError, InvalidParameterError
+from zmpwalk.stabilizer_gains import StabilizerGains
 
 if TYPE_CHECKING:
     from zmpwalk.leg_chain import LegChain
-    from zmpwalk.robots.imported import ModelPlant
+    from zmpwalk.robots.description import ModelPlant
 
 JOINT_NAMES = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll")
 HUBO_PENDULUM = 0.62  # [m] pendulum length the HUBO tables were tuned for (robots/data/hubo.toml)
@@ -264,90 +264,6 @@ def schedule_scale(pendulum_length: float, leg_length: float, hip_spacing: float
     return (math.sqrt(pendulum_length / HUBO_PENDULUM), leg_length / HUBO_LEG_LENGTH, hip_spacing / HUBO_HIP_SPACING)
 
 
-def robot_from_toml(path: Path) -> RobotModel:
-    """Read a robot data file.
-
-    Raises:
-        FileFormatError: Missing, unknown or out-of-range fields (names the field).
-    """
-    from zmpwalk.files import read_toml
-
-    data = read_toml(path)
-    if "model" in data:
-        return _robot_from_model_table(data, path)
-    return robot_from_dict(data, str(path))
-
-
-_MODEL_OVERRIDES = {"posture": ("pelvis_height",),
-                    "walking": ("dsp_time", "foot_lift", "lateral_velocity", "foot_speed_limit",
-                                "foot_acceleration_limit")}
-
-
-def _robot_from_model_table(data: dict[str, Any], path: Path) -> RobotModel:
-    """A robot file whose ``[model]`` names the robot's own MJCF or URDF (written by ``zmpwalk robot --write``)."""
-    from zmpwalk.robots.imported import import_robot
-
-    source = str(path)
-    table = data["model"]
-    known = {"file", "feet", "keyframe", "package_paths", "name"}
-    if not isinstance(table, dict) or "file" not in table or set(table) - known:
-        raise FileFormatError(source, f"[model] needs file = \"MODEL.xml\" and may have: {', '.join(sorted(known))}")
-    feet = table.get("feet")
-    if feet is not None and (not isinstance(feet, list) or len(feet) != 2 or not all(isinstance(f, str) for f in feet)):
-        raise FileFormatError(source, "[model] feet must be two body names: [left, right]")
-    overrides: dict[str, float] = {}
-    for section, names in _MODEL_OVERRIDES.items():
-        values = data.get(section, {})
-        if not isinstance(values, dict):
-            raise FileFormatError(source, f"[{section}] must be a table")
-        for key, value in values.items():
-            if key not in names:
-                raise FileFormatError(source, f"[{section}] unknown field {key!r} for a model robot; known: "
-                                      f"{', '.join(names)}")
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
-                raise FileFormatError(source, f"[{section}] {key} = {value!r} must be a number > 0")
-            overrides[key] = float(value)
-    unknown = set(data) - {"model", "pd", *_MODEL_OVERRIDES}
-    if unknown:
-        raise FileFormatError(source, f"unknown table(s) {', '.join(sorted(unknown))} in a robot file with [model]")
-    packages = tuple(path.parent / str(p) for p in table.get("package_paths", []))
-    try:
-        return import_robot(path.parent / str(table["file"]), feet=(feet[0], feet[1]) if feet else None,
-                            keyframe=table.get("keyframe"), package_paths=packages, name=table.get("name"),
-                            overrides=overrides, pd_gains=_pd_table(data.get("pd"), source))
-    except InvalidParameterError as error:
-        raise FileFormatError(source, f"[pd] {error}") from None
-
-
-def _pd_table(table: object, source: str) -> dict[str, tuple[float, float | None]]:
-    """The ``[pd]`` table of a model robot file: the joint PD layer's gains per model joint,
-    ``JOINT = {kp = [N m/rad], kv = [N m s/rad]}`` (``kv`` may be left out: critical damping)."""
-    if table is None:
-        return {}
-    if not isinstance(table, dict):
-        raise FileFormatError(source, "[pd] must be a table: JOINT = {kp = N m/rad, kv = N m s/rad}")
-    gains: dict[str, tuple[float, float | None]] = {}
-    for joint, entry in table.items():
-        if not isinstance(entry, dict) or "kp" not in entry or set(entry) - {"kp", "kv"}:
-            raise FileFormatError(source, f"[pd] {joint} must be {{kp = N m/rad, kv = N m s/rad}} (kv may be left "
-                                  "out: critical damping)")
-        values: list[float | None] = []
-        for key in ("kp", "kv"):
-            value = entry.get(key)
-            if value is None:
-                values.append(None)
-            elif isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
-                    or not value > 0:
-                raise FileFormatError(source, f"[pd] {joint} {key} = {value!r} must be a finite number > 0")
-            else:
-                values.append(float(value))
-        kp = values[0]
-        if kp is None:  # pragma: no cover - "kp" is required above
-            raise FileFormatError(source, f"[pd] {joint} needs kp")
-        gains[str(joint)] = (kp, values[1])
-    return gains
-
-
 def _table(kind: type[Any], table: object, name: str, source: str) -> Any:
     """A table of positive numbers into the dataclass ``kind`` (None when the table is absent)."""
     if table is None:
@@ -364,12 +280,11 @@ def _table(kind: type[Any], table: object, name: str, source: str) -> Any:
     return kind(**values)
 
 
-def _stabilizer_gains(table: object, source: str) -> tuple[tuple[str, float], ...]:
-    """The [stabilizer] table: gains of :class:`zmpwalk.balance.StabilizerGains` tuned for this robot (the others
-    keep their defaults), checked as the gains check them."""
+def stabilizer_gains(table: object, source: str) -> tuple[tuple[str, float], ...]:
+    """The [stabilizer] table: gains of :class:`zmpwalk.stabilizer_gains.StabilizerGains` tuned for this robot
+    (the others keep their defaults), checked as the gains check them."""
     if table is None:
         return ()
-    from zmpwalk.balance import StabilizerGains  # balance reads this module: import here, when a file has one
 
     known = [f.name for f in fields(StabilizerGains)]
     if not isinstance(table, dict):
@@ -461,7 +376,7 @@ def robot_from_dict(data: dict[str, Any], source: str = "<robot>") -> RobotModel
     values["links"] = _links(data.get("bodies"), values, source)
     values["servos"] = _table(Servos, data.get("servos"), "servos", source)
     values["contact"] = _table(Contact, data.get("contact"), "contact", source)
-    values["stabilizer_gains"] = _stabilizer_gains(data.get("stabilizer"), source)
+    values["stabilizer_gains"] = stabilizer_gains(data.get("stabilizer"), source)
     if values.pop("scale_schedule", True):
         values["schedule_scale"] = schedule_scale(values["pendulum_length"], values["thigh_length"]
                                                   + values["shank_length"], values["hip_spacing"])

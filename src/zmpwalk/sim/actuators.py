@@ -30,7 +30,7 @@ class ActuatorRow:
         mean_power: Mean |torque x velocity| [W].
         torque_limit: The model's actuator limit [N m] (inf where it has none): a position servo's force range,
             a torque motor's control range times its gear (where the joint PD layer clips its torque), the joint's
-            ``actuatorfrcrange`` (a URDF's effort limit), the smallest (:class:`zmpwalk.robots.imported.Actuator`).
+            ``actuatorfrcrange`` (a URDF's effort limit), the smallest (:class:`zmpwalk.robots.description.Actuator`).
         planned_torque: Largest |torque| the plan needs on an ideal robot, held for at least
             :data:`IMPACT_WINDOW` [N m] (the feedforward's inverse dynamics; nan where it did not run).
     """

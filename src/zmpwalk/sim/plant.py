@@ -29,15 +29,11 @@ from numpy.typing import NDArray
 
 from zmpwalk.errors import InvalidParameterError
 from zmpwalk.kinematics import JOINT_COLUMNS
-from zmpwalk.robots.imported import (
-    PHYSICS_STEP,
-    ModelPlant,
-    collision_points,
-    is_position_servo,
-    load_model_spec,
-    rigid_bodies,
-)
+from zmpwalk.robots.collision import collision_points, rigid_bodies
+from zmpwalk.robots.description import PHYSICS_STEP, ModelPlant
+from zmpwalk.robots.imported import load_model_spec
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.robots.pd import is_position_servo
 
 Array = NDArray[np.float64]
 
