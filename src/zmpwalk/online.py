@@ -306,6 +306,14 @@ class OnlineWalker:
         """The command waiting for the step under way to end, if any."""
         return self._pending.command if self._pending else None
 
+    @property
+    def rejected(self) -> StepCommand | None:
+        """The last command, where its check refused it (None: none refused since the last :meth:`command`).
+
+        Free to read in a hard loop: it names no parameter (:attr:`rejection` does, searching the largest
+        stride that fits the first time it is read)."""
+        return self._rejection.command if self._rejection is not None else None
+
     def command(self, command: StepCommand, *, wait: bool = False) -> None:
         """Give ``command`` for after the step under way, replacing one given before it started.
 
