@@ -187,3 +187,64 @@ def test_a_table_without_alpha_serves_stride_zero_and_names_the_missing_alpha_ot
         schedule.stage_parameters(StepCommand(0.8, 0.1), hubo)
     given, _ = schedule.stage_parameters(StepCommand(0.8, 0.1, alpha=1.5), hubo)  # the command's own alpha
     assert given.alpha == pytest.approx(1.5, abs=TOL)
+
+
+def test_the_default_schedule_is_the_papers_tables_with_a_v_y_column():
+    """The two built-in files agree cell by cell in every printed value; the default adds Table 2's
+    lateral_velocity column (0.1 m at 0.95 and 0.8 s, 0.09 m at 0.7 s: tests/test_tables.py derives it)."""
+    from zmpwalk.files import read_toml
+    from zmpwalk.schedule import SCHEDULE_FILES, schedule_path
+
+    assert set(SCHEDULE_FILES) == {"default", "paper"}
+    default, paper = (read_toml(schedule_path(name)) for name in ("default", "paper"))
+    assert default["side"] == paper["side"]
+    forward, printed = default["forward"], paper["forward"]
+    assert {k: v for k, v in forward.items() if k not in ("columns", "rows")} == {
+        k: v for k, v in printed.items() if k not in ("columns", "rows")}
+    assert forward["columns"] == [*printed["columns"], "lateral_velocity"]
+    for row, printed_row in zip(forward["rows"], printed["rows"], strict=True):
+        assert row[:-1] == pytest.approx(printed_row, nan_ok=True, abs=0.0)
+        assert row[-1] == {0.95: 0.1, 0.8: 0.1, 0.7: 0.09}[row[0]]
+
+
+def test_named_schedules_and_the_robots_v_y(hubo):
+    """Schedule.hubo() is the default, Schedule.paper() the printed tables (every step takes the robot's V_y),
+    each read once; an unknown name is an error naming the parameter and what is allowed."""
+    from zmpwalk.errors import InvalidParameterError
+
+    assert Schedule.hubo() is Schedule.named("default") and Schedule.paper() is Schedule.named("paper")
+    for duration, expected in ((0.95, 0.1), (0.8, 0.1), (0.75, 0.095), (0.7, 0.09)):
+        default, _ = Schedule.hubo().stage_parameters(StepCommand(duration, 0.2), hubo)
+        paper, _ = Schedule.paper().stage_parameters(StepCommand(duration, 0.2), hubo)
+        assert default.lateral_velocity == pytest.approx(expected, abs=1e-12)
+        assert paper.lateral_velocity == hubo.lateral_velocity == 0.1
+        assert (default.sway, default.alpha, default.up_ratio) == (paper.sway, paper.alpha, paper.up_ratio)
+    side, recovery = Schedule.hubo().stage_parameters(StepCommand(0.7, side=0.05), hubo)
+    assert side.lateral_velocity == recovery.lateral_velocity == pytest.approx(0.09, abs=1e-12)  # the stride-0 row
+    override, _ = Schedule.hubo().stage_parameters(StepCommand(0.7, 0.2, lateral_velocity=0.08), hubo)
+    assert override.lateral_velocity == 0.08 and override.source == "table+override"
+    with pytest.raises(InvalidParameterError, match=r"schedule = 'tuned' is not allowed; expected one of default, "
+                                                    r"paper or a schedule file"):
+        Schedule.named("tuned")
+
+
+def test_the_schedule_option_takes_a_name_or_a_file(tmp_path, capsys):
+    """--schedule paper reproduces the printed tables' margins, --schedule default (or none) the default's, a
+    file is read, and anything else is one usage error (exit 2) naming the option and the names."""
+    import json
+
+    from zmpwalk.cli import main
+    from zmpwalk.schedule import schedule_path
+
+    margins = {}
+    for option in ([], ["--schedule", "default"], ["--schedule", "paper"],
+                   ["--schedule", str(schedule_path("paper"))]):
+        assert main(["plan", "--scenario", "fig27", "--json", "--allow-outside", *option]) == 0
+        margins[" ".join(option[1:]) or "none"] = json.loads(capsys.readouterr().out)["min_zmp_margin"]
+    assert margins["none"] == margins["default"] == pytest.approx(0.0170, abs=0.5e-3)  # [m]
+    assert margins["paper"] == margins[str(schedule_path("paper"))] == pytest.approx(-0.0127, abs=0.5e-3)
+    assert main(["tables", "--schedule", "paper", "--steps", "2", "--json"]) == 0
+    rows = {(r["mode"], r["duration"], r["stride"]): r["min_margin"] for r in json.loads(capsys.readouterr().out)}
+    assert rows[("forward", 0.7, 0.2)] < 0.0 < rows[("forward", 0.8, 0.2)]
+    assert main(["plan", "--scenario", "fig27", "--schedule", str(tmp_path / "nope")]) == 2
+    assert "--schedule" in capsys.readouterr().err

@@ -30,10 +30,10 @@ from zmpwalk.patterns.result import WalkingPattern, write_pieces_csv
 from zmpwalk.robots import list_robots, load_robot
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.scenarios import list_scenarios, load_scenario_with_labels, load_steps_file_with_labels
-from zmpwalk.schedule import Schedule
+from zmpwalk.schedule import SCHEDULE_FILES, Schedule, schedule_path
 from zmpwalk.sim.motors import Motor
 from zmpwalk.sim.verdict import HOLD, SETTLE, Verdict
-from zmpwalk.tables import condition_margins, margins_markdown
+from zmpwalk.tables import condition_margins, margins_markdown, zmp_advice
 
 if TYPE_CHECKING:
     from zmpwalk.patterns.correction import ZmpCorrection
@@ -89,10 +89,23 @@ def _load_robot(args: argparse.Namespace) -> RobotModel:
 
 
 def _schedule(args: argparse.Namespace) -> Schedule | None:
-    path = getattr(args, "schedule", None)
-    if path is None:
+    """--schedule: a built-in schedule's name (default, paper) or a schedule file; None without it (the default)."""
+    value = getattr(args, "schedule", None)
+    if value is None:
         return None
-    return Schedule.from_file(path)  # the polynomial pattern's tables, and every generator's footstep timing
+    if value in SCHEDULE_FILES:
+        return Schedule.named(value)
+    if not Path(value).exists():
+        raise _UsageError(f"--schedule {value!r} is neither a built-in schedule ({', '.join(SCHEDULE_FILES)}) nor a "
+                          "file")
+    return Schedule.from_file(Path(value))  # the polynomial pattern's tables, and every generator's footstep timing
+
+
+def _schedule_option(parser: argparse.ArgumentParser, example: str = "") -> None:
+    names = ", ".join(SCHEDULE_FILES)
+    parser.add_argument("--schedule", metavar="NAME|FILE",
+                        help=f"parameter tables: one of {names} (default: HUBO's, Tables 2-3 with V_y per step "
+                        f"time; paper: Tables 2-3 as printed) or a schedule file (TOML){example}")
 
 
 DASK_HELP = ("run on a Dask cluster: its scheduler's address (tcp://host:8786), or local "
@@ -156,7 +169,7 @@ def _plan_parsers(commands: argparse._SubParsersAction[_Parser]) -> None:
     plan.add_argument("steps", nargs="?", help="steps file (TOML, [[steps]] tables)")
     plan.add_argument("--scenario", help="a built-in scenario instead of a steps file (see 'zmpwalk scenarios')")
     _robot_options(plan)
-    plan.add_argument("--schedule", type=Path, help="your own parameter tables (TOML, the format of Tables 2-3)")
+    _schedule_option(plan)
     plan.add_argument("--pelvis", choices=("cubic", "quintic"), default="cubic",
                         help="pelvis curves: the paper's cubics, or quintics with a continuous cart-table ZMP")
     plan.add_argument("--rate", type=float, default=1000.0,
@@ -198,7 +211,7 @@ def _simulate_parser(commands: argparse._SubParsersAction[_Parser]) -> None:
                               help="the walk of Lim et al. (start, 2 steady steps, stop; hyperbolic)")
     simulate_cmd.add_argument("--steady-steps", type=int, default=2, help="steady steps of --paper-example")
     _robot_options(simulate_cmd)
-    simulate_cmd.add_argument("--schedule", type=Path, help="your own parameter tables (TOML)")
+    _schedule_option(simulate_cmd)
     simulate_cmd.add_argument("--pelvis", choices=("cubic", "quintic"), default="cubic",
                         help="pelvis curves: the paper's cubics, or quintics with a continuous cart-table ZMP")
     _balance_options(simulate_cmd)
@@ -239,7 +252,7 @@ def _report_parsers(commands: argparse._SubParsersAction[_Parser]) -> None:
         report_cmd.add_argument("--steps", type=Path, dest="steps_option", metavar="STEPS",
                                 help="the steps file given as an option (the same as the positional STEPS)")
         _robot_options(report_cmd)
-        report_cmd.add_argument("--schedule", type=Path, help="your own parameter tables (TOML)")
+        _schedule_option(report_cmd)
         report_cmd.add_argument("--pelvis", choices=("cubic", "quintic"), default="cubic",
                             help="pelvis curves: the paper's cubics, or quintics with a continuous cart-table ZMP")
         _balance_options(report_cmd, default="on")
@@ -260,6 +273,7 @@ def _batch_parsers(commands: argparse._SubParsersAction[_Parser]) -> None:
         epilog="example: zmpwalk tables --steps 10",
     )
     _robot_options(tables)
+    _schedule_option(tables)
     tables.add_argument("--steps", type=int, default=10, help="steps walked per condition (default: 10)")
     tables.add_argument("--json", action="store_true", help="print JSON instead of Markdown")
     sweep_cmd = commands.add_parser(
@@ -275,7 +289,7 @@ def _batch_parsers(commands: argparse._SubParsersAction[_Parser]) -> None:
     sweep_cmd.add_argument("--balance", choices=("on", "off"), default=None,
                            help="the stabilizer (default: on for a robot's own model, off for the box models)")
     sweep_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
-    sweep_cmd.add_argument("--schedule", type=Path, help="your own parameter tables (TOML), e.g. from zmpwalk tune")
+    _schedule_option(sweep_cmd, " (e.g. from zmpwalk tune)")
     sweep_cmd.add_argument("--pelvis", choices=("cubic", "quintic"), default="cubic",
                            help="pelvis curves: the paper's cubics, or quintics with a continuous cart-table ZMP")
     sweep_cmd.add_argument("--json", action="store_true", help="print JSON")
@@ -287,7 +301,9 @@ def _batch_parsers(commands: argparse._SubParsersAction[_Parser]) -> None:
         epilog="example: zmpwalk tune --robot hubo --out hubo_tuned.toml --storage tune.db",
     )
     _robot_options(tune_cmd)
-    tune_cmd.add_argument("--schedule", type=Path, help="the schedule to start from (default: Tables 2-3)")
+    tune_cmd.add_argument("--schedule", metavar="NAME|FILE",
+                          help="the schedule to start from: default, paper or a schedule file (TOML); without it "
+                          "Tables 2-3 as printed (paper)")
     tune_cmd.add_argument("--out", type=Path, required=True, help="schedule file to write (TOML)")
     tune_cmd.add_argument("--trials", type=int, default=40, help="candidates per condition (default: 40)")
     tune_cmd.add_argument("--steps", type=int, default=10, help="steps walked per candidate (default: 10)")
@@ -591,7 +607,8 @@ def _sweep(args: argparse.Namespace) -> int:
     started, cpu = time.perf_counter(), time.process_time()
     schedule = _schedule(args)  # read here: a bad file is one error, not one per worker
     results = sweep(args.robot, names, balance=balance, workers=workers, progress=show, generator=args.generator,
-                    schedule=str(args.schedule.resolve()) if schedule is not None else None, pelvis=_pelvis(args),
+                    schedule=str(schedule_path(args.schedule).resolve()) if schedule is not None else None,
+                    pelvis=_pelvis(args),
                     scheduler=args.dask)
     wall = time.perf_counter() - started
     walked = sum(r.seconds for r in results)
@@ -620,7 +637,7 @@ def _tune(args: argparse.Namespace) -> int:
     _robot_by_name(args)
     if args.workers is not None and args.workers < 1:
         raise _UsageError(f"--workers = {args.workers} must be >= 1")
-    data = read_toml(args.schedule) if args.schedule else None
+    data = read_toml(schedule_path(args.schedule)) if args.schedule else None
     show = None if args.json else (
         (lambda done, total, best: _progress(f"conditions (best {best * 1e3:+.1f} mm)", done, total))
         if sys.stderr.isatty() else  # a log file: one line per condition (a tune runs for minutes)
@@ -717,6 +734,10 @@ def _plan(args: argparse.Namespace) -> int:
             for _ in stream:
                 pass
     result = {**summary.result(), "out": str(args.out) if args.out else None}
+    outside = float(result["min_zmp_margin"]) < 0  # type: ignore[arg-type]
+    if outside and args.generator == "polynomial" and _pelvis(args) == "cubic":  # what to change, from its terms
+        result["advice"] = zmp_advice(robot, commands, float(result["min_zmp_margin_time"]),  # type: ignore[arg-type]
+                                      float(result["min_zmp_margin"]), schedule, labels).text  # type: ignore[arg-type]
     if args.json:
         print(json.dumps(result, indent=2))
     else:
@@ -725,7 +746,8 @@ def _plan(args: argparse.Namespace) -> int:
               f"{args.rate:g} Hz" + (f" -> {args.out}" if args.out else
                                      "; no CSV written (give --out FILE to write it)"))
         print(f"min ZMP margin: {_margin_words(margin, float(result['min_zmp_margin_time']))}")  # type: ignore[arg-type]
-    outside = float(result["min_zmp_margin"]) < 0  # type: ignore[arg-type]
+        if "advice" in result:
+            print(f"to bring it inside: {result['advice']}")
     return EXIT_FAILED if outside and not args.allow_outside else 0
 
 
@@ -780,7 +802,7 @@ def _run(args: argparse.Namespace) -> int:
     if args.command == "tables":
         if args.steps < 1:
             raise _UsageError(f"--steps = {args.steps} must be >= 1")
-        results = condition_margins(_load_robot(args), steps=args.steps)
+        results = condition_margins(_load_robot(args), schedule=_schedule(args), steps=args.steps)
         if args.json:
             print(json.dumps([vars(r) for r in results], indent=2))
         else:

@@ -26,7 +26,12 @@ step up as follows:
    --timing`` writes them).
 4. Outside the tabulated range (a step time below 0.7 s or above 0.95 s, a
    stride beyond the longest row) the nearest edge value is held and the
-   lookup is marked ``extrapolated``; the pattern reports it per step.
+   lookup is marked ``extrapolated``; the pattern reports it per step. ``V_y``
+   is the exception below the shortest tabulated step time: held, the sway's
+   crossing acceleration ``(4 alpha1 V_y - 6 beta1 S_y) / tau^2`` would grow as
+   ``1 / T^2``; instead ``4 alpha1 V_y - 6 beta1 S_y`` shrinks with ``T^2``, so
+   the cart-table ZMP where the sway crosses the middle stays where the
+   shortest row puts it (:func:`held_crossing_velocity`).
 5. Any value given in the :class:`~zmpwalk.commands.StepCommand` replaces the
    scheduled one.
 6. Another robot walks the tables at the dynamically similar condition
@@ -37,6 +42,11 @@ step up as follows:
    ``f / (L / L_HUBO)`` with ``L`` the leg length (the legs sweep HUBO's
    angles), and a side step and the sway ``S_y`` scale with the hip spacing
    (the lateral distance the sway must cover). HUBO's own factors are 1.
+
+Named schedules (:data:`SCHEDULE_FILES`): ``default`` (:meth:`Schedule.hubo`), Tables 2-3 with Table 2's
+``lateral_velocity`` column (``V_y`` per step time, chosen with :func:`sway_crossing_zmp`: 0.1 m at 0.95 and
+0.8 s, 0.09 m at 0.7 s), and ``paper`` (:meth:`Schedule.paper`), Tables 2-3 as printed, where every step takes
+the robot's ``V_y``.
 """
 
 from __future__ import annotations
@@ -53,7 +63,7 @@ from typing import Any
 import numpy as np
 
 from zmpwalk.commands import StepCommand
-from zmpwalk.errors import FileFormatError
+from zmpwalk.errors import FileFormatError, InvalidParameterError
 from zmpwalk.files import read_toml
 from zmpwalk.robots.model import RobotModel
 
@@ -236,8 +246,25 @@ class Schedule:
 
     @classmethod
     def hubo(cls) -> Schedule:
-        """Tables 2 and 3 of Park et al. (2008) (read once; a schedule is not modified after reading)."""
-        return _hubo_schedule()
+        """HUBO's default schedule: Tables 2 and 3 of Park et al. (2008) with ``V_y`` per step time
+        (``data/schedule_hubo_default.toml``; read once, a schedule is not modified after reading)."""
+        return cls.named("default")
+
+    @classmethod
+    def paper(cls) -> Schedule:
+        """Tables 2 and 3 of Park et al. (2008) as printed (``data/schedule_hubo.toml``): ``V_y`` is the robot's."""
+        return cls.named("paper")
+
+    @classmethod
+    def named(cls, name: str) -> Schedule:
+        """A built-in schedule by name (:data:`SCHEDULE_FILES`), read once.
+
+        Raises:
+            InvalidParameterError: An unknown name.
+        """
+        if name not in SCHEDULE_FILES:
+            raise InvalidParameterError("schedule", name, f"one of {', '.join(SCHEDULE_FILES)} or a schedule file")
+        return _named_schedule(name)
 
     def stage_parameters(
         self, command: StepCommand, robot: RobotModel
@@ -292,6 +319,11 @@ class Schedule:
         # V_y and d: Table 2's row where the forward table carries them (table units), else the robot's
         lateral_velocity = row["lateral_velocity"] * lateral_scale if "lateral_velocity" in row \
             else robot.lateral_velocity
+        shortest = self._forward.durations[0]
+        if duration < shortest - EXACT:  # below the tables: the crossing's ZMP held, not V_y (module docstring)
+            lateral_velocity = held_crossing_velocity(
+                lateral_velocity, sway, open_alpha1, open_beta1, duration / shortest,
+                (1.0 - open_d1) * command.duration / 2.0, robot.pendulum_length, robot.gravity)
         dsp_time = row["dsp_time"] * time_scale if "dsp_time" in row else robot.dsp_time
         common = {
             "alpha": alpha, "up_ratio": up_ratio, "sway": sway,
@@ -323,7 +355,84 @@ def _worse(first: str, second: str) -> str:
     return order[max(order.index(first), order.index(second))]
 
 
-@lru_cache(maxsize=1)
-def _hubo_schedule() -> Schedule:
-    path = Path(str(resources.files("zmpwalk") / "data" / "schedule_hubo.toml"))
-    return Schedule.from_file(path)
+# the built-in schedules by name: --schedule NAME, Schedule.named(NAME)
+SCHEDULE_FILES = {"default": "schedule_hubo_default.toml", "paper": "schedule_hubo.toml"}
+
+
+def schedule_path(name_or_file: str | Path) -> Path:
+    """The file of a built-in schedule's name (:data:`SCHEDULE_FILES`), or the path given (a file named like a
+    built-in schedule is given as ``./paper``)."""
+    if isinstance(name_or_file, str) and name_or_file in SCHEDULE_FILES:
+        return Path(str(resources.files("zmpwalk") / "data" / SCHEDULE_FILES[name_or_file]))
+    return Path(name_or_file)
+
+
+@lru_cache(maxsize=len(SCHEDULE_FILES))
+def _named_schedule(name: str) -> Schedule:
+    return Schedule.from_file(schedule_path(name))
+
+
+SWAY_RULE = (1.5, 3.0)  # [-] alpha1 V_y / (beta1 S_y) strictly between: sway cubics without inflection (Eq. 20)
+
+
+def sway_crossing_zmp(lateral_velocity: float, sway: float, alpha1: float, beta1: float, back_time: float,
+                      pendulum_length: float, gravity: float) -> float:
+    """Distance [m] of the cart-table ZMP from the middle of the stance where the sway crosses it (Eqs. 1-2, 20).
+
+    The returning sway cubic of Eq. 20 runs, in units of its own time ``tau = back_time`` (``(1 - d1) T / 2``,
+    Eq. 18), from ``-beta1 S_y`` at rest to the middle at the slope ``alpha1 V_y``. A cubic Hermite curve's
+    second derivative at its end is ``6 p0 + 2 m0 - 6 p1 + 4 m1``, here ``4 alpha1 V_y - 6 beta1 S_y`` per unit
+    time squared; the pelvis is then at the middle, so the ZMP ``p = y - (l / g) y''`` (Eqs. 1-2) lies
+    ``(l / g) (4 alpha1 V_y - 6 beta1 S_y) / tau^2`` from it, on the side of the foot the sway leaves (the next
+    stage's outgoing cubic starts with the opposite acceleration: as far on the other side when the two
+    stages share their parameters). Positive when ``alpha1 V_y > 1.5 beta1 S_y``.
+
+    Args:
+        lateral_velocity: ``V_y`` [m per unit ``2 t_bar``].
+        sway: ``S_y`` [m].
+        alpha1: Eq. 20's multiplier of ``V_y`` [-].
+        beta1: Eq. 20's multiplier of ``S_y`` [-].
+        back_time: ``tau``, the returning cubic's length [s].
+        pendulum_length: ``l`` [m].
+        gravity: ``g`` [m/s^2].
+    """
+    return pendulum_length / gravity * (4.0 * alpha1 * lateral_velocity - 6.0 * beta1 * sway) / back_time**2
+
+
+def crossing_velocity(offset: float, sway: float, alpha1: float, beta1: float, back_time: float,
+                      pendulum_length: float, gravity: float) -> float:
+    """The ``V_y`` [m per unit ``2 t_bar``] that puts the crossing's ZMP ``offset`` [m] from the middle:
+    :func:`sway_crossing_zmp` solved for ``V_y``, ``(6 beta1 S_y + (g / l) offset tau^2) / (4 alpha1)``
+    (arguments as there)."""
+    return (6.0 * beta1 * sway + gravity / pendulum_length * offset * back_time**2) / (4.0 * alpha1)
+
+
+def held_crossing_velocity(lateral_velocity: float, sway: float, alpha1: float, beta1: float, time_ratio: float,
+                           back_time: float, pendulum_length: float, gravity: float) -> float:
+    """``V_y`` [m per unit ``2 t_bar``] of a step ``time_ratio`` (< 1) times as long as the shortest tabulated
+    step: lowered to hold the crossing's ZMP (:func:`sway_crossing_zmp`) where ``lateral_velocity`` puts it at
+    that step, but not below the ``V_y`` where the sway's turn-around takes over as the farther ZMP.
+
+    With ``d1`` held, ``tau`` is proportional to the step time, so the crossing's offset stays when
+    ``4 alpha1 V_y - 6 beta1 S_y`` shrinks with ``time_ratio^2``:
+    ``V_y' = (6 beta1 S_y + (4 alpha1 V_y - 6 beta1 S_y) time_ratio^2) / (4 alpha1)``. Lowering ``V_y`` moves the
+    other end of the sway outwards: where the outgoing cubic (0 at slope ``alpha1 V_y`` to ``beta1 S_y`` at rest)
+    turns into the stay, its second derivative is ``2 alpha1 V_y - 6 beta1 S_y``, so the ZMP there is
+    ``beta1 S_y + (l / g) (6 beta1 S_y - 2 alpha1 V_y) / tau^2`` from the middle. The two are equal at
+    ``alpha1 V_y = beta1 S_y (2 + tau^2 g / (6 l))``; below it the turn-around is the farther, and ``V_y`` is not
+    lowered past it. ``V_y`` is never raised.
+
+    Args:
+        lateral_velocity: ``V_y`` at the shortest tabulated step time [m per unit ``2 t_bar``].
+        sway: ``S_y`` [m].
+        alpha1: Eq. 20's multiplier of ``V_y`` [-].
+        beta1: Eq. 20's multiplier of ``S_y`` [-].
+        time_ratio: The step time over the shortest tabulated one [-].
+        back_time: ``tau`` of the short step, ``(1 - d1) T / 2`` [s].
+        pendulum_length: ``l`` [m].
+        gravity: ``g`` [m/s^2].
+    """
+    excess = 4.0 * alpha1 * lateral_velocity - 6.0 * beta1 * sway  # [m] per unit time squared
+    held = (6.0 * beta1 * sway + excess * time_ratio**2) / (4.0 * alpha1)
+    balance = beta1 * sway * (2.0 + back_time**2 * gravity / (6.0 * pendulum_length)) / alpha1
+    return min(lateral_velocity, max(held, balance))
