@@ -1,0 +1,299 @@
+"""One object for a robot's control loop: the walker, the stabilizer and the feedforward behind ``update()``.
+
+.. code-block:: python
+
+    controller = WalkingController(load_robot("hubo"), rate=1000)
+    controller.command(StepCommand(duration=0.8, forward=0.2))   # or controller.set_velocity(0.2, 0.0, 0.0)
+    while running:
+        targets = controller.update(plant.measure())             # one walker tick, one stabilizer tick
+        plant.apply(targets)                                     # angles [rad], rates [rad/s], tau_ff [N m]
+        plant.step()
+
+Per tick :meth:`WalkingController.update` runs one :meth:`~zmpwalk.online.OnlineWalker.tick` (the walker's bounded
+share of a command's check included), one :meth:`~zmpwalk.balance.Stabilizer.update` on the measurement and, where
+one is given, the :class:`Feedforward`'s torques of the tick's sample: no planning beyond what the walker's tick
+does, whatever the timing of commands.
+
+**Velocity commands** (:meth:`WalkingController.set_velocity`), as joysticks and learned policies give them, become
+one :class:`~zmpwalk.commands.StepCommand` by :func:`velocity_command`'s rule, given to the walker for every step
+while the velocity holds; nothing is clipped: a step the robot cannot take is the walker's rejection
+(:attr:`WalkingController.rejection`), and the walk then stops after the step under way.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from typing import Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zmpwalk.balance import BalanceMeasurement, Stabilizer
+from zmpwalk.commands import StepCommand
+from zmpwalk.control.plant import JointTargets
+from zmpwalk.errors import InvalidParameterError, ZmpwalkError
+from zmpwalk.online import OnlineWalker, WalkingSample
+from zmpwalk.robots.model import RobotModel
+from zmpwalk.schedule import Schedule
+from zmpwalk.stabilizer_gains import StabilizerGains
+
+Array = NDArray[np.float64]
+
+SUPPORT_CODES = {"double": 0, "left": 1, "right": 2}  # a sample's support as the stabilizer takes it
+VELOCITY_FIELDS = {"forward": "vx", "side": "vy", "turn": "wz"}  # a step's stride field -> its velocity
+
+
+class Feedforward(Protocol):
+    """The joint torques [N m] (12,) the planned motion of one sample needs (inverse dynamics of a model).
+
+    :class:`zmpwalk.sim.loop.ModelFeedforward` computes them from a MuJoCo model, tick by tick.
+    """
+
+    def torques(self, sample: WalkingSample) -> Array:
+        """Torques [N m], (12,), in the walker's joint-column order, for ``sample`` (given once per tick, in order)."""
+        ...
+
+
+def velocity_step_time(schedule: Schedule, robot: RobotModel, vx: float, vy: float, wz: float) -> float:
+    """The step time [s] a walking velocity is walked at: the longest of the schedule's tabulated step times (scaled
+    to ``robot``) whose tables hold the velocity's steps, else the shortest.
+
+    A step of time ``T`` takes the stride ``|vx| T``, a side step ``2 |vy| T`` and a turn ``2 |wz| T`` (side and
+    turn steps take two swings, :mod:`zmpwalk.commands`); each must be at most the table's longest entry at that
+    step time (the side table's, the turn table's where the schedule has one; strides scaled by the robot's stride
+    and lateral factors, step times by its time factor). The longest such step time is the slowest cadence whose
+    steps the tables were tuned for; a velocity beyond every table takes the shortest step time, and its steps
+    are checked by the walker like any other.
+
+    Args:
+        schedule: The walker's schedule.
+        robot: The robot (its :attr:`~zmpwalk.robots.model.RobotModel.schedule_scale`).
+        vx, vy, wz: Forward [m/s], leftward [m/s] and counter-clockwise [rad/s] velocity.
+    """
+    time_scale, stride_scale, lateral_scale = robot.schedule_scale
+    scales = {"forward": stride_scale, "side": lateral_scale, "turn": 1.0}
+    longest: dict[tuple[str, float], float] = {}
+    for mode, duration, value in schedule.conditions():
+        key = (mode, duration)
+        longest[key] = max(longest.get(key, 0.0), abs(value) * scales[mode])
+    has_turn_table = any(mode == "turn" for mode, _ in longest)
+    times = sorted({duration for mode, duration in longest if mode == "forward"}, reverse=True)
+    for duration in times:
+        step_time = duration * time_scale
+        needs = {"forward": abs(vx) * step_time, "side": 2.0 * abs(vy) * step_time, "turn": 2.0 * abs(wz) * step_time}
+        if all(need == 0.0 or (mode == "turn" and not has_turn_table)
+               or need <= longest.get((mode, duration), 0.0) + 1e-12 for mode, need in needs.items()):
+            return step_time
+    return times[-1] * time_scale
+
+
+def velocity_command(schedule: Schedule, robot: RobotModel, vx: float, vy: float, wz: float,
+                     step_time: float | None = None) -> StepCommand:
+    """The step that walks a velocity: ``forward = vx T``, ``side = 2 vy T``, ``turn = 2 wz T`` at the step time
+    ``T`` of :func:`velocity_step_time` (or ``step_time``), nothing clipped.
+
+    Raises:
+        InvalidParameterError: A velocity that is not a finite number, or whose step no robot could take (a stride
+            over :data:`~zmpwalk.commands.MAX_STRIDE`, a turn over :data:`~zmpwalk.commands.MAX_TURN` per swing),
+            naming the velocity, its value and the step time; or a step time outside
+            [:data:`~zmpwalk.commands.MIN_DURATION`, :data:`~zmpwalk.commands.MAX_DURATION`].
+    """
+    velocity = {"vx": vx, "vy": vy, "wz": wz}
+    for name, value in velocity.items():
+        if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(float(value)):
+            raise InvalidParameterError(name, value, "a finite number (m/s for vx and vy, rad/s for wz)")
+    vx, vy, wz = float(vx), float(vy), float(wz)
+    if step_time is None:
+        step_time = velocity_step_time(schedule, robot, vx, vy, wz)
+    try:
+        return StepCommand(duration=step_time, forward=vx * step_time, side=2.0 * vy * step_time,
+                           turn=2.0 * wz * step_time)
+    except InvalidParameterError as error:
+        if error.parameter not in VELOCITY_FIELDS:
+            raise InvalidParameterError("step_time", step_time, error.allowed) from None
+        name = VELOCITY_FIELDS[error.parameter]
+        factor = "" if name == "vx" else "2 "
+        raise InvalidParameterError(
+            name, velocity[name], f"a velocity whose step at the step time {step_time:g} s ({error.parameter} = "
+            f"{factor}{name} T = {error.value:g}) is {error.allowed}") from None
+
+
+class WalkingController:
+    """The walker (with joints), the stabilizer and an optional feedforward behind one :meth:`update` per tick.
+
+    Args:
+        robot: The robot.
+        rate: Control rate [Hz] (the walker's and the stabilizer's).
+        schedule: The walker's parameter tables (default: HUBO's, :meth:`Schedule.hubo`).
+        generator: ``"polynomial"`` or ``"hyperbolic"`` (:class:`~zmpwalk.online.OnlineWalker`).
+        pelvis: ``"cubic"`` or ``"quintic"`` (polynomial generator).
+        balance: Run the stabilizer (False: the pattern's angles, open loop).
+        gains: The stabilizer's gains (default: the robot file's, :class:`~zmpwalk.balance.Stabilizer`).
+        feedforward: Torques of the planned motion per tick (:class:`Feedforward`), sent as
+            :attr:`JointTargets.torques`; None: no torques (the targets' ``torques`` is None).
+
+    Raises:
+        InvalidParameterError: As :class:`~zmpwalk.online.OnlineWalker` and :class:`~zmpwalk.balance.Stabilizer`
+            (a rate outside [10, 10000] Hz, an unknown generator or pelvis).
+
+    Attributes:
+        walker: The :class:`~zmpwalk.online.OnlineWalker` (read its state; command through the controller).
+        stabilizer: The :class:`~zmpwalk.balance.Stabilizer`, or None with ``balance=False``.
+        fault: The last error that kept the stabilizer from correcting a tick (a measurement it could not use), or
+            None; that tick's targets are the pattern's (``corrected`` False) and the stabilizer starts again.
+        faults: How many ticks it kept it from correcting.
+    """
+
+    def __init__(self, robot: RobotModel, rate: float = 1000.0, *, schedule: Schedule | None = None,
+                 generator: str = "polynomial", pelvis: str = "cubic", balance: bool = True,
+                 gains: StabilizerGains | None = None, feedforward: Feedforward | None = None) -> None:
+        self.robot = robot
+        self.schedule = schedule or Schedule.hubo()
+        self.walker = OnlineWalker(robot, rate, self.schedule, joints=True, pelvis=pelvis, generator=generator)
+        self.rate = self.walker.rate
+        self.stabilizer = Stabilizer(robot, rate, gains) if balance else None
+        self.feedforward = feedforward
+        self.fault: ZmpwalkError | None = None
+        self.faults = 0
+        self._velocity: tuple[float, float, float] | None = None
+        self._velocity_step: StepCommand | None = None
+        self._velocity_refused = False
+        self._sample: WalkingSample | None = None
+
+    @property
+    def time(self) -> float:
+        """Time of the next tick [s]."""
+        return self.walker.time
+
+    @property
+    def sample(self) -> WalkingSample | None:
+        """The last tick's sample of the pattern (None before the first :meth:`update`)."""
+        return self._sample
+
+    @property
+    def velocity(self) -> tuple[float, float, float] | None:
+        """The walking velocity being walked (vx [m/s], vy [m/s], wz [rad/s]), or None (step commands)."""
+        return self._velocity
+
+    @property
+    def velocity_step(self) -> StepCommand | None:
+        """The step the velocity is walked with (:func:`velocity_command`), or None."""
+        return self._velocity_step
+
+    @property
+    def rejection(self) -> ZmpwalkError | None:
+        """Why the last command (or the velocity's step) was refused, naming the parameter, its value and what
+        fits (:attr:`OnlineWalker.rejection`: the first read searches the largest stride that fits, tens of
+        milliseconds; read it outside the hard part of the loop, e.g. once :attr:`rejected` is not None)."""
+        return self.walker.rejection
+
+    @property
+    def rejected(self) -> StepCommand | None:
+        """The last command, where it was refused (free to read every tick)."""
+        return self.walker.rejected
+
+    def command(self, step: StepCommand) -> None:
+        """Give the step that follows the one under way (:meth:`OnlineWalker.command`: stored in microseconds,
+        checked a little per :meth:`update`; a refusal is :attr:`rejection`). Leaves velocity mode.
+
+        Raises:
+            InvalidParameterError: ``step`` is not a :class:`~zmpwalk.commands.StepCommand`.
+        """
+        self.walker.command(step)
+        self._leave_velocity()
+
+    def stop(self) -> None:
+        """Stop after the step under way (:meth:`OnlineWalker.stop`); leaves velocity mode."""
+        self.walker.stop()
+        self._leave_velocity()
+
+    def set_velocity(self, vx: float, vy: float, wz: float, *, step_time: float | None = None) -> None:
+        """Walk at a velocity: forward ``vx`` [m/s], leftward ``vy`` [m/s], counter-clockwise ``wz`` [rad/s].
+
+        Every step takes :func:`velocity_command`'s step (its step time from the schedule unless ``step_time``
+        [s] is given), given to the walker as soon as the step before it has begun, so a new velocity takes
+        effect at the next step whose check completes before it begins. All three 0 stops after the step under
+        way (:meth:`stop`). A step the walker refuses is :attr:`rejection`; it is not given again (the walk stops
+        after the step under way) until the next :meth:`set_velocity`.
+
+        Raises:
+            InvalidParameterError: As :func:`velocity_command` (the walk goes on as it was).
+        """
+        if all(isinstance(v, numbers.Real) and not isinstance(v, bool) and v == 0 for v in (vx, vy, wz)):
+            self.stop()
+            return
+        step = velocity_command(self.schedule, self.robot, vx, vy, wz, step_time)
+        self._velocity = (float(vx), float(vy), float(wz))
+        self._velocity_step = step
+        self._velocity_refused = False
+        self.walker.command(step)  # replaces a step queued (or being checked) for after the one under way
+
+    def _leave_velocity(self) -> None:
+        self._velocity = None
+        self._velocity_step = None
+        self._velocity_refused = False
+
+    def _give_velocity_step(self) -> None:
+        """Give the velocity's step for after the step under way, once the walker holds none (bounded: it only
+        stores the command)."""
+        step = self._velocity_step
+        walker = self.walker
+        if step is None or self._velocity_refused or walker.checking is not None or walker.queued is not None:
+            return
+        if walker.rejected is step:
+            self._velocity_refused = True
+            return
+        walker.command(step)
+
+    def update(self, measurement: BalanceMeasurement) -> JointTargets:
+        """One control tick: the walker's sample, corrected by the stabilizer on ``measurement``, and the
+        feedforward's torques.
+
+        Never raises once the measurement is one: a measurement the stabilizer cannot use (wrong sizes, values that
+        make its targets non-finite) gives the pattern's own angles for this tick (``corrected`` False), keeps the
+        error in :attr:`fault` and restarts the stabilizer.
+
+        Raises:
+            InvalidParameterError: ``measurement`` is not a :class:`~zmpwalk.balance.BalanceMeasurement`.
+        """
+        if not isinstance(measurement, BalanceMeasurement):
+            raise InvalidParameterError("measurement", type(measurement).__name__, "a BalanceMeasurement")
+        sample = self.walker.tick()
+        self._sample = sample
+        self._give_velocity_step()
+        angles = sample.joint_angles
+        velocities = sample.joint_velocities
+        if angles is None or velocities is None:  # pragma: no cover - the walker is made with joints
+            raise InvalidParameterError("walker.joints", False, "True")
+        corrected = self._corrected(sample, angles, measurement)
+        torques = None if self.feedforward is None else self.feedforward.torques(sample)
+        return JointTargets(sample.time, angles if corrected is None else corrected, velocities, torques, sample,
+                            corrected is not None)
+
+    def _corrected(self, sample: WalkingSample, angles: Array, measurement: BalanceMeasurement) -> Array | None:
+        """The stabilizer's targets (a copy), or None without a stabilizer or on a fault."""
+        stabilizer = self.stabilizer
+        if stabilizer is None:
+            return None
+        try:
+            targets = stabilizer.update(
+                support=SUPPORT_CODES[sample.support], position_com_in_world=sample.position_pelvis_in_world,
+                yaw_pelvis_in_world=sample.yaw_pelvis_in_world, zmp_in_world=sample.zmp_in_world,
+                ankles_in_world=(sample.position_left_ankle_in_world, sample.position_right_ankle_in_world),
+                foot_yaws=(sample.yaw_left_foot_in_world, sample.yaw_right_foot_in_world), joint_angles=angles,
+                measurement=measurement)
+        except ZmpwalkError as error:
+            self._fault(error)
+            return None
+        if not math.isfinite(float(targets.sum())):
+            self._fault(InvalidParameterError("measurement", "values that make the stabilizer's targets non-finite",
+                                              "finite wrenches, attitude, rates and encoders"))
+            return None
+        return targets.copy()
+
+    def _fault(self, error: ZmpwalkError) -> None:
+        self.fault = error
+        self.faults += 1
+        if self.stabilizer is not None:
+            self.stabilizer.reset()

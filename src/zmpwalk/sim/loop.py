@@ -1,0 +1,303 @@
+"""The simulator runs what a robot runs: a :class:`~zmpwalk.control.WalkingController` on the MuJoCo plant.
+
+:func:`simulate_controller` steps :class:`~zmpwalk.sim.mujoco_plant.MujocoPlant` (the model of
+:func:`zmpwalk.sim.plant.build_plant`, its sensors read as the robot's) and calls
+``controller.update(plant.measure())`` every control period, giving a list of step commands as an operator gives
+them: the first at the first tick (the walk starts :data:`~zmpwalk.online.START_DELAY` later, as a robot's does),
+each next one during the step before it, once that step has begun, ``command_phase`` of its step time into it. The
+result is the :class:`~zmpwalk.sim.run.SimulationResult` of :func:`zmpwalk.sim.run.simulate`, so
+:func:`zmpwalk.sim.verdict.walk_verdict` judges it.
+
+The feedforward runs per tick (:class:`~zmpwalk.sim.mujoco_plant.ModelFeedforward`): the inverse dynamics of the
+tick's planned pose with the planned ground reaction, as :func:`zmpwalk.sim.plant.static_feedforward` computes it
+for a whole pattern; the planned joint rates go to the servos as their rate reference (the servo damping's
+feedforward). Where the batch path differences the planned poses centrally (it sees the future), the per-tick path
+differences backwards over one tick (0.5-1 ms late); a robot's other servos (arms, torso) hold their pose with the
+static torque of the ready posture (the batch path gives them the walk's inverse dynamics). Not simulated here yet:
+sensor latency and noise, capture steps.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zmpwalk.commands import StepCommand
+from zmpwalk.control import JointTargets, WalkingController
+from zmpwalk.control.controller import SUPPORT_CODES
+from zmpwalk.errors import InvalidParameterError, ZmpwalkError
+from zmpwalk.footsteps import sole_corners
+from zmpwalk.kinematics import JOINT_COLUMNS
+from zmpwalk.online import START_DELAY, OnlineWalker
+from zmpwalk.robots.model import RobotModel
+from zmpwalk.sim.mujoco_plant import MujocoPlant
+from zmpwalk.sim.run import (
+    AFTER_FALL,
+    HOLD,
+    LOADED_FRACTION,
+    Disturbances,
+    SimulationResult,
+    _cop_margins,
+    _ground_reaction,
+    _rotation,
+    _rpy,
+)
+from zmpwalk.zmp import batch_hull_margin, edge_margin
+
+Array = NDArray[np.float64]
+
+
+@dataclass
+class ControllerRun:
+    """A walk simulated through a :class:`~zmpwalk.control.WalkingController`.
+
+    Attributes:
+        result: The measurements (:func:`zmpwalk.sim.verdict.walk_verdict` judges them).
+        given: When each command was given [s], in order.
+        rejections: The commands refused: their index in the list, the command and the rejection.
+        faults: Ticks the stabilizer could not correct (:attr:`WalkingController.faults`).
+        controller: The controller, as the run left it.
+    """
+
+    result: SimulationResult
+    given: list[float]  # [s]
+    rejections: list[tuple[int, StepCommand, ZmpwalkError]]
+    faults: int
+    controller: WalkingController
+
+
+class _Operator:
+    """Gives a list of commands as an operator does: the first at once, each next one ``phase`` of the step
+    time into the step before it, once that step has begun (or at once after a refusal)."""
+
+    def __init__(self, commands: Sequence[StepCommand], phase: float, rate: float) -> None:
+        self.pending = list(commands)
+        self.phase, self.rate = phase, rate
+        self.index = -1
+        self.waiting: StepCommand | None = None  # given, not yet begun or refused
+        self.due = 0  # tick at which the next one is given
+        self.given: list[float] = []
+        self.rejections: list[tuple[int, StepCommand, ZmpwalkError]] = []
+
+    @property
+    def done(self) -> bool:
+        return not self.pending and self.waiting is None
+
+    def __call__(self, controller: WalkingController, tick: int) -> None:
+        walker = controller.walker
+        if self.waiting is not None:
+            if walker.checking is not None or walker.queued is not None:
+                return
+            if walker.rejected is not None:  # refused: the operator gives the next one at once
+                self.rejections.append((self.index, self.waiting, controller.rejection or ZmpwalkError()))
+                self.due = tick
+            else:  # its step has begun
+                self.due = tick + round(self.phase * self.waiting.duration * self.rate)
+            self.waiting = None
+        if self.waiting is None and self.pending and tick >= self.due:
+            self.waiting = self.pending.pop(0)
+            self.index += 1
+            controller.command(self.waiting)
+            self.given.append(tick / self.rate)
+
+
+class _Log:
+    """What a run records per tick, preallocated for ``size`` ticks."""
+
+    def __init__(self, size: int, sensors: int, feedforward: bool, balance: bool) -> None:
+        self.readings = np.empty((size, sensors))
+        self.zmp, self.ankles, self.yaws = np.empty((size, 2)), np.empty((size, 2, 3)), np.empty((size, 2))
+        self.support, self.walking = np.empty(size, dtype=np.intp), np.empty(size, dtype=bool)
+        self.torques = np.empty((size, 12)) if feedforward else None
+        self.balance = {"zmp_desired": np.empty((size, 2)), "com_offset": np.empty((size, 2)),
+                        "ankle_offsets": np.empty((size, 4)), "height_difference": np.empty(size),
+                        "pelvis_turn": np.empty((size, 2))} if balance else None
+
+    def record(self, k: int, plant: MujocoPlant, controller: WalkingController, targets: JointTargets) -> None:
+        sample = targets.sample
+        self.readings[k] = plant.data.sensordata
+        self.zmp[k] = sample.zmp_in_world
+        self.ankles[k] = (sample.position_left_ankle_in_world, sample.position_right_ankle_in_world)
+        self.yaws[k] = (sample.yaw_left_foot_in_world, sample.yaw_right_foot_in_world)
+        self.support[k] = SUPPORT_CODES[sample.support]
+        self.walking[k] = controller.walker.walking
+        if self.torques is not None and targets.torques is not None:
+            self.torques[k] = targets.torques
+        if self.balance is not None and controller.stabilizer is not None:
+            state = controller.stabilizer.state
+            for name, value in (("zmp_desired", state.zmp_desired), ("com_offset", state.com_offset),
+                                ("ankle_offsets", state.ankle_offsets.ravel()),
+                                ("height_difference", state.height_difference), ("pelvis_turn", state.pelvis_turn)):
+                self.balance[name][k] = value
+
+
+def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (), *, rate: float = 1000.0,
+                        controller: WalkingController | None = None, plant: MujocoPlant | None = None,
+                        command_phase: float = 0.5, duration: float | None = None, hold: float = HOLD,
+                        operator: Callable[[WalkingController, int], None] | None = None, balance: bool = True,
+                        feedforward: bool = True, mass_scale: float = 1.0, disturbances: Disturbances | None = None,
+                        progress: Callable[[float], None] | None = None) -> ControllerRun:
+    """Walk ``commands`` through a walking controller on the MuJoCo plant, tick by tick (module docstring).
+
+    Args:
+        robot: The robot.
+        commands: The steps, given one by one during the walk (a steps file's, :func:`zmpwalk.scenarios.load_scenario`).
+        rate: Control rate [Hz].
+        controller: The controller (default: a :class:`~zmpwalk.control.WalkingController` with the stabilizer
+            where ``balance`` and the plant's :class:`~zmpwalk.sim.mujoco_plant.ModelFeedforward` where
+            ``feedforward``).
+        plant: The plant (default: a :class:`~zmpwalk.sim.mujoco_plant.MujocoPlant` with ``mass_scale`` and
+            ``disturbances``).
+        command_phase: Each command after the first is given this fraction of the step time into the step before
+            it, in [0, 1).
+        duration: Run this long [s]; None: until every command is given and the walker stands still, then ``hold``.
+        hold: Standing still after the walk [s] (the verdict judges how the walk ends over it).
+        operator: Called every tick before the update with the controller and the tick's index: anything an
+            operator does (commands, velocities, stops); needs a ``duration``.
+        progress: Called with the fraction done now and then (of the run's longest length).
+
+    Returns:
+        The run: its :class:`~zmpwalk.sim.run.SimulationResult`, when each command was given, the refusals.
+
+    Raises:
+        InvalidParameterError: No commands and no duration, an operator without a duration, a phase outside
+            [0, 1), a hold outside [0, 60] s, a controller whose rate is not the plant's.
+    """
+    if not 0.0 <= command_phase < 1.0:
+        raise InvalidParameterError("command_phase", command_phase, "a fraction of the step time in [0, 1)")
+    if duration is None and (operator is not None or not commands):
+        raise InvalidParameterError("duration", duration, "a run length [s] where an operator gives the commands "
+                                    "or none are given")
+    if duration is not None and not 0.0 < duration <= 3600.0:
+        raise InvalidParameterError("duration", duration, "a run length in (0, 3600] s")
+    if not 0.0 <= hold <= 60.0:
+        raise InvalidParameterError("hold", hold, "a time in [0, 60] s")
+    plant = plant or MujocoPlant(robot, rate, mass_scale=mass_scale, disturbances=disturbances)
+    controller = controller or WalkingController(robot, plant.rate, balance=balance,
+                                                 feedforward=plant.feedforward() if feedforward else None)
+    if controller.rate != plant.rate:
+        raise InvalidParameterError("controller.rate", controller.rate, f"the plant's rate, {plant.rate:g} Hz")
+    plant.stand(OnlineWalker(robot, plant.rate, controller.schedule, joints=True).tick())
+    longest = START_DELAY + sum(3.0 * c.duration for c in commands) + 3.0 * max((c.duration for c in commands),
+                                                                               default=0.0) + hold + 5.0
+    size = round((duration if duration is not None else longest) * plant.rate)
+    log = _Log(size, plant.model.nsensordata, controller.feedforward is not None, controller.stabilizer is not None)
+    giver = _Operator(commands, command_phase, plant.rate)
+    end, fall = size, None
+    for k in range(size):
+        if progress is not None and k % 1000 == 0:
+            progress(k / size)
+        giver(controller, k)
+        if operator is not None:
+            operator(controller, k)
+        targets = controller.update(plant.measure())
+        plant.apply(targets)
+        plant.step()
+        log.record(k, plant, controller, targets)
+        if fall is None and plant.fallen():
+            fall, end = k, min(end, k + round(AFTER_FALL * plant.rate) + 1)
+        if duration is None and end == size and giver.done and not controller.walker.walking:
+            end = min(size, k + 1 + round(hold * plant.rate))
+        if k + 1 >= end:
+            break
+    result = _result(robot, plant, log, k + 1, fall, size / plant.rate, hold)
+    return ControllerRun(result, giver.given, giver.rejections, controller.faults, controller)
+
+
+def _plan_margin(robot: RobotModel, log: _Log, n: int) -> float:
+    """The least margin [m] of the walker's ZMP to the planned support polygon (the stance sole, or the hull of both
+    soles in double support) over the run's samples (> 0 inside)."""
+    support, ankles, yaws, zmp = log.support[:n], log.ankles[:n], log.yaws[:n], log.zmp[:n]
+    corners = np.stack([sole_corners(ankles[:, f, 0], ankles[:, f, 1], yaws[:, f], np.full(n, side), robot)
+                        for f, side in ((0, 1.0), (1, -1.0))], axis=1)  # (n, 2, 4, 2), counter-clockwise
+    margin = np.empty(n)
+    single = support != 0
+    if single.any():
+        quad = corners[single, support[single] - 1]
+        edge = np.roll(quad, -1, axis=1) - quad
+        margin[single] = edge_margin(zmp[single], quad, edge, np.ones(edge.shape[:2], dtype=bool))
+    if (~single).any():
+        margin[~single] = batch_hull_margin(zmp[~single], corners[~single].reshape(-1, 8, 2))
+    return float(margin.min())
+
+
+def _soles(robot: RobotModel, plant: MujocoPlant, readings: Array) -> dict[str, Array]:
+    """Per sample: each sole's normal force ``forces`` (n, 2) [N] and CoP ``cop_feet`` (n, 2, 2) (nan unloaded),
+    the total ``cop`` (n, 2), its ``margin`` to the loaded soles, the ankles' ``ankles`` (n, 2, 2) [m], and
+    ``loaded`` (n, 2), as :func:`zmpwalk.sim.run.simulate` measures them."""
+    sensors = plant.sensors
+    reactions = [_ground_reaction(sensors, readings, label, robot.ankle_height) for label in ("left", "right")]
+    forces = np.column_stack([r[0] for r in reactions])
+    loaded = forces > LOADED_FRACTION * plant.weight
+    cop_feet = np.stack([r[1] for r in reactions], axis=1)
+    cop_feet[~loaded] = np.nan
+    weights = np.where(loaded, forces, 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cop = np.nansum(cop_feet * weights[..., None], axis=1) / weights.sum(axis=1)[:, None]
+    cop[~loaded.any(axis=1)] = np.nan
+    corners, ankles = np.empty((len(readings), 2, 4, 2)), np.empty((len(readings), 2, 2))
+    half_length, half_width = robot.foot_length / 2, robot.foot_width / 2
+    for foot, (label, side) in enumerate((("left", 1), ("right", -1))):
+        rotation = _rotation(sensors.take(readings, f"{label}_ankle_quat"))
+        origin = sensors.take(readings, f"{label}_ankle_pos")
+        cx, cy, z = robot.sole_center_x, side * robot.sole_center_y, -robot.ankle_height
+        local = np.array([[cx - half_length, cy - half_width, z], [cx + half_length, cy - half_width, z],
+                          [cx + half_length, cy + half_width, z], [cx - half_length, cy + half_width, z]])
+        corners[:, foot] = (origin[:, None, :] + np.einsum("nij,cj->nci", rotation, local))[..., :2]
+        ankles[:, foot] = origin[:, :2]
+    return {"forces": forces, "loaded": loaded, "cop_feet": cop_feet, "cop": cop, "ankles": ankles,
+            "margin": _cop_margins(cop, corners, loaded)}
+
+
+def _slip(loaded: NDArray[np.bool_], ankles: Array) -> float:
+    """The largest horizontal slide [m] of an ankle while its sole stays loaded."""
+    slip = 0.0
+    for foot in range(2):
+        starts = np.flatnonzero(loaded[:, foot] & ~np.concatenate([[False], loaded[:-1, foot]]))
+        stops = np.flatnonzero(loaded[:, foot] & ~np.concatenate([loaded[1:, foot], [False]]))
+        for a, b in zip(starts, stops, strict=True):
+            slip = max(slip, float(np.linalg.norm(ankles[a:b + 1, foot] - ankles[a, foot], axis=1).max()))
+    return slip
+
+
+def _result(robot: RobotModel, plant: MujocoPlant, log: _Log, n: int, fall: int | None, planned_end: float,
+            hold: float) -> SimulationResult:
+    """The run's :class:`~zmpwalk.sim.run.SimulationResult` from its first ``n`` ticks (sample ``k`` at the end of
+    tick ``k``, time ``(k + 1) / rate``)."""
+    sensors, readings = plant.sensors, log.readings[:n]
+    time = np.arange(1, n + 1) / plant.rate
+    pelvis, rpy = sensors.take(readings, "pelvis_pos"), _rpy(sensors.take(readings, "pelvis_quat"))
+    soles = _soles(robot, plant, readings)
+    angles, velocities, torques = (sensors.columns(readings, [f"{c}_{s}" for c in JOINT_COLUMNS])
+                                   for s in ("q", "qd", "tau"))
+    end = {"final_feet_error": math.nan, "final_feet_yaw_error": math.nan, "end_min_sole_force": math.nan,
+           "end_max_speed": math.nan, "end_attitude_range": math.nan}
+    if fall is None:
+        feet = soles["ankles"][-1]
+        end["final_feet_error"] = max(float(np.linalg.norm(feet[f] - log.ankles[n - 1, f, :2])) for f in range(2))
+        yaws = [_rpy(sensors.take(readings[-1:], f"{label}_ankle_quat"))[0, 2] for label in ("left", "right")]
+        end["final_feet_yaw_error"] = max(abs(float((yaws[f] - log.yaws[n - 1, f] + math.pi) % (2 * math.pi)
+                                                    - math.pi)) for f in range(2))
+        window = time > time[-1] - max(hold, 1.0 / plant.rate)
+        end["end_min_sole_force"] = float(soles["forces"][window].min())
+        speed = np.linalg.norm(np.gradient(pelvis[:, :2], time, axis=0), axis=1)
+        end["end_max_speed"] = float(speed[window].max())
+        end["end_attitude_range"] = float(np.ptp(rpy[window, :2], axis=0).max())
+    distance = float(np.linalg.norm(pelvis[-1, :2] - pelvis[0, :2]))
+    walked = max(float(log.walking[:n].sum()) / plant.rate, 1.0 / plant.rate)
+    return SimulationResult(
+        robot=robot, time=time, torso_position=pelvis, torso_rpy=rpy, fell=fall is not None,
+        fall_time=None if fall is None else float(time[fall]), distance=distance, average_speed=distance / walked,
+        foot_slip=_slip(soles["loaded"], soles["ankles"]), cop_left=soles["cop_feet"][:, 0],
+        cop_right=soles["cop_feet"][:, 1], cop=soles["cop"], force_left=soles["forces"][:, 0],
+        force_right=soles["forces"][:, 1], reference_zmp=log.zmp[:n].copy(), cop_margin=soles["margin"],
+        joint_angles=angles, joint_velocities=velocities, joint_torques=torques, joint_power=torques * velocities,
+        balance=None if log.balance is None else {k: v[:n].copy() for k, v in log.balance.items()},
+        ankle_positions=np.stack([sensors.take(readings, f"{s}_ankle_pos") for s in ("left", "right")], axis=1),
+        planned_torques=None if log.torques is None else log.torques[:n].copy(),
+        plan_zmp_margin=_plan_margin(robot, log, n), planned_end=planned_end if fall is not None else float(time[-1]),
+        **end)

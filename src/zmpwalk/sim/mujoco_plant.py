@@ -1,0 +1,253 @@
+"""The MuJoCo model of a robot as a :class:`~zmpwalk.control.plant.Plant`, and the feedforward a controller computes
+from it tick by tick.
+
+:class:`MujocoPlant` wraps what :mod:`zmpwalk.sim.plant` and :mod:`zmpwalk.sim.run` do for a whole pattern into the
+calls of a control loop: ``measure()`` reads the model's sensors as the robot's (the ground's wrench on each sole at
+the ankle in the foot frame, the torso IMU, the joint encoders), ``apply(targets)`` drives the leg servos with the
+angles, rates and feedforward torques of :class:`~zmpwalk.control.plant.JointTargets`, ``step()`` integrates one
+control period. :class:`ModelFeedforward` is the inverse dynamics of :func:`zmpwalk.sim.plant.static_feedforward`
+for one sample at a time (:class:`zmpwalk.control.controller.Feedforward`).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+from zmpwalk.balance import BalanceMeasurement
+from zmpwalk.control.plant import JointTargets
+from zmpwalk.errors import InvalidParameterError
+from zmpwalk.online import WalkingSample
+from zmpwalk.robots.model import RobotModel
+from zmpwalk.robots.pd import is_position_servo
+from zmpwalk.sim.mjcf import contact_mapping
+from zmpwalk.sim.plant import Plant as SimPlant
+from zmpwalk.sim.plant import build_plant, set_initial_state, static_feedforward
+from zmpwalk.sim.run import FALL_HEIGHT_FRACTION, FALL_TILT, Disturbances, _MeasurementReader, _Sensors
+
+Array = NDArray[np.float64]
+
+
+def _upright(qpos: Array, yaw: float) -> None:
+    """Set the free base's orientation in ``qpos`` to upright at ``yaw`` [rad]."""
+    qpos[3:7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
+
+
+def _base_position(plant: SimPlant, data: mujoco.MjData, sample: WalkingSample, angles: Array) -> Array:
+    """The base origin [m] (3,) of a sample's pose: the pelvis point on a box model; on a robot's own model, where
+    the leg angles put the ankles at the sample's (on average; the walker's pelvis point is its whole-body CoM)."""
+    if not plant.imported:
+        return np.array(sample.position_pelvis_in_world, dtype=np.float64)
+    data.qpos[:] = plant.qpos_hold
+    data.qpos[0:3] = 0.0
+    _upright(data.qpos, sample.yaw_pelvis_in_world)
+    data.qpos[plant.leg_qpos] = angles
+    mujoco.mj_kinematics(plant.model, data)
+    sites = [mujoco.mj_name2id(plant.model, mujoco.mjtObj.mjOBJ_SITE, f"{s}_ankle") for s in ("left", "right")]
+    planned = (sample.position_left_ankle_in_world, sample.position_right_ankle_in_world)
+    return np.asarray(sum(p - data.site_xpos[s] for p, s in zip(planned, sites, strict=True)) / 2, dtype=np.float64)
+
+
+class ModelFeedforward:
+    """The joint torques of each tick's planned motion by inverse dynamics of a MuJoCo model (a
+    :class:`~zmpwalk.control.controller.Feedforward`).
+
+    As :func:`zmpwalk.sim.plant.static_feedforward` for a whole pattern, ``tau = M(q) q'' + C(q, q') + g(q) -
+    sum_feet J^T w``, for one sample: ``q`` its pose (the base upright at the pelvis yaw), ``q'`` the base's rate by
+    a backward difference over one tick and the legs' planned rates, ``q''`` their backward difference; ``w`` the
+    ground wrench ``m (c'' + g)`` at the planned ZMP, ``c'' = (g / z_c)(c - p)`` of the model's CoM, on the stance
+    sole, split by the ZMP's place between the soles in double support. Bounded work per tick: one forward
+    kinematics, one recursive Newton-Euler pass and two site Jacobians.
+
+    Args:
+        plant: The model (its nominal masses: what the controller knows of the robot).
+        rate: Control rate [Hz]; :meth:`torques` is called once per tick, in order.
+
+    Attributes:
+        servo_torques: The last tick's torque at every position servo [N m], (nu,) (0 at other actuators).
+    """
+
+    def __init__(self, plant: SimPlant, rate: float) -> None:
+        model = plant.model
+        self.plant = plant
+        self.dt = 1.0 / float(rate)
+        self._data = mujoco.MjData(model)
+        self._scratch = mujoco.MjData(model)
+        self._servos = np.array([a for a in range(model.nu) if is_position_servo(model, a)], dtype=np.intp)
+        self._dofs = np.array([model.jnt_dofadr[model.actuator_trnid[a][0]] for a in self._servos], dtype=np.intp)
+        self._leg_dofs = np.array([model.jnt_dofadr[model.actuator_trnid[a][0]] for a in plant.leg_actuators],
+                                  dtype=np.intp)
+        self._sites = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, f"{s}_ankle") for s in ("left", "right")]
+        self._mass = float(np.sum(model.body_mass))
+        self._gravity = -float(model.opt.gravity[2])
+        self._qpos = plant.qpos_hold.copy()
+        self._previous_qpos: Array | None = None
+        self._qvel, self._previous_qvel = np.zeros(model.nv), np.zeros(model.nv)
+        self._tau = np.zeros(model.nv)
+        self._jacp, self._jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
+        self.servo_torques = np.zeros(model.nu)
+
+    def torques(self, sample: WalkingSample) -> Array:
+        """The leg joints' torques [N m], (12,), in the walker's column order, for this tick's ``sample``."""
+        plant, model, data = self.plant, self.plant.model, self._data
+        angles = sample.joint_angles if sample.joint_angles is not None else plant.qpos_hold[plant.leg_qpos]
+        qpos = self._qpos
+        qpos[0:3] = _base_position(plant, self._scratch, sample, angles)
+        _upright(qpos, sample.yaw_pelvis_in_world)
+        qpos[plant.leg_qpos] = angles
+        self._previous_qvel[:] = self._qvel
+        if self._previous_qpos is None:
+            self._previous_qpos = qpos.copy()
+        mujoco.mj_differentiatePos(model, self._qvel, self.dt, self._previous_qpos, qpos)
+        if sample.joint_velocities is not None:
+            self._qvel[self._leg_dofs] = sample.joint_velocities
+        self._previous_qpos[:] = qpos
+        data.qpos[:] = qpos
+        data.qvel[:] = self._qvel
+        data.qacc[:] = (self._qvel - self._previous_qvel) / self.dt
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_comPos(model, data)
+        mujoco.mj_comVel(model, data)
+        mujoco.mj_rne(model, data, 1, self._tau)
+        self._subtract_reaction(sample)
+        self.servo_torques[self._servos] = self._tau[self._dofs]
+        return np.array(self.servo_torques[plant.leg_actuators], dtype=np.float64)
+
+    def _subtract_reaction(self, sample: WalkingSample) -> None:
+        """Take the planned ground wrench's share of each sole off the torques (``tau -= J^T w``)."""
+        data, zmp, gravity = self._data, sample.zmp_in_world, self._gravity
+        com = data.subtree_com[0]
+        acceleration = gravity / max(float(com[2]), 1e-6) * (com[:2] - zmp)  # cart-table: c'' = (g / z)(c - p)
+        left, right = sample.position_left_ankle_in_world[:2], sample.position_right_ankle_in_world[:2]
+        if sample.support == "left":
+            shares = (1.0, 0.0)
+        elif sample.support == "right":
+            shares = (0.0, 1.0)
+        else:
+            span = right - left
+            ratio = float(np.clip((zmp - left) @ span / max(float(span @ span), 1e-12), 0.0, 1.0))
+            shares = (1.0 - ratio, ratio)
+        base_point = left + (right - left) * shares[1]
+        force = self._mass * np.array([acceleration[0], acceleration[1], gravity])
+        for site, share, ankle in zip(self._sites, shares, (left, right), strict=True):
+            if share == 0.0:
+                continue
+            cop = np.append(ankle + (zmp - base_point), 0.0)  # this sole's CoP, keeping the total at the ZMP
+            moment = np.cross(cop - data.site_xpos[site], share * force)
+            mujoco.mj_jacSite(self.plant.model, data, self._jacp, self._jacr, site)
+            self._tau -= self._jacp.T @ (share * force) + self._jacr.T @ moment
+
+
+class MujocoPlant:
+    """The MuJoCo model of a robot as a :class:`~zmpwalk.control.plant.Plant`: its sensors read as the robot's
+    (:class:`~zmpwalk.balance.BalanceMeasurement`), its leg servos driven as a humanoid's low-level interface
+    drives them (``q, dq, tau_ff``: control ``u = q + (kv / kp) dq + tau_ff / (kp gear^2)`` of a position servo
+    ``kp (u - q) - kv q'``, docs/balance.md), every other actuator holding the reference pose.
+
+    Args:
+        robot: The robot (its own MJCF or URDF, else its robot file's box model).
+        rate: Control rate [Hz]: a whole number of the model's time steps per period.
+        mass_scale: Multiply the box model's masses (:func:`zmpwalk.sim.plant.build_plant`).
+        disturbances: A push, a floor tilt or a mass error (:class:`~zmpwalk.sim.run.Disturbances`); the
+            :meth:`feedforward` keeps the nominal model.
+
+    Raises:
+        InvalidParameterError: A rate whose period is not a whole number of time steps, or as
+            :func:`~zmpwalk.sim.plant.build_plant`.
+    """
+
+    def __init__(self, robot: RobotModel, rate: float = 1000.0, *, mass_scale: float = 1.0,
+                 disturbances: Disturbances | None = None) -> None:
+        plant = build_plant(robot, mass_scale)
+        model = plant.model
+        steps = 1.0 / (float(rate) * float(model.opt.timestep))
+        if not (math.isfinite(steps) and steps >= 1.0 - 1e-9 and abs(steps - round(steps)) < 1e-6):
+            raise InvalidParameterError("rate", rate, f"a rate whose period is a whole number of the model's "
+                                        f"{model.opt.timestep:g} s time steps (at most {1 / model.opt.timestep:g} Hz)")
+        self.robot, self.plant, self.rate = robot, plant, float(rate)
+        self.steps_per_tick = round(steps)
+        self._nominal = SimPlant(copy.deepcopy(model), plant.leg_actuators, plant.leg_qpos, plant.ctrl_hold,
+                                 plant.qpos_hold, plant.imported)
+        self.disturbances = disturbances
+        if disturbances is not None:
+            disturbances.apply(model)
+        self.model, self.data = model, mujoco.MjData(model)
+        self.sensors = _Sensors(model)
+        self._reader = _MeasurementReader(self.sensors, None if disturbances is None else disturbances.floor_rotation)
+        servos = plant.leg_actuators
+        kp, gear = model.actuator_gainprm[servos, 0], model.actuator_gear[servos, 0]
+        self._damping_ratio = -model.actuator_biasprm[servos, 2] / kp
+        self._compliance = 1.0 / (kp * gear**2)
+        self._ctrl = plant.ctrl_hold.copy()
+        self._push_body = int(model.site_bodyid[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "pelvis")])
+        self._pelvis, self._quaternion = self.sensors.slices["pelvis_pos"], self.sensors.slices["pelvis_quat"]
+        self._touch = self.sensors.slices.get("torso_touch")
+        self._penetration = 0.0 if plant.imported else contact_mapping(
+            RobotModel(**{**vars(robot), "mass": robot.link_mass * mass_scale})).penetration
+        self.weight = float(model.body_subtreemass[1]) * robot.gravity  # [N]
+        self._ticks = 0
+
+    @property
+    def time(self) -> float:
+        """[s] since :meth:`stand`."""
+        return self._ticks / self.rate
+
+    def feedforward(self) -> ModelFeedforward:
+        """A :class:`ModelFeedforward` on this plant's nominal model (before its disturbances)."""
+        return ModelFeedforward(self._nominal, self.rate)
+
+    def stand(self, sample: WalkingSample) -> None:
+        """Stand the robot at rest in ``sample``'s pose (a walker's standing sample, with joint angles), its lowest
+        sole on the floor; the other servos hold the reference pose with its static torque."""
+        if sample.joint_angles is None:
+            raise InvalidParameterError("sample.joint_angles", None, "the 12 angles (a walker with joints=True)")
+        plant = self.plant
+        base = _base_position(plant, mujoco.MjData(plant.model), sample, sample.joint_angles)
+        set_initial_state(plant, self.data, base, sample.yaw_pelvis_in_world, sample.joint_angles, self._penetration)
+        others = np.setdiff1d(np.arange(self.model.nu), plant.leg_actuators)
+        self._ctrl[:] = plant.ctrl_hold
+        if len(others):
+            qpos = self.data.qpos.copy()[None, :]
+            ankles = (sample.position_left_ankle_in_world[None, :], sample.position_right_ankle_in_world[None, :])
+            offsets = static_feedforward(self._nominal, qpos, sample.zmp_in_world[None, :], np.zeros(1, dtype=int),
+                                         ankles, self.rate, dynamic=False)[0]
+            self._ctrl[others] += offsets[others]
+        self._ctrl[plant.leg_actuators] = sample.joint_angles
+        self.data.ctrl[:] = self._ctrl
+        self._ticks = 0
+
+    def measure(self) -> BalanceMeasurement:
+        """The sensors now: each sole's wrench (the ground's, at the ankle, foot frame), the IMU, the encoders."""
+        return self._reader.read(self.data.sensordata)
+
+    def apply(self, targets: JointTargets) -> None:
+        """Drive the leg servos with the targets (the control of the class docstring)."""
+        leg = targets.angles + self._damping_ratio * targets.velocities
+        if targets.torques is not None:
+            leg = leg + targets.torques * self._compliance
+        self._ctrl[self.plant.leg_actuators] = leg
+        self.data.ctrl[:] = self._ctrl
+
+    def step(self) -> None:
+        """Integrate one control period (a push acting where :attr:`disturbances` has one)."""
+        if self.disturbances is not None:
+            self.data.xfrc_applied[self._push_body, :3] = self.disturbances.force_at(self.time)
+        for _ in range(self.steps_per_tick):
+            mujoco.mj_step(self.model, self.data)
+        self._ticks += 1
+
+    def fallen(self) -> bool:
+        """The fall criterion of :mod:`zmpwalk.sim.run` now (the torso touching the floor, tilted over
+        :data:`~zmpwalk.sim.run.FALL_TILT` or sunk below :data:`~zmpwalk.sim.run.FALL_HEIGHT_FRACTION` of the pelvis
+        height), or a state that is no longer finite."""
+        row = self.data.sensordata
+        _, x, y, _ = row[self._quaternion]
+        upright = 1.0 - 2.0 * (x * x + y * y)  # cos(tilt): the torso's z axis against the vertical
+        touched = self._touch is not None and row[self._touch][0] > 0
+        return bool(touched or upright < math.cos(FALL_TILT) or not np.isfinite(self.data.qpos).all()
+                    or row[self._pelvis][2] < FALL_HEIGHT_FRACTION * self.robot.pelvis_height)
+
