@@ -307,6 +307,12 @@ class OnlineWalker:
         return self._pending.command if self._pending else None
 
     @property
+    def current(self) -> StepCommand | None:
+        """The command whose step is under way (a stop's closing step and settle included, as the stop command),
+        or None while standing still (a walk commanded from standstill that has not begun included)."""
+        return self._current.command if self._current is not None else None
+
+    @property
     def rejected(self) -> StepCommand | None:
         """The last command, where its check refused it (None: none refused since the last :meth:`command`).
 
