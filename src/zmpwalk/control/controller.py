@@ -212,10 +212,14 @@ class WalkingController:
         """Walk at a velocity: forward ``vx`` [m/s], leftward ``vy`` [m/s], counter-clockwise ``wz`` [rad/s].
 
         Every step takes :func:`velocity_command`'s step (its step time from the schedule unless ``step_time``
-        [s] is given), given to the walker as soon as the step before it has begun, so a new velocity takes
-        effect at the next step whose check completes before it begins. All three 0 stops after the step under
-        way (:meth:`stop`). A step the walker refuses is :attr:`rejection`; it is not given again (the walk stops
-        after the step under way) until the next :meth:`set_velocity`.
+        [s] is given). Only stored here (tens of microseconds); :meth:`update` gives it to the walker (module
+        docstring): as soon as the walker holds no step, and in place of a step it holds for after the one under
+        way once that step's check is done (a step held for a walk from standstill is kept: replacing it would
+        start the walk :data:`~zmpwalk.online.START_DELAY` later again). So a new velocity takes effect at the next
+        step whose check completes before it begins. The same velocity again changes nothing (a joystick may send
+        it every tick; a velocity that changes every tick re-checks the next step continually: quantise it). All
+        three 0 stops after the step under way (:meth:`stop`). A step the walker refuses is :attr:`rejection`; it
+        is not given again (the walk stops after the step under way) until another velocity is set.
 
         Raises:
             InvalidParameterError: As :func:`velocity_command` (the walk goes on as it was).
@@ -224,10 +228,11 @@ class WalkingController:
             self.stop()
             return
         step = velocity_command(self.schedule, self.robot, vx, vy, wz, step_time)
+        if step == self._velocity_step:
+            return
         self._velocity = (float(vx), float(vy), float(wz))
         self._velocity_step = step
         self._velocity_refused = False
-        self.walker.command(step)  # replaces a step queued (or being checked) for after the one under way
 
     def _leave_velocity(self) -> None:
         self._velocity = None
@@ -235,16 +240,18 @@ class WalkingController:
         self._velocity_refused = False
 
     def _give_velocity_step(self) -> None:
-        """Give the velocity's step for after the step under way, once the walker holds none (bounded: it only
-        stores the command)."""
+        """Give the velocity's step to the walker where it is due (:meth:`set_velocity`); bounded: it only
+        compares commands and stores one."""
         step = self._velocity_step
         walker = self.walker
-        if step is None or self._velocity_refused or walker.checking is not None or walker.queued is not None:
+        if step is None or self._velocity_refused or walker.checking is not None:
             return
-        if walker.rejected is step:
+        if walker.rejected == step:
             self._velocity_refused = True
             return
-        walker.command(step)
+        queued = walker.queued
+        if queued is None or (queued != step and walker.current is not None):
+            walker.command(step)
 
     def update(self, measurement: BalanceMeasurement) -> JointTargets:
         """One control tick: the walker's sample, corrected by the stabilizer on ``measurement``, and the

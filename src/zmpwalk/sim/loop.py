@@ -266,10 +266,10 @@ def _slip(loaded: NDArray[np.bool_], ankles: Array) -> float:
 
 def _result(robot: RobotModel, plant: MujocoPlant, log: _Log, n: int, fall: int | None, planned_end: float,
             hold: float) -> SimulationResult:
-    """The run's :class:`~zmpwalk.sim.run.SimulationResult` from its first ``n`` ticks (sample ``k`` at the end of
-    tick ``k``, time ``(k + 1) / rate``)."""
+    """The run's :class:`~zmpwalk.sim.run.SimulationResult` from its first ``n`` ticks (row ``k``: the state at the end
+    of tick ``k``, labelled with the tick's time ``k / rate``, as :func:`~zmpwalk.sim.run.simulate` labels it)."""
     sensors, readings = plant.sensors, log.readings[:n]
-    time = np.arange(1, n + 1) / plant.rate
+    time = np.arange(n) / plant.rate
     pelvis, rpy = sensors.take(readings, "pelvis_pos"), _rpy(sensors.take(readings, "pelvis_quat"))
     soles = _soles(robot, plant, readings)
     angles, velocities, torques = (sensors.columns(readings, [f"{c}_{s}" for c in JOINT_COLUMNS])
