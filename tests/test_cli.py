@@ -43,14 +43,16 @@ def test_every_scenario_plans_inside_the_polygon_with_the_exact_csv_columns(tmp_
 
 
 def test_plan_exit_status_outside_the_polygon_and_the_default_rate(tmp_path, capsys):
-    # 0.7 s steps with HUBO's V_y of 0.1 m leave the support polygon by 12.7 mm (docs/zmp-margins.md)
+    # 0.7 s steps with the paper's V_y of 0.1 m leave the support polygon by 12.7 mm (docs/zmp-margins.md)
     steps = tmp_path / "fast.toml"
     steps.write_text("[[steps]]\nduration = 0.7\nforward = 0.2\nrepeat = 4\n")
     out = tmp_path / "fast.csv"
-    assert main(["plan", str(steps), "--out", str(out)]) == 3
+    assert main(["plan", str(steps), "--schedule", "paper", "--out", str(out)]) == 3
     assert "OUTSIDE the support polygon" in capsys.readouterr().out
     assert out.is_file()  # the pattern is written all the same; the status says it leaves the polygon
-    assert main(["plan", str(steps), "--allow-outside"]) == 0
+    assert main(["plan", str(steps), "--schedule", "paper", "--allow-outside"]) == 0
+    capsys.readouterr()
+    assert main(["plan", str(steps)]) == 0  # the default tables keep 0.7 s steps inside
     capsys.readouterr()
     assert main(["plan", "--scenario", "fig10", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["rate"] == 1000.0  # the default rate, as report's

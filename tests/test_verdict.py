@@ -18,7 +18,7 @@ def test_a_too_long_stride_at_0_4_s_on_hubo_fails_and_exits_non_zero(tmp_path: P
                                                                       capsys: pytest.CaptureFixture[str]) -> None:
     steps = tmp_path / "fast.toml"
     steps.write_text("[[steps]]\nduration = 0.4\nforward = 0.28\nrepeat = 6\n", encoding="utf-8")
-    assert main(["simulate", str(steps), "--json"]) == EXIT_FAILED
+    assert main(["simulate", str(steps), "--balance", "off", "--json"]) == EXIT_FAILED  # open loop it falls
     verdict = json.loads(capsys.readouterr().out)["verdict"]
     assert verdict["passed"] is False
     by_name = {c["name"]: c for c in verdict["criteria"]}
@@ -115,7 +115,8 @@ def test_a_touchdown_starts_at_first_contact_not_when_the_sole_becomes_loaded() 
     assert cop_margin_outside_touchdowns(result) == pytest.approx(-0.030, abs=1e-12)  # type: ignore[arg-type]
 
 
-FAST = "[[steps]]\nduration = 0.7\nforward = 0.2\nrepeat = 4\n"  # HUBO's V_y at 0.7 s: the plan leaves the soles
+FAST = "[[steps]]\nduration = 0.7\nforward = 0.2\nrepeat = 4\n"
+PAPER = ["--schedule", "paper"]  # Tables 2-3 as printed, V_y 0.1 m at 0.7 s: the plan leaves the soles
 
 
 def test_a_plan_outside_the_soles_fails_the_verdict_and_simulate_says_outside(
@@ -124,11 +125,12 @@ def test_a_plan_outside_the_soles_fails_the_verdict_and_simulate_says_outside(
     fails on it with that figure, and simulate's summary says OUTSIDE as plan does."""
     steps = tmp_path / "fast.toml"
     steps.write_text(FAST, encoding="utf-8")
-    assert main(["simulate", str(steps)]) == EXIT_FAILED
+    assert main(["simulate", str(steps), *PAPER]) == EXIT_FAILED
     printed = capsys.readouterr().out
+    assert "controller: the walking pattern with the stabilizer in the loop" in printed  # the default
     assert "plan: min ZMP margin -12.7 mm (OUTSIDE the support polygon)" in printed
     assert "FAIL the plan keeps its ZMP inside the soles: -12.7 mm (limit: at least 0.0 mm)" in printed
-    assert main(["simulate", str(steps), "--json"]) == EXIT_FAILED
+    assert main(["simulate", str(steps), *PAPER, "--json"]) == EXIT_FAILED
     summary = json.loads(capsys.readouterr().out)
     by_name = {c["name"]: c for c in summary["verdict"]["criteria"]}
     plan = by_name["the plan keeps its ZMP inside the soles"]
@@ -143,11 +145,11 @@ def test_a_plan_outside_the_soles_fails_the_verdict_and_simulate_says_outside(
 
 def test_a_negative_sole_force_says_the_sole_was_off_the_floor(tmp_path: Path,
                                                                capsys: pytest.CaptureFixture[str]) -> None:
-    """The fast walk ends rocking on one sole: the other's ankle sensor carries the hanging foot (HUBO's 2 kg),
-    a pull that reads as a negative ground force, and the verdict says so beside the figure."""
+    """Open loop, the fast walk on the paper's tables ends rocking on one sole: the other's ankle sensor carries
+    the hanging foot (HUBO's 2 kg), a pull that reads as a negative ground force, and the verdict says so."""
     steps = tmp_path / "fast.toml"
     steps.write_text(FAST, encoding="utf-8")
-    assert main(["simulate", str(steps), "--json"]) == EXIT_FAILED
+    assert main(["simulate", str(steps), *PAPER, "--balance", "off", "--json"]) == EXIT_FAILED
     by_name = {c["name"]: c for c in json.loads(capsys.readouterr().out)["verdict"]["criteria"]}
     loaded = by_name["both soles loaded at the end"]
     assert loaded["figure"] == pytest.approx(-2.0 * 9.81, rel=0.2)  # about the foot's weight, hanging [N]

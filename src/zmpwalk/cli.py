@@ -136,20 +136,17 @@ def _motors(args: argparse.Namespace) -> list[Motor] | None:
     return load_motors(args.motors) if getattr(args, "motors", None) else None
 
 
-def _balance_options(parser: argparse.ArgumentParser, default: str | None = None) -> None:
-    explained = (f"default: {default}" if default else
-                 "default: on for a robot's own model, off for the built-in box models (the papers' open-loop walks)")
-    parser.add_argument("--balance", choices=("on", "off"), default=default,
-                        help=f"close the loop with the stabilizer on the simulated sensors ({explained})")
+def _balance_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--balance", choices=("on", "off"), default="on",
+                        help="close the loop with the stabilizer on the simulated sensors (default: on, for every "
+                        "robot; off: the pattern alone, open loop, as the papers walk it)")
     parser.add_argument("--latency", type=float, default=0.0, help="sensor latency of the stabilizer [s]")
     parser.add_argument("--motors", type=Path, help="a motor file (TOML, examples/motors.toml): does each joint's "
                         "motor fit?")
 
 
-def _balance(args: argparse.Namespace, robot: RobotModel) -> bool:
-    if args.balance is None:
-        return robot.plant is not None
-    return bool(args.balance == "on")
+def _balance(args: argparse.Namespace) -> bool:
+    return bool(args.balance != "off")
 
 
 def _plan_parsers(commands: argparse._SubParsersAction[_Parser]) -> None:
@@ -255,7 +252,7 @@ def _report_parsers(commands: argparse._SubParsersAction[_Parser]) -> None:
         _schedule_option(report_cmd)
         report_cmd.add_argument("--pelvis", choices=("cubic", "quintic"), default="cubic",
                             help="pelvis curves: the paper's cubics, or quintics with a continuous cart-table ZMP")
-        _balance_options(report_cmd, default="on")
+        _balance_options(report_cmd)
         report_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
         default_out = Path("zmpwalk-demo" if name == "demo" else "zmpwalk-report")
         report_cmd.add_argument("--out", type=Path, default=default_out,
@@ -286,8 +283,8 @@ def _batch_parsers(commands: argparse._SubParsersAction[_Parser]) -> None:
     sweep_cmd.add_argument("--scenario", nargs="+", help="scenarios to walk (default: every built-in one)")
     sweep_cmd.add_argument("--workers", type=int, help="walks at a time (default: one per core)")
     sweep_cmd.add_argument("--dask", metavar="SCHEDULER", help=DASK_HELP)
-    sweep_cmd.add_argument("--balance", choices=("on", "off"), default=None,
-                           help="the stabilizer (default: on for a robot's own model, off for the box models)")
+    sweep_cmd.add_argument("--balance", choices=("on", "off"), default="on",
+                           help="the stabilizer (default: on, for every robot; off: open loop, as the papers walk)")
     sweep_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
     _schedule_option(sweep_cmd, " (e.g. from zmpwalk tune)")
     sweep_cmd.add_argument("--pelvis", choices=("cubic", "quintic"), default="cubic",
@@ -405,7 +402,7 @@ def _report(args: argparse.Namespace) -> int:
         report = build_report(robot, commands, args.out, title=f"zmpwalk: {robot.name}, {name}",
                               generator=args.generator, animate=not args.no_animation,
                               progress=None if quiet else _progress, labels=labels,
-                              balance=_balance(args, robot), latency=args.latency, schedule=_schedule(args),
+                              balance=_balance(args), latency=args.latency, schedule=_schedule(args),
                               motors=_motors(args), pelvis=_pelvis(args))
     verdict = report.verdict
     if args.json:
@@ -463,7 +460,7 @@ def _simulate(args: argparse.Namespace) -> int:
     joints = pattern_joint_trajectory(pattern, check_limits=False)
     if show:
         show(stages[2], 2, len(stages))
-    stabilizer = Stabilizer(robot, 1000.0, com_reference=pattern.com_point) if _balance(args, robot) else None
+    stabilizer = Stabilizer(robot, 1000.0, com_reference=pattern.com_point) if _balance(args) else None
     if args.capture and stabilizer is None:
         raise _UsageError("--capture needs the stabilizer (--balance on): its DCM estimate triggers the capture step")
     if args.capture and correction is not None:
@@ -528,9 +525,10 @@ def _simulation_summary(result: SimulationResult, verdict: Verdict, rows: list[A
 def _print_simulation(result: SimulationResult, verdict: Verdict, rows: list[ActuatorRow], fits: list[MotorFit],
                       correction: ZmpCorrection | None) -> None:
     """What ``simulate`` prints: the walk, the plan's ZMP margin, the CoP, the motors, the warnings, the verdict."""
-    from zmpwalk.sim.verdict import cop_margin_outside_touchdowns
+    from zmpwalk.sim.verdict import controller_words, cop_margin_outside_touchdowns
 
     state = f"FELL at t = {result.fall_time:.3f} s" if result.fell else "walked to the end without falling"
+    print(f"controller: {controller_words(result.balance is not None)}")
     print(f"{result.robot.name}: {state}; distance {result.distance:.3f} m, average speed "
           f"{result.average_speed * 1e3:.1f} mm/s, foot slip {result.foot_slip * 1e3:.1f} mm")
     if correction is not None:
@@ -603,7 +601,7 @@ def _sweep(args: argparse.Namespace) -> int:
         raise _UsageError(f"--workers = {args.workers} must be >= 1")
     workers = args.workers or os.cpu_count() or 1
     show = None if args.json or not sys.stderr.isatty() else (lambda done, total: _progress("walks", done, total))
-    balance = None if args.balance is None else args.balance == "on"
+    balance = _balance(args)
     started, cpu = time.perf_counter(), time.process_time()
     schedule = _schedule(args)  # read here: a bad file is one error, not one per worker
     results = sweep(args.robot, names, balance=balance, workers=workers, progress=show, generator=args.generator,

@@ -283,7 +283,7 @@ def walk(robot: RobotModel, data: dict[str, Any], condition: Condition, steps: i
         joints = pattern_joint_trajectory(pattern, check_limits=False)
     except ZmpwalkError:
         return False, math.inf, math.inf
-    stabilizer = Stabilizer(robot, RATE) if robot.plant is not None else None
+    stabilizer = Stabilizer(robot, RATE, com_reference=pattern.com_point)  # as every walk runs (zmpwalk simulate)
     result = simulate(robot, joints, pattern, stabilizer=stabilizer, settle=SETTLE, hold=HOLD)
     verdict = {c.name: c for c in walk_verdict(result, HOLD).criteria}
     passes = verdict["no fall"].passed and verdict["CoP inside the loaded soles"].passed

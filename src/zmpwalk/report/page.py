@@ -35,7 +35,7 @@ from zmpwalk.sim.actuators import (
 )
 from zmpwalk.sim.motors import Motor, MotorFit, motor_fits
 from zmpwalk.sim.run import SimulationResult, simulate, write_result_csv
-from zmpwalk.sim.verdict import FAIL, HOLD, PASS, SETTLE, SKIP, WARN, Verdict, walk_verdict
+from zmpwalk.sim.verdict import FAIL, HOLD, PASS, SETTLE, SKIP, WARN, Verdict, controller_words, walk_verdict
 
 Progress = Callable[[str, int, int], None]
 STAGES = ("pattern", "joints", "simulation", "plots", "animation", "page")
@@ -86,7 +86,7 @@ def build_report(
     animate: bool = True,
     progress: Progress | None = None,
     labels: Sequence[str] | None = None,
-    balance: bool = False,
+    balance: bool = True,
     latency: float = 0.0,
     schedule: Schedule | None = None,
     motors: list[Motor] | None = None,
@@ -118,7 +118,7 @@ def build_report(
     done("pattern")
     joints = pattern_joint_trajectory(pattern)
     done("joints")
-    stabilizer = Stabilizer(robot, 1000.0) if balance else None
+    stabilizer = Stabilizer(robot, 1000.0, com_reference=pattern.com_point) if balance else None
     def simulating(done: float) -> None:
         if progress is not None:
             progress("simulation", round(100 * done), 100)
@@ -191,7 +191,8 @@ def _summary(pattern: WalkingPattern, result: SimulationResult, verdict: Verdict
         "swings": len(pattern.steps), "min_zmp_margin": margin, "min_zmp_margin_time": at, "fell": result.fell,
         "fall_time": result.fall_time, "distance": result.distance, "average_speed": result.average_speed,
         "foot_slip": result.foot_slip, "cop_error_rms": rms, "cop_error_max": largest,
-        "balance": result.balance is not None, "verdict": verdict.as_dict(), "warnings": list(verdict.warnings),
+        "balance": result.balance is not None, "controller": controller_words(result.balance is not None),
+        "verdict": verdict.as_dict(), "warnings": list(verdict.warnings),
         "motors": [{"joint": f.joint, "motor": f.motor, "rms_use": f.rms_use, "peak_use": f.peak_use,
                     "fits": f.fits} for f in fits],
     }
@@ -299,7 +300,8 @@ def _page(title: str, robot: RobotModel, summary: dict[str, Any], images: dict[s
 <body data-images-loaded="no">
 <h1>{esc(title)}</h1>
 <p>{esc(robot.description)}. Pattern: {esc(str(summary['generator']))} generator,
-{summary['swings']} swings over {summary['duration']:.2f} s, sampled at 1 kHz.</p>
+{summary['swings']} swings over {summary['duration']:.2f} s, sampled at 1 kHz.
+Controller: {esc(str(summary['controller']))}.</p>
 <h2>Does it walk?</h2>
 {_verdict_html(verdict, summary)}
 <p>Distance {summary['distance']:.3f} m, average speed

@@ -59,14 +59,14 @@ class SweepResult:
     error: str = ""
 
 
-def walk_scenario(robot: str, scenario: str, balance: bool | None = None, generator: str = "polynomial",
+def walk_scenario(robot: str, scenario: str, balance: bool = True, generator: str = "polynomial",
                   schedule: str | None = None, pelvis: str = "cubic") -> SweepResult:
     """Simulate one built-in scenario on a robot (name, robot file or model path) and judge it.
 
     Args:
         robot: What ``--robot`` takes.
         scenario: A built-in scenario name.
-        balance: Close the loop with the stabilizer; None: on for a robot's own model, off for a box model.
+        balance: Close the loop with the stabilizer (the default, for every robot); False: open loop.
         generator: The pattern generator's name (:data:`zmpwalk.patterns.GENERATORS`).
         schedule: A schedule file (e.g. from ``zmpwalk tune``) instead of Tables 2-3.
         pelvis: ``"cubic"`` or ``"quintic"`` (the polynomial generator's pelvis curves).
@@ -97,8 +97,7 @@ def walk_scenario(robot: str, scenario: str, balance: bool | None = None, genera
                            distance=math.nan, cop_error_rms=math.nan, simulated=0.0,
                            seconds=time.perf_counter() - start, error=str(error))
     joints = pattern_joint_trajectory(pattern, check_limits=False)
-    closed = model.plant is not None if balance is None else balance
-    stabilizer = Stabilizer(model, 1000.0) if closed else None
+    stabilizer = Stabilizer(model, 1000.0, com_reference=pattern.com_point) if balance else None
     result = simulate(model, joints, pattern, stabilizer=stabilizer, settle=SETTLE, hold=HOLD)
     verdict = walk_verdict(result, HOLD)
     rms, _ = result.cop_error_stats()
@@ -161,7 +160,7 @@ def _on_dask(function: Callable[..., T], arguments: dict[int, tuple[Any, ...]], 
             cluster.close()
 
 
-def sweep(robot: str, scenarios: Sequence[str], balance: bool | None = None, workers: int | None = None,
+def sweep(robot: str, scenarios: Sequence[str], balance: bool = True, workers: int | None = None,
           progress: Callable[[int, int], None] | None = None, generator: str = "polynomial",
           schedule: str | None = None, pelvis: str = "cubic", scheduler: str | None = None) -> list[SweepResult]:
     """Simulate every scenario on ``robot``, ``workers`` walks at a time (default: one per core), or on a

@@ -302,6 +302,13 @@ def walk_warnings(rows: list[ActuatorRow], fits: list[MotorFit]) -> list[str]:
     return warnings
 
 
+def controller_words(balance: bool) -> str:
+    """What ran in the simulation's loop, in words (the console's and the page's summary)."""
+    if balance:
+        return "the walking pattern with the stabilizer in the loop (DCM, ankle, force and attitude loops)"
+    return "the walking pattern alone, open loop (--balance off: no stabilizer, as the papers walk it)"
+
+
 def cop_margin_outside_touchdowns(result: SimulationResult) -> float:
     """Least CoP margin [m] over the samples not within :data:`TOUCHDOWN_WINDOW` after a sole touched the floor
     or became loaded.
