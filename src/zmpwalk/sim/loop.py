@@ -225,10 +225,22 @@ def _plan_margin(robot: RobotModel, log: _Log, n: int) -> float:
     return float(margin.min())
 
 
-def _soles(robot: RobotModel, plant: MujocoPlant, readings: Array) -> dict[str, Array]:
-    """Per sample: each sole's normal force ``forces`` (n, 2) [N] and CoP ``cop_feet`` (n, 2, 2) (nan unloaded),
-    the total ``cop`` (n, 2), its ``margin`` to the loaded soles, the ankles' ``ankles`` (n, 2, 2) [m], and
-    ``loaded`` (n, 2), as :func:`zmpwalk.sim.run.simulate` measures them."""
+@dataclass
+class _Soles:
+    """Per sample, as :func:`zmpwalk.sim.run.simulate` measures them: each sole's normal force (n, 2) [N], whether
+    it is loaded (n, 2), its CoP (n, 2, 2) [m] (nan unloaded), the total CoP (n, 2) [m] and its margin to the loaded
+    soles (n,) [m], the ankles (n, 2, 2) [m]."""
+
+    forces: Array
+    loaded: NDArray[np.bool_]
+    cop_feet: Array
+    cop: Array
+    margin: Array
+    ankles: Array
+
+
+def _soles(robot: RobotModel, plant: MujocoPlant, readings: Array) -> _Soles:
+    """The soles' forces and centres of pressure from the ankle sensors' rows (:class:`_Soles`)."""
     sensors = plant.sensors
     reactions = [_ground_reaction(sensors, readings, label, robot.ankle_height) for label in ("left", "right")]
     forces = np.column_stack([r[0] for r in reactions])
@@ -249,8 +261,7 @@ def _soles(robot: RobotModel, plant: MujocoPlant, readings: Array) -> dict[str, 
                           [cx + half_length, cy + half_width, z], [cx - half_length, cy + half_width, z]])
         corners[:, foot] = (origin[:, None, :] + np.einsum("nij,cj->nci", rotation, local))[..., :2]
         ankles[:, foot] = origin[:, :2]
-    return {"forces": forces, "loaded": loaded, "cop_feet": cop_feet, "cop": cop, "ankles": ankles,
-            "margin": _cop_margins(cop, corners, loaded)}
+    return _Soles(forces, loaded, cop_feet, cop, _cop_margins(cop, corners, loaded), ankles)
 
 
 def _slip(loaded: NDArray[np.bool_], ankles: Array) -> float:
@@ -274,30 +285,37 @@ def _result(robot: RobotModel, plant: MujocoPlant, log: _Log, n: int, fall: int 
     soles = _soles(robot, plant, readings)
     angles, velocities, torques = (sensors.columns(readings, [f"{c}_{s}" for c in JOINT_COLUMNS])
                                    for s in ("q", "qd", "tau"))
-    end = {"final_feet_error": math.nan, "final_feet_yaw_error": math.nan, "end_min_sole_force": math.nan,
-           "end_max_speed": math.nan, "end_attitude_range": math.nan}
-    if fall is None:
-        feet = soles["ankles"][-1]
-        end["final_feet_error"] = max(float(np.linalg.norm(feet[f] - log.ankles[n - 1, f, :2])) for f in range(2))
-        yaws = [_rpy(sensors.take(readings[-1:], f"{label}_ankle_quat"))[0, 2] for label in ("left", "right")]
-        end["final_feet_yaw_error"] = max(abs(float((yaws[f] - log.yaws[n - 1, f] + math.pi) % (2 * math.pi)
-                                                    - math.pi)) for f in range(2))
-        window = time > time[-1] - max(hold, 1.0 / plant.rate)
-        end["end_min_sole_force"] = float(soles["forces"][window].min())
-        speed = np.linalg.norm(np.gradient(pelvis[:, :2], time, axis=0), axis=1)
-        end["end_max_speed"] = float(speed[window].max())
-        end["end_attitude_range"] = float(np.ptp(rpy[window, :2], axis=0).max())
+    end = (math.nan,) * 5 if fall is not None else _end_figures(plant, log, n, soles, hold)
     distance = float(np.linalg.norm(pelvis[-1, :2] - pelvis[0, :2]))
     walked = max(float(log.walking[:n].sum()) / plant.rate, 1.0 / plant.rate)
     return SimulationResult(
         robot=robot, time=time, torso_position=pelvis, torso_rpy=rpy, fell=fall is not None,
         fall_time=None if fall is None else float(time[fall]), distance=distance, average_speed=distance / walked,
-        foot_slip=_slip(soles["loaded"], soles["ankles"]), cop_left=soles["cop_feet"][:, 0],
-        cop_right=soles["cop_feet"][:, 1], cop=soles["cop"], force_left=soles["forces"][:, 0],
-        force_right=soles["forces"][:, 1], reference_zmp=log.zmp[:n].copy(), cop_margin=soles["margin"],
+        foot_slip=_slip(soles.loaded, soles.ankles), cop_left=soles.cop_feet[:, 0], cop_right=soles.cop_feet[:, 1],
+        cop=soles.cop, force_left=soles.forces[:, 0], force_right=soles.forces[:, 1],
+        reference_zmp=log.zmp[:n].copy(), cop_margin=soles.margin,
         joint_angles=angles, joint_velocities=velocities, joint_torques=torques, joint_power=torques * velocities,
         balance=None if log.balance is None else {k: v[:n].copy() for k, v in log.balance.items()},
         ankle_positions=np.stack([sensors.take(readings, f"{s}_ankle_pos") for s in ("left", "right")], axis=1),
         planned_torques=None if log.torques is None else log.torques[:n].copy(),
         plan_zmp_margin=_plan_margin(robot, log, n), planned_end=planned_end if fall is not None else float(time[-1]),
-        **end)
+        final_feet_error=end[0], final_feet_yaw_error=end[1], end_min_sole_force=end[2], end_max_speed=end[3],
+        end_attitude_range=end[4])
+
+
+def _end_figures(plant: MujocoPlant, log: _Log, n: int, soles: _Soles,
+                 hold: float) -> tuple[float, float, float, float, float]:
+    """How the walk ends: the feet against the walker's final plan (largest distance [m] and yaw error [rad]), and
+    over the last ``hold``: the least sole force [N], the base's largest speed [m/s] and the torso's attitude spread
+    [rad]."""
+    sensors, readings = plant.sensors, log.readings[:n]
+    time = np.arange(n) / plant.rate
+    feet = soles.ankles[-1]
+    feet_error = max(float(np.linalg.norm(feet[f] - log.ankles[n - 1, f, :2])) for f in range(2))
+    yaws = [_rpy(sensors.take(readings[-1:], f"{label}_ankle_quat"))[0, 2] for label in ("left", "right")]
+    yaw_error = max(abs(float((yaws[f] - log.yaws[n - 1, f] + math.pi) % (2 * math.pi) - math.pi)) for f in range(2))
+    window = time > time[-1] - max(hold, 1.0 / plant.rate)
+    pelvis, rpy = sensors.take(readings, "pelvis_pos"), _rpy(sensors.take(readings, "pelvis_quat"))
+    speed = np.linalg.norm(np.gradient(pelvis[:, :2], time, axis=0), axis=1)
+    return (feet_error, yaw_error, float(soles.forces[window].min()), float(speed[window].max()),
+            float(np.ptp(rpy[window, :2], axis=0).max()))
