@@ -282,6 +282,7 @@ def test_plan_names_the_parameter_to_change_and_its_limit_brings_the_zmp_back(tm
 
 @pytest.mark.parametrize("commands, parameter", [
     ([StepCommand(0.7, 0.2)] * 4, "lateral_velocity"),
+    ([StepCommand(0.7, 0.2)] * 4, "sway"),
     ([StepCommand(0.7, side=0.05)] * 4, "lateral_velocity"),
     ([StepCommand(0.7, turn=0.26)] * 3, "lateral_velocity"),
     ([StepCommand(0.8, 0.1, sway=0.012)] * 4, "sway"),
@@ -302,3 +303,16 @@ def test_each_limit_of_the_advice_moves_the_zmp_at_that_point_onto_the_edge(hubo
     assert fixed.zmp_margin()[at] == pytest.approx(0.0, abs=0.5e-3)  # [m] that point, now on the edge
     if advice.cause == "crossing":
         assert -1e-9 <= fixed.min_zmp_margin()[0] <= 0.4e-3  # [m] on the edge, to rounding
+
+
+@pytest.mark.parametrize("commands", [[StepCommand(0.7, 0.2)] * 4, [StepCommand(0.7, side=0.05)] * 4,
+                                      [StepCommand(0.7, turn=0.26)] * 3])
+def test_the_step_time_limit_of_the_advice_plans_inside(hubo, commands):
+    """The step-time limit is searched in 0.5 % steps with the schedule's values at each step time: given to
+    every step it plans the paper's 0.7 s walks inside, by less than 5 mm (the last step was not yet enough)."""
+    paper = Schedule.paper()
+    margin, time = generate(hubo, commands, rate=1000.0, schedule=paper).min_zmp_margin()
+    change = next(c for c in zmp_advice(hubo, commands, time, margin, paper).changes if c.parameter == "duration")
+    assert not change.lower and 0.7 < change.limit < 0.75
+    longer = generate(hubo, [replace(c, duration=change.limit) for c in commands], rate=1000.0, schedule=paper)
+    assert 0.0 <= longer.min_zmp_margin()[0] < 5e-3  # [m]
