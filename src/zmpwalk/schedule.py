@@ -274,7 +274,8 @@ class Schedule:
         Overrides in ``command`` replace the scheduled values; the robot gives
         the values the tables do not hold (``d``, foot lift, ``V_y``).
         """
-        key = (command, robot.lateral_velocity, robot.dsp_time, robot.foot_lift, robot.schedule_scale)
+        key = (command, robot.lateral_velocity, robot.dsp_time, robot.foot_lift, robot.schedule_scale,
+               robot.pendulum_length, robot.gravity)  # l and g: V_y below the tables (held_crossing_velocity)
         cached = self._cache.get(key)
         if cached is None:
             if len(self._cache) > 4096:
