@@ -77,15 +77,18 @@ def test_the_mock_soles_carry_the_pendulum_at_the_zmp(hubo):
 
 def test_a_command_mid_walk_changes_the_walk(hubo):
     controller, plant = WalkingController(hubo, RATE), MockPlant(hubo, RATE)
-    controller.command(StepCommand(0.8, 0.1))
+    first, second, third = StepCommand(0.8, 0.1), StepCommand(0.8, 0.1), StepCommand(0.8, 0.25)
+    controller.command(first)
 
     def operator(tick):
-        if tick == 600 + 200:  # 0.2 s into the first step (the walk starts START_DELAY after the command)
-            controller.command(StepCommand(0.8, 0.1))
-        if tick == 600 + 1800:  # during the second step: a longer stride
-            controller.command(StepCommand(0.8, 0.25))
+        # each command during the step before it, once that step is under way
+        walker = controller.walker
+        if walker.current is first and walker.queued is None and walker.checking is None and tick % 200 == 0:
+            controller.command(second)
+        if walker.current is second and walker.queued is None and walker.checking is None:
+            controller.command(third)  # a longer stride, given while the second step is under way
 
-    log = _loop(controller, plant, 3000, operator) + _until_standing(controller, plant)
+    log = _loop(controller, plant, 4000, operator) + _until_standing(controller, plant)
     landings = [x for _, x, _ in _landings(log)]
     np.testing.assert_allclose(landings, [0.1, 0.2, 0.45, 0.45], atol=1e-9, rtol=0)  # the last: the closing step
     final = log[-1].sample
