@@ -25,7 +25,7 @@ def test_the_grid_is_the_paper_tables():
 def test_the_cheap_criterion_is_the_whole_walks_margin(hubo):
     """The margins of the paper's 0.7 s row over a walk of its steps from standstill to standstill."""
     cart, multibody = margins(hubo, hubo_schedule_data(), SLOW_ROW, steps=10)
-    pattern = generate(hubo, [StepCommand(0.7, 0.2)] * 10, rate=1000.0)
+    pattern = generate(hubo, [StepCommand(0.7, 0.2)] * 10, rate=1000.0, schedule=Schedule.paper())
     assert cart == pytest.approx(-0.0127, abs=5e-4)  # [m] as docs/zmp-margins.md, steady walking
     assert cart == pytest.approx(pattern.min_zmp_margin()[0], abs=1e-12)
     assert multibody < 0.0 and not math.isnan(multibody)
