@@ -37,7 +37,14 @@ def _upright(qpos: Array, yaw: float) -> None:
     qpos[3:7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
 
 
-def _base_position(plant: SimPlant, data: mujoco.MjData, sample: WalkingSample, angles: Array) -> Array:
+def _ankle_sites(model: mujoco.MjModel) -> tuple[int, int]:
+    """The ids of the left and right ankle sites."""
+    left, right = (mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, f"{s}_ankle") for s in ("left", "right"))
+    return int(left), int(right)
+
+
+def _base_position(plant: SimPlant, data: mujoco.MjData, sample: WalkingSample, angles: Array,
+                   sites: tuple[int, int]) -> Array:
     """The base origin [m] (3,) of a sample's pose: the pelvis point on a box model; on a robot's own model, where
     the leg angles put the ankles at the sample's (on average; the walker's pelvis point is its whole-body CoM)."""
     if not plant.imported:
@@ -47,7 +54,6 @@ def _base_position(plant: SimPlant, data: mujoco.MjData, sample: WalkingSample, 
     _upright(data.qpos, sample.yaw_pelvis_in_world)
     data.qpos[plant.leg_qpos] = angles
     mujoco.mj_kinematics(plant.model, data)
-    sites = [mujoco.mj_name2id(plant.model, mujoco.mjtObj.mjOBJ_SITE, f"{s}_ankle") for s in ("left", "right")]
     planned = (sample.position_left_ankle_in_world, sample.position_right_ankle_in_world)
     return np.asarray(sum(p - data.site_xpos[s] for p, s in zip(planned, sites, strict=True)) / 2, dtype=np.float64)
 
@@ -81,7 +87,7 @@ class ModelFeedforward:
         self._dofs = np.array([model.jnt_dofadr[model.actuator_trnid[a][0]] for a in self._servos], dtype=np.intp)
         self._leg_dofs = np.array([model.jnt_dofadr[model.actuator_trnid[a][0]] for a in plant.leg_actuators],
                                   dtype=np.intp)
-        self._sites = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, f"{s}_ankle") for s in ("left", "right")]
+        self._sites = _ankle_sites(model)
         self._mass = float(np.sum(model.body_mass))
         self._gravity = -float(model.opt.gravity[2])
         self._qpos = plant.qpos_hold.copy()
@@ -96,7 +102,7 @@ class ModelFeedforward:
         plant, model, data = self.plant, self.plant.model, self._data
         angles = sample.joint_angles if sample.joint_angles is not None else plant.qpos_hold[plant.leg_qpos]
         qpos = self._qpos
-        qpos[0:3] = _base_position(plant, self._scratch, sample, angles)
+        qpos[0:3] = _base_position(plant, self._scratch, sample, angles, self._sites)
         _upright(qpos, sample.yaw_pelvis_in_world)
         qpos[plant.leg_qpos] = angles
         self._previous_qvel[:] = self._qvel
@@ -211,7 +217,8 @@ class MujocoPlant:
         if sample.joint_angles is None:
             raise InvalidParameterError("sample.joint_angles", None, "the 12 angles (a walker with joints=True)")
         plant = self.plant
-        base = _base_position(plant, mujoco.MjData(plant.model), sample, sample.joint_angles)
+        base = _base_position(plant, mujoco.MjData(plant.model), sample, sample.joint_angles,
+                              _ankle_sites(plant.model))
         set_initial_state(plant, self.data, base, sample.yaw_pelvis_in_world, sample.joint_angles, self._penetration)
         others = np.setdiff1d(np.arange(self.model.nu), plant.leg_actuators)
         self._ctrl[:] = plant.ctrl_hold
