@@ -68,7 +68,21 @@ separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega 
 
 All corrections are small offsets of the feet relative to the pelvis, mapped onto the joints through each
 leg's Jacobian at the pattern's angles (``Delta q = J^{-1} Delta x``): nothing is planned or solved
-iteratively on the control path, and the work per tick is fixed. It runs compiled
+iteratively on the control path, and the work per tick is fixed.
+
+**Five-joint legs** (no ankle roll: Unitree H1). The leg's chain has a virtual ankle roll, an axis ``a`` along
+the sole's centre line on the floor (:mod:`zmpwalk.leg_chain`), so ``J`` is still 6 x 6 and the same solve
+runs; the change it gives the virtual joint is dropped (no motor turns it). Splitting ``J Delta q = Delta x``
+into the five real columns ``J_5`` and the virtual one ``j_v = (a x (p - o), a)``,
+
+.. math:: J_5 \Delta q_5 = \Delta x - j_v \Delta q_v,
+
+the real joints make the whole correction less a twist about the virtual axis: a roll of the sole about its
+centre line, the one motion five joints cannot make at any posture (the sole's roll then follows from its
+position, heading and pitch). No ankle-roll torque is asked for: the ankle damping's roll and the torso roll
+reach the sole only as that dropped twist, and the lateral balance is the hip roll's, moving the CoM sideways
+(the CoM admittance) and placing the swinging foot (landing control); ``tests/test_five_joint_legs.py`` checks
+the split on a five-joint chain. It runs compiled
 (:mod:`zmpwalk.balance_kernel`, numba, cached on disk after the first compile) on arrays allocated once per
 stabilizer: a tick costs about 5 µs from Python and allocates nothing.
 """
@@ -208,6 +222,8 @@ class Stabilizer:
         params[kernel.P_SOLE_CENTER_Y] = robot.sole_center_y
         params[kernel.P_LOAD_THRESHOLD] = LOAD_FRACTION * self._mass * robot.gravity
         params[kernel.P_ANKLE_OFFSET:kernel.P_ANKLE_OFFSET + 6] = np.concatenate([c.ankle for c in self.chains])
+        params[kernel.P_SOLE_NORMAL:kernel.P_SOLE_NORMAL + 6] = np.concatenate([c.sole_rotation[:, 2]
+                                                                               for c in self.chains])
         params[kernel.P_SERVO_GAIN:kernel.P_SERVO_GAIN + 12] = self.servo_gain
         params[kernel.P_STIFFEN] = float(self.servo_gain.any())
         params[kernel.P_FEET_CLEARANCE] = self.gains.feet_clearance

@@ -18,6 +18,12 @@ Arrays (all float64):
   Jacobians at the reference (rows 0:6, columns 0:6 and 6:12) and the torso's rotation in world (row 6, 0:9);
   ``work[5]`` the factors' row swaps (row 0, 0:6 and 6:12) and a leg's foot correction (row 1, 0:6).
 
+A five-joint leg's chain (:mod:`zmpwalk.leg_chain`) carries its virtual ankle roll as a sixth joint: its Jacobian
+stays 6 x 6 and invertible, and the change the solve gives that joint is sent nowhere (the plant has no joint
+there, :mod:`zmpwalk.sim.plant`); its measured angle is 0. What the five real joints then do is the correction less
+a roll of the sole about its centre line, the one motion they cannot make (:mod:`zmpwalk.balance`, "Five-joint
+legs").
+
 The frames: *base* is the torso (pelvis) frame, x forward, y left, z up; *world* is the walk's frame, z up against
 gravity. Every position is in metres, every angle in radians.
 """
@@ -75,7 +81,8 @@ P_LANDING_HEIGHT_LIMIT = 57  # [m] the gain landing_height_limit
 P_SOLE_STIFFNESS = 58  # [N/m^e] k of the sole's contact law f = k x^e (0: a rigid sole)
 P_SOLE_EXPONENT = 59  # [-] e
 P_WHOLE_BODY_REST = 60  # [-] the gain whole_body_rest where the CoM input is a pelvis point, else 0
-PARAMETERS = 61
+P_SOLE_NORMAL = 61  # (2, 3) each sole's normal in the last frame of its leg (the sole frame's z axis) [-]
+PARAMETERS = 67
 GAIN_NAMES = ("dcm", "com_admittance", "com_stiffness", "com_damping", "com_limit", "ankle_gain",
               "ankle_time_constant", "ankle_limit", "force_gain", "force_time_constant", "force_limit",
               "attitude_gain", "attitude_damping", "attitude_limit", "zmp_margin", "velocity_filter",
@@ -214,6 +221,17 @@ def ankle_in_base(params: np.ndarray, leg: int, frames: np.ndarray) -> tuple[flo
     x, y, z = params[o], params[o + 1], params[o + 2]
     return (f[9] + f[0] * x + f[1] * y + f[2] * z, f[10] + f[3] * x + f[4] * y + f[5] * z,
             f[11] + f[6] * x + f[7] * y + f[8] * z)
+
+
+@njit(cache=True, nogil=True)
+def sole_normal(params: np.ndarray, leg: int, frames: np.ndarray) -> tuple[float, float, float]:
+    """The leg's sole normal in the base frame: the last frame's rotation times the sole frame's z axis
+    (:attr:`zmpwalk.leg_chain.LegChain.sole_rotation`; the last frame's own z axis where the sole is level at zero
+    angles)."""
+    f = frames[6]
+    o = P_SOLE_NORMAL + 3 * leg
+    x, y, z = params[o], params[o + 1], params[o + 2]
+    return f[0] * x + f[1] * y + f[2] * z, f[3] * x + f[4] * y + f[5] * z, f[6] * x + f[7] * y + f[8] * z
 
 
 @njit(cache=True, nogil=True)
@@ -438,9 +456,11 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
     a1 = ankle_in_base(p, 1, work[2])
     # CoM in the base from the measured legs
     com_bx, com_by, com_bz = com_in_base(p, chain, work, 0)
-    # each measured sole's normal (third column of its last frame) in world, horizontal part
-    n0 = _rotate3(rot, work[0, 6, 2], work[0, 6, 5], work[0, 6, 8])
-    n1 = _rotate3(rot, work[2, 6, 2], work[2, 6, 5], work[2, 6, 8])
+    # each measured sole's normal (its sole frame's z axis, sole_normal) in world, horizontal part
+    s0 = sole_normal(p, 0, work[0])
+    s1 = sole_normal(p, 1, work[2])
+    n0 = _rotate3(rot, s0[0], s0[1], s0[2])
+    n1 = _rotate3(rot, s1[0], s1[1], s1[2])
     if not started:
         state[S_SOLE_NORMALS], state[S_SOLE_NORMALS + 1] = n0[0], n0[1]
         state[S_SOLE_NORMALS + 2], state[S_SOLE_NORMALS + 3] = n1[0], n1[1]
@@ -476,8 +496,7 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
     # --- 7. floor slope: the soles' normal in world (IMU and measured kinematics), low-pass filtered
     slope_on = p[P_SLOPE_TIME_CONSTANT] > 0.0
     if slope_on and loaded0 and loaded1:  # both soles down: both flat on the floor
-        m_n = _rotate3(rot, (work[0, 6, 2] + work[2, 6, 2]) / 2, (work[0, 6, 5] + work[2, 6, 5]) / 2,
-                       (work[0, 6, 8] + work[2, 6, 8]) / 2)
+        m_n = _rotate3(rot, (s0[0] + s1[0]) / 2, (s0[1] + s1[1]) / 2, (s0[2] + s1[2]) / 2)
         beta = dt / (p[P_SLOPE_TIME_CONSTANT] + dt)
         for i in range(3):
             state[S_FLOOR_NORMAL + i] += beta * (m_n[i] - state[S_FLOOR_NORMAL + i])

@@ -89,6 +89,28 @@ class JointLimitError(ZmpwalkError, ValueError):
         )
 
 
+class SoleRollError(JointLimitError):
+    """A five-joint leg's sole would roll further than its virtual ankle roll's range allows: the walk needs an
+    ankle roll the leg does not have (:func:`zmpwalk.leg_chain.sole_roll_bound`).
+
+    Attributes:
+        joint, angle, time, limits: As :class:`JointLimitError`; ``joint`` is the virtual column
+            (``"left_ankle_roll"``), ``angle`` the sole roll the five joints leave, ``limits`` the bound.
+        largest: The largest |sole roll| of the walk [rad].
+    """
+
+    def __init__(self, joint: str, angle: float, time: float, limits: tuple[float, float], largest: float) -> None:
+        super().__init__(joint, angle, time, limits)
+        self.largest = largest
+        leg = joint.split("_", 1)[0]
+        self.args = (
+            f"{joint}: the {leg} leg has 5 joints and no ankle roll; with the pelvis upright over it the walk leaves "
+            f"its sole rolled up to {largest:.4f} rad, beyond the bound [{limits[0]:.4f}, {limits[1]:.4f}] rad from "
+            f"t = {time:.3f} s ({angle:+.4f} rad there; the bound is asin of the sole's half width over the pendulum "
+            "length: the centre of mass moves sideways by l sin(roll), at most half the sole). What is missing: an "
+            "ankle roll joint, or a walk whose pelvis does not sway over its soles",)
+
+
 def rot_x(angle: Array) -> Array:
     """Rotation matrices about x, shape (n, 3, 3)."""
     c, s = np.cos(angle), np.sin(angle)
@@ -257,6 +279,7 @@ def _leg_ik_yaw_rates_in_parts(leg: Leg, px: Array, py: Array, pz: Array, yaw: A
     c, s = np.cos(yaw), np.sin(yaw)
     dx, dy, dz = leg.hip[0] - px, leg.hip[1] - py, leg.hip[2] - pz
     rx, ry, rz = c * dx + s * dy, c * dy - s * dx, dz
+    yield
     a, b = leg.thigh, leg.shank
     distance = np.sqrt(rx * rx + ry * ry + rz * rz)
     excess = np.maximum(distance - (a + b), abs(a - b) - distance)
@@ -298,6 +321,8 @@ def _leg_ik_yaw_rates_in_parts(leg: Leg, px: Array, py: Array, pz: Array, yaw: A
         dq4 = -distance * d_distance / (a * b * sin4)  # such a sample is beyond reach, which the caller rejects)
         du = (ry * dry + rz * drz) / u_z
         dq6 = (rz * dry - ry * drz) / u_squared
+    yield  # (not inside the errstate: the caller runs between the parts)
+    with np.errstate(divide="ignore", invalid="ignore"):
         d_big_y, d_big_x = -a * cos4 * dq4, -a * sin4 * dq4
         dq5 = ((big_x * d_big_y - big_y * d_big_x) / (big_x * big_x + big_y * big_y)
                - (u_z * drx - rx * du) / (rx * rx + u_squared))
@@ -499,19 +524,20 @@ def joint_trajectory_in_parts(
     if robot.legs is None:  # closed form, written row by row into (12, n) and returned transposed
         rows_angles, rows_rates = np.empty((12, n)), np.empty((12, n))
         for index, (side, (position, yaw, velocity, yaw_rate)) in enumerate(zip((1, -1), feet, strict=True)):
+            yield
             rx, ry = position[:, 0] - position_pelvis_in_world[:, 0], position[:, 1] - position_pelvis_in_world[:, 1]
             vx = velocity[:, 0] - velocity_pelvis_in_world[:, 0] + yaw_rate_pelvis * ry  # in the rotating frame
             vy = velocity[:, 1] - velocity_pelvis_in_world[:, 1] - yaw_rate_pelvis * rx
             rows = slice(6 * index, 6 * index + 6)
             yield
-            excess = yield from _leg_ik_yaw_rates_in_parts(
-                Leg.of(robot, side), c * rx + s * ry, c * ry - s * rx, position[:, 2] - position_pelvis_in_world[:, 2],
-                yaw - yaw_pelvis_in_world,
-                (c * vx + s * vy, c * vy - s * vx, velocity[:, 2] - velocity_pelvis_in_world[:, 2],
-                 yaw_rate - yaw_rate_pelvis),
-                knee_forward, rows_angles[rows], rows_rates[rows])
-            _check_reach(excess, time, "left" if side > 0 else "right", "inverse kinematics")
+            ankle = (c * rx + s * ry, c * ry - s * rx, position[:, 2] - position_pelvis_in_world[:, 2],
+                     yaw - yaw_pelvis_in_world)
+            ankle_rates = (c * vx + s * vy, c * vy - s * vx, velocity[:, 2] - velocity_pelvis_in_world[:, 2],
+                           yaw_rate - yaw_rate_pelvis)
             yield
+            excess = yield from _leg_ik_yaw_rates_in_parts(Leg.of(robot, side), *ankle, ankle_rates, knee_forward,
+                                                           rows_angles[rows], rows_rates[rows])
+            _check_reach(excess, time, "left" if side > 0 else "right", "inverse kinematics")
         angles, velocities = rows_angles.T, rows_rates.T
     else:  # an imported robot's legs: angles from _base_under_com, rates from J q' = twist
         for index, (side, (position, _, velocity, yaw_rate)) in enumerate(zip((1, -1), feet, strict=True)):
@@ -610,14 +636,38 @@ def joint_bounds(robot: RobotModel) -> tuple[Array, Array]:
 
 
 def check_joint_limits(time: Array, angles: Array, robot: RobotModel) -> None:
-    """Raise :class:`JointLimitError` for the first sample and joint outside the robot's ranges."""
+    """Raise :class:`JointLimitError` for the first sample and joint outside the robot's ranges (a
+    :class:`SoleRollError` where that joint is a five-joint leg's virtual ankle roll)."""
     lower, upper = joint_bounds(robot)
     outside = (angles < lower) | (angles > upper)
     if np.any(outside):
         sample = int(np.argmax(outside.any(axis=1)))
         column = int(np.argmax(outside[sample]))
-        raise JointLimitError(JOINT_COLUMNS[column], float(angles[sample, column]), float(time[sample]),
-                              (float(lower[column]), float(upper[column])))
+        limits = (float(lower[column]), float(upper[column]))
+        if column in virtual_columns(robot):
+            raise SoleRollError(JOINT_COLUMNS[column], float(angles[sample, column]), float(time[sample]), limits,
+                                float(np.abs(angles[:, column]).max()))
+        raise JointLimitError(JOINT_COLUMNS[column], float(angles[sample, column]), float(time[sample]), limits)
+
+
+def virtual_columns(robot: RobotModel) -> list[int]:
+    """The joint columns of five-joint legs' virtual ankle rolls (:mod:`zmpwalk.leg_chain`): their angle is the
+    sole roll the leg leaves; no motor turns them."""
+    return [6 * index + chain.virtual_column for index, chain in enumerate(robot.legs or ())
+            if chain.virtual_column is not None]
+
+
+def check_sole_roll(time: Array, angles: Array, robot: RobotModel) -> None:
+    """Raise :class:`SoleRollError` where a five-joint leg's sole roll (its virtual column of ``angles``, (n, 12)
+    [rad]) leaves its range, the first sample outside; nothing for six-joint legs."""
+    lower, upper = joint_bounds(robot)
+    for column in virtual_columns(robot):
+        roll = angles[:, column]
+        outside = (roll < lower[column]) | (roll > upper[column])
+        if np.any(outside):
+            sample = int(np.argmax(outside))
+            raise SoleRollError(JOINT_COLUMNS[column], float(roll[sample]), float(time[sample]),
+                                (float(lower[column]), float(upper[column])), float(np.abs(roll).max()))
 
 
 def pattern_joint_trajectory(pattern: SampledMotion, knee_forward: bool = True,

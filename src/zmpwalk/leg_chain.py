@@ -10,10 +10,31 @@ frame; x forward, y left, z up) at the model's zero configuration:
     \qquad \xi_i = (\omega_i, r_i)
 
 with ``omega_i`` the unit axis of joint ``i`` and ``r_i`` a point on it, both at
-``q = 0``, and ``M`` the **foot frame** at ``q = 0``: its origin is the ankle
-point (where the two ankle axes meet, or the last joint's anchor), its axes
-those of the pelvis (a model's zero pose has the sole flat under the pelvis;
-the importer checks it). Angles are the model's own (its signs and zeros).
+``q = 0``, and ``M = (R_s, A_0)`` the **foot frame** at ``q = 0``: its origin
+``A_0`` is the ankle point (where the two ankle axes meet, or the last joint's
+anchor), its axes the **sole frame** ``R_s`` (:attr:`LegChain.sole_rotation`:
+x forward along the sole, z its normal), which is level when the sole is flat
+on the floor. A model whose sole is tilted at zero angles (a foot box pitched
+10 degrees, level in the keyframe) has ``R_s = R_y(10 deg)``
+(:func:`zmpwalk.robots.collision.foot_sole`): the inverse kinematics is asked
+for the sole's pose, so a walking pattern's flat foot is a flat sole. Angles
+are the model's own (its signs and zeros).
+
+**Five-joint legs** (hip yaw, roll and pitch, knee, ankle pitch: Unitree H1)
+are a six-joint chain whose ankle roll is **virtual** (:attr:`LegChain.virtual`):
+an axis along the sole's x axis, ``a = R_s e_x``, through the sole's centre line
+on the floor (:mod:`zmpwalk.robots.legs`), which no motor turns. The chain is
+solved as any six-joint leg; the virtual angle it returns is the sole's roll
+that the five joints cannot give. It leaves the sole's x axis where the target
+puts it: with ``R_{1..5}`` the rotation of the five real joints,
+
+.. math:: R_{foot} e_x = R_{1..5}\, e^{\hat a q_6} R_s e_x = R_{1..5}\, e^{\hat a q_6} a = R_{1..5}\, a,
+
+and every point of the axis where the target puts it (a rotation fixes its
+axis): the five real joints meet the sole's centre line on the floor and the
+sole's heading and pitch exactly, and the virtual angle is the sole's
+**residual roll** about that line: what the foot rolls on the floor when the
+real joints are sent alone (``tests/test_five_joint_legs.py``).
 
 **Closed form** (:meth:`LegChain.solve`), wherever the three hip axes meet in
 one point ``H`` and the two ankle axes meet in one point ``A_0`` (any axis order:
@@ -150,6 +171,11 @@ class LegChain:
         link_coms: Its centre of mass at ``q = 0`` in the pelvis frame [m], (6, 3).
         role_order: Chain index of each role (hip yaw, hip roll, hip pitch, knee, ankle pitch, ankle
             roll): ``angles[:, role_order]`` lists a solution in the role order of zmpwalk's joint columns.
+        sole_rotation: The sole frame in the pelvis frame at ``q = 0`` (the rotation of ``M``), (3, 3).
+        virtual: Chain index of the virtual joint of a five-joint leg (its ankle roll, which no motor turns;
+            see the module docstring), or None.
+        sole_tilt_reference: The (roll, pitch) of the sole's lowest points' plane in the model's reference
+            posture, relative to level [rad] (:class:`zmpwalk.robots.collision.Sole`; for reading).
     """
 
     side: int
@@ -163,6 +189,20 @@ class LegChain:
     role_order: tuple[int, ...] = (0, 1, 2, 3, 4, 5)
     link_masses: Array = field(default_factory=lambda: np.zeros(6))
     link_coms: Array = field(default_factory=lambda: np.zeros((6, 3)))
+    sole_rotation: Array = field(default_factory=lambda: np.eye(3))
+    virtual: int | None = None
+    sole_tilt_reference: tuple[float, float] = (0.0, 0.0)  # [rad]
+
+    @property
+    def virtual_column(self) -> int | None:
+        """The virtual joint's place among the leg's six role-ordered columns (5: the ankle roll), or None."""
+        return None if self.virtual is None else list(self.role_order).index(self.virtual)
+
+    def residual_roll(self, q: Array) -> Array:
+        """The sole's roll about its own x axis that the real joints cannot give [rad], (n,): the virtual joint's
+        angle of a five-joint leg (zeros for a six-joint leg)."""
+        q = np.atleast_2d(q)
+        return np.asarray(q[:, self.virtual] if self.virtual is not None else np.zeros(len(q)), dtype=np.float64)
 
     def link_com_positions(self, q: Array, transforms: tuple[Array, Array] | None = None) -> Array:
         """Centres of mass of the six moving segments in the pelvis frame [m], (n, 6, 3).
@@ -233,7 +273,12 @@ class LegChain:
         return rotations, translations
 
     def fk(self, q: Array, transforms: tuple[Array, Array] | None = None) -> tuple[Array, Array]:
-        """Ankle position [m] (n, 3) and foot rotation (n, 3, 3) in the pelvis frame for angles (n, 6) [rad]."""
+        """Ankle position [m] (n, 3) and sole rotation (n, 3, 3) in the pelvis frame for angles (n, 6) [rad]."""
+        position, rotation = self._fk_chain(q, transforms)
+        return position, np.asarray(rotation @ self.sole_rotation, dtype=np.float64)
+
+    def _fk_chain(self, q: Array, transforms: tuple[Array, Array] | None = None) -> tuple[Array, Array]:
+        """Ankle position and the chain's rotation ``prod exp(xi_i q_i)`` (the sole's, without ``R_s``)."""
         rotations, translations = self.transforms(q) if transforms is None else transforms
         rotation, translation = rotations[:, 6], translations[:, 6]
         return translation + rotation @ self.ankle, rotation
@@ -252,7 +297,8 @@ class LegChain:
     # --- inverse kinematics -------------------------------------------------------------------------------
     def solve(self, position_ankle_in_pelvis: Array, rotation_foot_in_pelvis: Array,
               numeric: bool | None = None, start: Array | None = None) -> tuple[Array, Array]:
-        """Joint angles (n, 6) [rad] for ankle positions (n, 3) [m] and foot rotations (n, 3, 3).
+        """Joint angles (n, 6) [rad] for ankle positions (n, 3) [m] and sole rotations (n, 3, 3) (the sole frame's,
+        :attr:`sole_rotation`; a flat sole of yaw ``psi`` is ``R_z(psi)``).
 
         Args:
             numeric: Force the numeric IK (True) or the closed form (False); None picks the closed form
@@ -264,7 +310,8 @@ class LegChain:
             numeric IK reports its remaining error there).
         """
         p = np.atleast_2d(position_ankle_in_pelvis)
-        rotation = np.asarray(rotation_foot_in_pelvis).reshape(-1, 3, 3)
+        # the chain's own rotation g = T_d M^-1: the sole's target turned back by R_s
+        rotation = np.asarray(rotation_foot_in_pelvis).reshape(-1, 3, 3) @ self.sole_rotation.T
         if numeric is None:
             numeric = not self.closed_form
         if numeric:
@@ -313,7 +360,7 @@ class LegChain:
         q3 = _subproblem1(w[2], np.broadcast_to(perpendicular, (n, 3)), seen)
         angles = np.column_stack([q1, q2, q3, q4, q5, q6])
         # Where the ankle cannot turn the foot as asked (no exact solution), report the residual.
-        position, _ = self.fk(angles)
+        position, _ = self._fk_chain(angles)
         residual = np.linalg.norm(position - p, axis=1)
         excess = np.where(excess > 0, excess, np.where(residual > 1e-6, residual, excess))
         return angles, excess
@@ -324,7 +371,7 @@ class LegChain:
         eye = np.eye(6)
         error = np.zeros((n, 6))
         for _ in range(IK_MAX_ITERATIONS):
-            position, current = self.fk(q)
+            position, current = self._fk_chain(q)
             error[:, :3] = p - position
             error[:, 3:] = _rotation_vector(rotation @ np.swapaxes(current, 1, 2))
             norm = np.max(np.abs(error), axis=1)
@@ -336,12 +383,32 @@ class LegChain:
             step = np.einsum("nji,nj->ni", jacobian, np.linalg.solve(jjt, error[active][..., None])[..., 0])
             largest = np.max(np.abs(step), axis=1, keepdims=True)
             q[active] += step * np.minimum(1.0, IK_MAX_STEP / np.maximum(largest, 1e-300))
-        position, current = self.fk(q)
+        position, current = self._fk_chain(q)
         residual = np.linalg.norm(p - position, axis=1)
         residual = np.maximum(residual, np.linalg.norm(_rotation_vector(rotation @ np.swapaxes(current, 1, 2)),
                                                        axis=1))
         excess = np.where(residual > 1e3 * IK_TOLERANCE, residual, -1.0)
         return _wrap(q), excess
+
+
+def sole_roll_bound(sole_width: float, pendulum_length: float) -> float:
+    r"""The largest sole roll a five-joint leg may leave (its virtual ankle roll's range) [rad].
+
+    A roll ``phi`` of the sole that the leg cannot give either stands the sole on an edge or, with the sole
+    pressed flat, rolls the body above it by ``phi``; either way the centre of mass, ``l`` above the sole, moves
+    sideways from its plan by ``l sin(phi)``. The stabilizer takes that up through the stance sole's centre of
+    pressure only while it stays within the sole's half width ``W / 2``:
+
+    .. math:: |\phi| \le \arcsin\frac{W}{2 l}
+
+    (Unitree H1: 60 mm soles, ``l`` = 0.951 m: 0.0316 rad). ``tests/test_five_joint_legs.py`` rolls a model about
+    its sole's centre line by the bound and finds its CoM moved by ``W / 2``.
+
+    Args:
+        sole_width: ``W`` [m].
+        pendulum_length: ``l``, the CoM's height in the ready posture [m].
+    """
+    return math.asin(min(1.0, sole_width / (2.0 * pendulum_length)))
 
 
 def _pick(solutions: list[tuple[Array, Array]], reference1: float, reference2: float) -> tuple[Array, Array]:
@@ -364,4 +431,4 @@ def _rotation_vector(rotation: Array) -> Array:
     return np.asarray(vee * scale[:, None], dtype=np.float64)
 
 
-__all__ = ["LegChain", "cross3"]
+__all__ = ["LegChain", "cross3", "sole_roll_bound"]

@@ -1,13 +1,37 @@
-"""The collision geometry of a robot's own model that touches the floor: the points spanning a body's colliding
-geoms (a foot's sole), for every geom shape, and the geoms that collide (contact type and affinity, or an explicit
-``<contact><pair>``)."""
+r"""The collision geometry of a robot's own model that touches the floor: the points spanning a body's colliding
+geoms (a foot's sole), for every geom shape, the geoms that collide (contact type and affinity, or an explicit
+``<contact><pair>``), and the sole they make (:func:`foot_sole`).
+
+**The sole is taken in the reference posture** (the keyframe, where the robot stands with its feet on a level
+floor), not at zero joint angles: a foot whose sole is pitched 10 degrees at zero angles and level in the
+keyframe has a 0 mm long sole at zero angles (only its toe edge is lowest) and its real one in the keyframe.
+The sole's normal is the world's up in the reference posture, carried into the foot body; the **sole frame**
+is the frame the inverse kinematics keeps level (x forward along the sole, y left, z along that normal),
+written in the pelvis frame at zero angles as
+
+.. math:: R_s = R_y(\theta) R_x(\phi), \qquad n = R_s e_z = (\cos\phi \sin\theta,\ -\sin\phi,\
+    \cos\phi \cos\theta)
+
+so the sole's roll ``phi = atan2(-n_y, sqrt(n_x^2 + n_z^2))`` and pitch ``theta = atan2(n_x, n_z)`` at zero
+angles are read from its normal ``n`` there, and ``R_s`` turns the sole no more than the tilt needs (its x axis
+stays in the pelvis's x-z plane: no yaw). ``R_s`` is the identity where the foot is level at zero angles too
+(TALOS, Booster T1, Fourier N1, Unitree H1: tilts below 1e-15 rad).
+"""
 
 from __future__ import annotations
+
+import math
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
+from zmpwalk.zmp import convex_hull
+
 Array = NDArray[np.float64]
+
+SOLE_BAND = 0.002  # [m] collision points this close to the lowest (along the sole's normal) form the sole
+LEVEL = 1e-12  # [rad] a tilt below this is level (the rounding of the model's own rotations)
 
 
 def rigid_bodies(model: object, body: int) -> list[int]:
@@ -93,3 +117,74 @@ def collision_points(model: object, data: object, bodies: list[int]) -> Array:
             continue
         points.append(centre + local @ rotation.T)
     return np.vstack(points) if points else np.zeros((0, 3))
+
+
+@dataclass(frozen=True)
+class Sole:
+    """One foot's sole (see the module docstring), in the sole frame: origin the ankle point, axes ``rotation``.
+
+    Attributes:
+        points: The foot's collision points within :data:`SOLE_BAND` of the lowest [m], (m, 3).
+        polygon: Their convex hull in the sole plane, counter-clockwise [m], (k, 2).
+        ankle_height: The ankle point's height above the sole [m].
+        rotation: The sole frame in the pelvis frame at zero joint angles, (3, 3).
+        tilt_zero: The sole's (roll, pitch) at zero angles, relative to the pelvis [rad].
+        tilt_reference: The (roll, pitch) of the plane through :attr:`points` in the reference posture, relative
+            to level [rad]: 0 where the reference posture stands the sole flat (nan where the points are on a line).
+    """
+
+    points: Array
+    polygon: Array
+    ankle_height: float  # [m]
+    rotation: Array
+    tilt_zero: tuple[float, float]  # [rad]
+    tilt_reference: tuple[float, float]  # [rad]
+
+    @property
+    def extent(self) -> tuple[float, float]:
+        """Length and width of the polygon's bounding rectangle [m]."""
+        if len(self.polygon) == 0:
+            return 0.0, 0.0
+        size = self.polygon.max(axis=0) - self.polygon.min(axis=0)
+        return float(size[0]), float(size[1])
+
+
+def tilt_of(normal: Array) -> tuple[float, float]:
+    """(roll, pitch) [rad] of the frame ``R_y(pitch) R_x(roll)`` whose z axis is the unit ``normal`` (module
+    docstring)."""
+    nx, ny, nz = (float(v) for v in normal)
+    return math.atan2(-ny, math.hypot(nx, nz)), math.atan2(nx, nz)
+
+
+def tilt_rotation(roll: float, pitch: float) -> Array:
+    """``R_y(pitch) R_x(roll)``, (3, 3)."""
+    cr, sr, cp, sp = math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch)
+    return np.array([[cp, sp * sr, sp * cr], [0.0, cr, -sr], [-sp, cp * sr, cp * cr]])
+
+
+def foot_sole(points: Array, up: Array, rotation: Array, position: Array, ankle: Array) -> Sole:
+    """The sole of one foot.
+
+    Args:
+        points: The foot's collision points (:func:`collision_points`) in the reference posture, in the foot
+            body's frame [m], (m, 3).
+        up: The world's up in the foot body's frame in the reference posture, (3,).
+        rotation, position: The foot body's pose in the pelvis frame at zero joint angles ((3, 3), [m] (3,)).
+        ankle: The ankle point in the pelvis frame at zero angles [m], (3,).
+    """
+    roll, pitch = tilt_of(rotation @ (up / np.linalg.norm(up)))
+    if abs(roll) < LEVEL and abs(pitch) < LEVEL:
+        roll = pitch = 0.0
+    frame = tilt_rotation(roll, pitch)
+    local = (points @ rotation.T + position - ankle) @ frame  # R_s^T (x - ankle), row by row
+    bottom = float(local[:, 2].min()) if len(local) else 0.0
+    band = local[local[:, 2] < bottom + SOLE_BAND]
+    polygon = convex_hull(band[:, :2]) if len(band) else np.zeros((0, 2))
+    tilt_reference = (math.nan, math.nan)
+    if len(band) >= 3:
+        centred = band - band.mean(axis=0)
+        _, singular, vectors = np.linalg.svd(centred)
+        if singular[1] > 1e-9:
+            normal = vectors[2] if vectors[2][2] > 0 else -vectors[2]
+            tilt_reference = tilt_of(normal)
+    return Sole(band, np.asarray(polygon, dtype=np.float64), -bottom, frame, (roll, pitch), tilt_reference)

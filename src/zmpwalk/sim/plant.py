@@ -16,12 +16,19 @@ model, unmodified in its meshes, masses, inertias, contacts and actuators, with:
 
 The leg joints must be driven by position servos (MuJoCo ``<position>`` or an equivalent ``general``) or by
 the PD layer: zmpwalk sends joint angles.
+
+A five-joint leg's virtual ankle roll (:mod:`zmpwalk.robots.legs`) has no joint in the model. Its joint column
+keeps zmpwalk's 12-column layout through an actuator that does nothing, ``zmpwalk_virtual_LEFT_ankle_roll``
+(gain, bias and gear 0 on the leg's ankle pitch: MuJoCo applies ``gear * force = 0``), and its sensors read that
+actuator's length, velocity and force, all 0: the foot is rigid on the ankle pitch, as the model says, and the
+angle the simulation measures there is 0 whatever the plan's residual roll. The column has no ``qpos``
+(:attr:`Plant.leg_columns` lists the columns that do).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
@@ -46,8 +53,10 @@ class Plant:
 
     Attributes:
         model: The MuJoCo model.
-        leg_actuators: Actuator index of each joint column (left leg then right, role order), (12,).
-        leg_qpos: ``qpos`` address of each joint column, (12,).
+        leg_actuators: Actuator index of each joint column (left leg then right, role order), (12,) (a virtual
+            column's: its actuator that does nothing).
+        leg_qpos: ``qpos`` address of each joint column that is a joint of the model, (len(leg_columns),).
+        leg_columns: Those columns (all 12 but a five-joint leg's virtual ankle roll).
         ctrl_hold: Controls of the reference pose (the other actuators keep them), (nu,).
         qpos_hold: The reference pose, (nq,).
         imported: True for the robot's own model, False for the box model.
@@ -59,6 +68,7 @@ class Plant:
     ctrl_hold: Array
     qpos_hold: Array
     imported: bool
+    leg_columns: NDArray[np.intp] = field(default_factory=lambda: np.arange(12))
 
 
 def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
@@ -105,7 +115,7 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
         rotation = data.xmat[body].reshape(3, 3)
         position = rotation.T @ (chain.ankle - data.xpos[body])
         quaternion = np.empty(4)
-        mujoco.mju_mat2Quat(quaternion, rotation.T.flatten())  # site axes = pelvis axes at the zero pose
+        mujoco.mju_mat2Quat(quaternion, (rotation.T @ chain.sole_rotation).flatten())  # site axes: the sole frame
         spec.body(foot).add_site(name=f"{label}_ankle", pos=position, quat=quaternion, size=[0.005, 0.005, 0.005])
     sensors = [("pelvis_pos", mujoco.mjtSensor.mjSENS_FRAMEPOS, "pelvis"),
                ("pelvis_quat", mujoco.mjtSensor.mjSENS_FRAMEQUAT, "pelvis"),
@@ -118,23 +128,53 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
     for name, kind, site in sensors:
         sensor = spec.add_sensor(name=name, type=kind, objname=site)
         sensor.objtype = mujoco.mjtObj.mjOBJ_SITE
-    for column, joint in zip(JOINT_COLUMNS, plant.joints, strict=True):
+    virtual = _virtual_columns(robot)
+    for index, (column, joint) in enumerate(zip(JOINT_COLUMNS, plant.joints, strict=True)):
+        if index in virtual:
+            _add_virtual_actuator(spec, joint.name, plant.joints[6 * (index // 6) + 4].name, column)
+            continue
         for suffix, kind in (("q", mujoco.mjtSensor.mjSENS_JOINTPOS), ("qd", mujoco.mjtSensor.mjSENS_JOINTVEL),
                              ("tau", mujoco.mjtSensor.mjSENS_JOINTACTFRC)):
             sensor = spec.add_sensor(name=f"{column}_{suffix}", type=kind, objname=joint.name)
             sensor.objtype = mujoco.mjtObj.mjOBJ_JOINT
     model = spec.compile()
     actuators = []
-    for column, joint in zip(JOINT_COLUMNS, plant.joints, strict=True):
+    for index, (column, joint) in enumerate(zip(JOINT_COLUMNS, plant.joints, strict=True)):
+        if index in virtual:
+            actuators.append(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, joint.name))
+            continue
         if joint.actuator is None or not joint.actuator.servo:
             kind = "none" if joint.actuator is None else joint.actuator.kind
             raise InvalidParameterError(f"{column} actuator", kind, "a position servo (MuJoCo <position>) or a "
                                         "torque motor (<motor>, driven by the PD layer): zmpwalk drives the leg "
                                         "joints with joint angles")
         actuators.append(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, joint.actuator.name))
-    leg_qpos = np.array([model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j.name)]
-                         for j in plant.joints])
-    return Plant(model, np.array(actuators), leg_qpos, _held_controls(model, plant), qpos, True)
+    columns = np.array([i for i in range(12) if i not in virtual], dtype=np.intp)
+    leg_qpos = np.array([model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, plant.joints[i].name)]
+                         for i in columns])
+    return Plant(model, np.array(actuators), leg_qpos, _held_controls(model, plant), qpos, True, columns)
+
+
+def _virtual_columns(robot: RobotModel) -> set[int]:
+    """The joint columns of five-joint legs' virtual ankle rolls (no joint of the model)."""
+    return {6 * index + chain.virtual_column for index, chain in enumerate(robot.legs or ())
+            if chain.virtual_column is not None}
+
+
+def _add_virtual_actuator(spec: mujoco.MjSpec, name: str, ankle_pitch: str, column: str) -> None:
+    """The actuator of a virtual joint column, which does nothing (gain, bias and gear 0 on the ankle pitch), and
+    its sensors (its length, velocity and force: 0), named as a joint column's (module docstring)."""
+    actuator = spec.add_actuator(name=name, target=ankle_pitch, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+    actuator.gaintype = mujoco.mjtGain.mjGAIN_FIXED
+    actuator.biastype = mujoco.mjtBias.mjBIAS_NONE
+    actuator.gainprm = [0.0] * 10
+    actuator.biasprm = [0.0] * 10
+    actuator.gear = [0.0] * 6
+    actuator.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
+    for suffix, kind in (("q", mujoco.mjtSensor.mjSENS_ACTUATORPOS), ("qd", mujoco.mjtSensor.mjSENS_ACTUATORVEL),
+                         ("tau", mujoco.mjtSensor.mjSENS_ACTUATORFRC)):
+        sensor = spec.add_sensor(name=f"{column}_{suffix}", type=kind, objname=name)
+        sensor.objtype = mujoco.mjtObj.mjOBJ_ACTUATOR
 
 
 def add_pd_layer(spec: mujoco.MjSpec, plant: ModelPlant) -> None:
@@ -186,7 +226,7 @@ def set_initial_state(plant: Plant, data: mujoco.MjData, position_base: Array, y
     data.qpos[:] = plant.qpos_hold
     data.qpos[0:3] = position_base
     data.qpos[3:7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
-    data.qpos[plant.leg_qpos] = angles
+    data.qpos[plant.leg_qpos] = angles[plant.leg_columns]
     data.qvel[:] = 0.0
     data.ctrl[:] = plant.ctrl_hold
     data.ctrl[plant.leg_actuators] = angles
@@ -212,7 +252,7 @@ def plant_qpos(plant: Plant, position_base: Array, yaw: Array, angles: Array) ->
     qpos = np.repeat(plant.qpos_hold[None, :], n, axis=0)
     qpos[:, 0:3] = position_base
     qpos[:, 3:7] = np.column_stack([np.cos(yaw / 2), np.zeros(n), np.zeros(n), np.sin(yaw / 2)])
-    qpos[:, plant.leg_qpos] = angles
+    qpos[:, plant.leg_qpos] = angles[:, plant.leg_columns]
     return qpos
 
 
@@ -348,6 +388,7 @@ def damping_feedforward(plant: Plant, velocities: Array) -> Array:
         velocities: Planned joint rates [rad/s], (n, 12) in the leg-column order.
     """
     model = plant.model
-    ratio = np.array([-model.actuator_biasprm[a][2] / model.actuator_gainprm[a][0] for a in plant.leg_actuators])
+    ratio = np.array([-model.actuator_biasprm[a][2] / model.actuator_gainprm[a][0] if model.actuator_gainprm[a][0]
+                      else 0.0 for a in plant.leg_actuators])  # a virtual column's actuator has no gain
     return np.asarray(velocities * ratio, dtype=np.float64)
 

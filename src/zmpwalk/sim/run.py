@@ -44,7 +44,7 @@ from zmpwalk.balance import BalanceMeasurement, Stabilizer
 from zmpwalk.capture import CapturePlan, CaptureSettings, capture_step
 from zmpwalk.errors import InfeasiblePatternError, InvalidParameterError, UnreachableError
 from zmpwalk.files import atomic_output
-from zmpwalk.kinematics import JOINT_COLUMNS, JointTrajectory, pattern_joint_trajectory
+from zmpwalk.kinematics import JOINT_COLUMNS, JointTrajectory, check_sole_roll, pattern_joint_trajectory
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sim.mjcf import contact_mapping
@@ -286,6 +286,8 @@ def simulate(
 
     Raises:
         InvalidParameterError: Mismatched inputs or a robot without simulation data.
+        SoleRollError: A five-joint leg's sole would roll beyond its bound (:func:`zmpwalk.kinematics.check_sole_roll`:
+            the walk needs an ankle roll the leg does not have).
     """
     if len(joints.time) != len(pattern.time) or len(pattern.time) < 2:
         raise InvalidParameterError("joints", len(joints.time), f"{len(pattern.time)} samples, as the pattern")
@@ -308,6 +310,7 @@ def simulate(
     if stabilizer is not None and stabilizer.com_reference != pattern.com_point:
         raise InvalidParameterError("stabilizer.com_reference", stabilizer.com_reference,
                                     f"{pattern.com_point}: the CoM point this pattern gives")
+    check_sole_roll(joints.time, joints.angles, robot)  # a five-joint leg's sole roll within its bound
     plant = build_plant(robot, mass_scale)
     if feedforward is None:
         feedforward = plant.imported or stabilizer is not None
