@@ -9,6 +9,7 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 
 from zmpwalk.balance import BalanceMeasurement, Stabilizer, StabilizerGains
 from zmpwalk.commands import StepCommand
+from zmpwalk.control import JointTargets, MockPlant, Plant, WalkingController
 from zmpwalk.errors import (
     FileFormatError,
     InfeasibleCommandError,
@@ -35,9 +36,12 @@ __all__ = [
     "InfeasiblePatternError",
     "InvalidParameterError",
     "JointLimitError",
+    "JointTargets",
     "JointTrajectory",
     "LegChain",
+    "MockPlant",
     "OnlineWalker",
+    "Plant",
     "RobotModel",
     "Schedule",
     "ShapeParameters",
@@ -46,6 +50,7 @@ __all__ = [
     "StepCommand",
     "UnknownNameError",
     "UnreachableError",
+    "WalkingController",
     "WalkingPattern",
     "WalkingSample",
     "ZmpwalkError",

@@ -3,7 +3,7 @@
 :class:`WalkingController` puts the :class:`~zmpwalk.online.OnlineWalker` (with joints), the
 :class:`~zmpwalk.balance.Stabilizer` and an optional :class:`Feedforward` behind ``update(measurement) ->
 JointTargets``; a :class:`Plant` measures and carries out the targets (a robot's driver,
-:class:`zmpwalk.sim.loop.MujocoPlant`, or :class:`MockPlant`). docs/controller.md shows a robot's loop.
+:class:`zmpwalk.sim.mujoco_plant.MujocoPlant`, or :class:`MockPlant`). docs/controller.md shows a robot's loop.
 """
 
 from zmpwalk.control.controller import Feedforward, WalkingController, velocity_command, velocity_step_time
