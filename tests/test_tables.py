@@ -316,3 +316,18 @@ def test_the_step_time_limit_of_the_advice_plans_inside(hubo, commands):
     assert not change.lower and 0.7 < change.limit < 0.75
     longer = generate(hubo, [replace(c, duration=change.limit) for c in commands], rate=1000.0, schedule=paper)
     assert 0.0 <= longer.min_zmp_margin()[0] < 5e-3  # [m]
+
+
+def test_advice_without_lateral_velocity_names_only_values_that_exist(hubo):
+    """V_y = 0 leaves the sway no slope to scale with the step time (was a division by zero), and an S_y below 0
+    is no advice: with V_y = 0 at 0.8 s only S_y <= 0 would bring the 101.8 mm back, so no change is named."""
+    from zmpwalk.tables import zmp_advice
+
+    for command in (StepCommand(0.8, d1=0.5, d1_recovery=0.5, lateral_velocity=0.0),
+                    StepCommand(0.8, lateral_velocity=0.0)):
+        pattern = generate(hubo, [command], rate=1000.0)
+        margin, time = pattern.min_zmp_margin()
+        assert margin < -0.05  # [m]
+        advice = zmp_advice(hubo, [command], time, margin)
+        assert all(c.limit > 0.0 for c in advice.changes)
+        assert advice.text.startswith(f"the ZMP leaves the support polygon by {-margin * 1e3:.1f} mm")

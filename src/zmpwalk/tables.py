@@ -171,6 +171,7 @@ def zmp_advice(robot: RobotModel, commands: Sequence[StepCommand], time: float, 
         cause, offset, changes = _sagittal(stages[k], time, zmp, margin, walk.label(k), support)
     else:
         cause, offset, changes = _sway(walk, k, time, margin, robot, (normal, support), schedule)
+    changes = [c for c in changes if c.parameter == "forward" or c.limit > 0.0]  # S_y, V_y, T cannot go below 0
     where = CAUSE_WORDS[cause].format(offset=offset * 1e3) + _rule_words(stages[k])
     text = (f"the ZMP leaves the support polygon by {-margin * 1e3:.1f} mm at t = {time:.3f} s in {walk.label(k)}"
             + (f", {where}" if where else "") + ": " + ("; or ".join(c.words() for c in changes) if changes else
@@ -315,7 +316,8 @@ def _step_time(walk: _OwnedStages, k: int, schedule: Schedule, robot: RobotModel
         first, second = schedule.stage_parameters(replace(command, duration=duration), robot)
         p = second if walk.stages[k].plan.kind == "recovery" else first
         tau_new = tau * (1.0 - p.d1) / (1.0 - now.d1) * duration / command.duration  # [s]
-        slope_new = slope * p.alpha1 * p.lateral_velocity / (now.alpha1 * now.lateral_velocity)  # [m] per unit tau
+        inherited = now.alpha1 * now.lateral_velocity  # [m]: 0 (no V_y) leaves no slope to scale
+        slope_new = slope * p.alpha1 * p.lateral_velocity / inherited if inherited else slope  # [m] per unit tau
         moved = p.beta1 * p.sway * (a - l_g * a2 / tau_new**2) + slope_new * (b - l_g * b2 / tau_new**2) - zmp
         if moved / push >= 1.0:
             return [_change(walk.label(k), "duration", command.duration, duration - command.duration)]
