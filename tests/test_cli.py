@@ -237,3 +237,12 @@ def test_a_missing_robot_file_says_no_such_file(capsys):
 def test_sweep_and_tune_take_model_options_through_a_robot_file(command, capsys):
     assert main([*command, "--feet", "left_foot,right_foot"]) == 2
     assert "write a robot file" in capsys.readouterr().err
+
+
+def test_version_and_help_load_neither_mujoco_nor_numba():
+    """The command line imports what a command needs when it runs: --version and --help start fast."""
+    for flag in ("--version", "--help"):
+        code = ("import sys\nfrom zmpwalk.cli import main\ntry:\n    main([" + repr(flag) + "])\nexcept SystemExit:\n"
+                "    pass\nprint(sorted(m for m in ('mujoco', 'numba') if m in sys.modules))")
+        result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True)
+        assert result.stdout.strip().splitlines()[-1] == "[]", flag

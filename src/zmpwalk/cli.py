@@ -31,15 +31,14 @@ from zmpwalk.robots import list_robots, load_robot
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.scenarios import list_scenarios, load_scenario_with_labels, load_steps_file_with_labels
 from zmpwalk.schedule import SCHEDULE_FILES, Schedule, schedule_path
-from zmpwalk.sim.motors import Motor
-from zmpwalk.sim.verdict import HOLD, SETTLE, Verdict
 from zmpwalk.tables import condition_margins, margins_markdown, zmp_advice
 
 if TYPE_CHECKING:
     from zmpwalk.patterns.correction import ZmpCorrection
     from zmpwalk.sim.actuators import ActuatorRow
-    from zmpwalk.sim.motors import MotorFit
+    from zmpwalk.sim.motors import Motor, MotorFit
     from zmpwalk.sim.run import SimulationResult
+    from zmpwalk.sim.verdict import Verdict
 
 EXIT_ERROR = 2
 EXIT_FAILED = 3  # the walk failed its verdict, or the plan's ZMP left the polygon
@@ -447,7 +446,7 @@ def _simulate(args: argparse.Namespace) -> int:
     from zmpwalk.sim import actuator_markdown, actuator_table, simulate, write_actuator_csv
     from zmpwalk.sim.motors import motor_fits
     from zmpwalk.sim.run import Disturbances, write_result_csv
-    from zmpwalk.sim.verdict import walk_verdict
+    from zmpwalk.sim.verdict import HOLD, SETTLE, walk_verdict
 
     robot = _load_robot(args)
     show = None if args.json or not sys.stderr.isatty() else _progress

@@ -15,8 +15,9 @@ from matplotlib.patches import Polygon
 from zmpwalk.footsteps import Pose2D, foot_corners
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import JOINT_NAMES
+from zmpwalk.sim.contact import LOADED_FRACTION
 from zmpwalk.sim.motors import Motor, motor_for
-from zmpwalk.sim.run import LOADED_FRACTION, SimulationResult
+from zmpwalk.sim.run import SimulationResult
 from zmpwalk.sim.verdict import COP_MARGIN, TOUCHDOWN_WINDOW
 
 DPI = 100

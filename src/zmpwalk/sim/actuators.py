@@ -6,12 +6,15 @@ import csv
 import math
 from dataclasses import asdict, dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
 from zmpwalk.files import atomic_output
-from zmpwalk.sim.run import SimulationResult
+
+if TYPE_CHECKING:
+    from zmpwalk.sim.run import SimulationResult
 
 IMPACT_WINDOW = 0.02  # [s] a torque or power held for less than this is an impact, shown apart
 

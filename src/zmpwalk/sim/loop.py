@@ -34,11 +34,11 @@ from zmpwalk.footsteps import sole_corners
 from zmpwalk.kinematics import JOINT_COLUMNS
 from zmpwalk.online import START_DELAY, OnlineWalker
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.sim.contact import LOADED_FRACTION
 from zmpwalk.sim.mujoco_plant import MujocoPlant
 from zmpwalk.sim.run import (
     AFTER_FALL,
     HOLD,
-    LOADED_FRACTION,
     Disturbances,
     SimulationResult,
     _cop_margins,

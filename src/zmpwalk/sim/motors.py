@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
@@ -28,7 +29,9 @@ from zmpwalk.errors import FileFormatError
 from zmpwalk.files import read_toml
 from zmpwalk.robots.model import JOINT_NAMES
 from zmpwalk.sim.actuators import IMPACT_WINDOW
-from zmpwalk.sim.run import SimulationResult
+
+if TYPE_CHECKING:
+    from zmpwalk.sim.run import SimulationResult
 
 _FIELDS = ("rated_torque", "peak_torque", "no_load_speed", "gear_ratio", "efficiency")
 

@@ -47,6 +47,7 @@ from zmpwalk.files import atomic_output
 from zmpwalk.kinematics import JOINT_COLUMNS, JointTrajectory, check_sole_roll, pattern_joint_trajectory
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.sim.contact import LOADED_FRACTION
 from zmpwalk.sim.mjcf import contact_mapping
 from zmpwalk.sim.plant import (
     Plant,
@@ -67,7 +68,6 @@ FALL_HEIGHT_FRACTION = 0.6  # [-] of the pelvis height
 AFTER_FALL = 0.3  # [s] simulated after a fall
 SETTLE = 1.0  # [s] default settle phase of a robot's own model
 HOLD = 2.0  # [s] default hold after the walk of a robot's own model
-LOADED_FRACTION = 0.15  # [-] of the weight: a sole carrying more is "loaded" (its CoP is measured)
 CAPTURE_INTERVAL = 0.02  # [s] least time between two capture steps planned in one single support
 NOSLIP_ITERATIONS = 5  # MuJoCo noslip iterations on a tilted floor (Disturbances.apply: no creep of loaded soles)
 

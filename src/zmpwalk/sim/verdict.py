@@ -34,12 +34,16 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from zmpwalk.sim.actuators import IMPACT_WINDOW, ActuatorRow, actuator_table, planned_over_limit
+from zmpwalk.sim.contact import CONTACT_FRACTION, LOADED_FRACTION
 from zmpwalk.sim.motors import Motor, MotorFit, motor_fits
-from zmpwalk.sim.run import LOADED_FRACTION, SimulationResult
+
+if TYPE_CHECKING:
+    from zmpwalk.sim.run import SimulationResult
 
 MIN_HOLD = 2.0  # [s]
 LOADED_SHARE = LOADED_FRACTION  # [-] of the weight on the less loaded sole
@@ -51,7 +55,6 @@ FEET_DISTANCE = 0.02  # [m]
 FEET_YAW = math.radians(2.0)  # [rad]
 COP_MARGIN = -0.005  # [m]: 5 mm of the sensors' CoP beyond an edge is the foot's own inertia at its limit
 TOUCHDOWN_WINDOW = 0.05  # [s]
-CONTACT_FRACTION = 0.01  # [-] of the weight: a sole carrying more touches the floor
 PLAN_ZMP_MARGIN = 0.0  # [m] the plan's cart-table ZMP on the edge of its support polygon at worst
 ACTUATOR_LIMIT = 1.0  # [-] of an actuator's limit: a held peak (or a motor's use) must stay at most at it
 ACTUATOR_WARNING = 0.9  # [-] of an actuator's limit: from here a passing walk is shown amber
