@@ -257,12 +257,28 @@ def _sample_row(sample):
     return np.concatenate([_rows(sample), sample.joint_angles, sample.joint_velocities])
 
 
+def counting_clock(monkeypatch, part: float):
+    """Make the walker's budget count parts: every part of a check takes ``part`` [s] on its clock, whatever
+    the machine (the pacing, and so which command is checked by when, is then the same on every run)."""
+    now = [0.0]
+
+    def clock() -> float:
+        now[0] += part
+        return now[0]
+
+    monkeypatch.setattr("zmpwalk.online._clock", clock)
+
+
 @pytest.mark.parametrize("rate", [100.0, 1000.0])
 @pytest.mark.parametrize("generator", ["polynomial", "hyperbolic"])
-def test_commands_checked_in_slices_give_the_same_walk_as_commands_checked_at_once(hubo, rate, generator):
+def test_commands_checked_in_slices_give_the_same_walk_as_commands_checked_at_once(hubo, rate, generator,
+                                                                                   monkeypatch):
     """command() (checked in parts, a few per tick) against command(wait=True) (checked at once): sample for
-    sample, joint angles and rates included; the walk from standstill starts START_DELAY later, as documented."""
-    from zmpwalk.online import START_DELAY
+    sample, joint angles and rates included; the walk from standstill starts START_DELAY later, as documented.
+    On a clock where a part takes a fifth of the budget, so that every check ends in time on any machine."""
+    from zmpwalk.online import START_DELAY, work_budget
+
+    counting_clock(monkeypatch, work_budget(rate) / 5)
 
     commands = [StepCommand(0.8, 0.2), StepCommand(0.7, 0.1, turn=0.1), StepCommand(0.8, side=0.05),
                 StepCommand(0.95, -0.1)]
@@ -286,12 +302,41 @@ def test_commands_checked_in_slices_give_the_same_walk_as_commands_checked_at_on
 
 
 @pytest.mark.parametrize("rate", [100.0, 1000.0])
+@pytest.mark.parametrize("generator", ["polynomial", "hyperbolic"])
+def test_commands_checked_in_parts_walk_the_batch_pattern(hubo, rate, generator, monkeypatch):
+    """The walks do not change with the slicing: the first command given with wait (so that the walk starts at
+    once, as the batch walk does), every other with command() soon after the step before it starts, checked
+    in parts over the ticks: generate()'s batch pattern of the same commands (positions, yaws, ZMP) and
+    pattern_joint_trajectory's joints and rates, sample for sample."""
+    from zmpwalk.kinematics import pattern_joint_trajectory
+    from zmpwalk.online import work_budget
+
+    counting_clock(monkeypatch, work_budget(rate) / 5)
+    commands = [StepCommand(0.8, 0.2), StepCommand(0.7, 0.1, turn=0.1), StepCommand(0.8, side=0.05),
+                StepCommand(0.95, -0.1), StepCommand(0.8, 0.15)]
+    pattern = (generate if generator == "polynomial" else generate_hyperbolic)(hubo, commands, rate=rate)
+    joints = pattern_joint_trajectory(pattern)
+    walker = OnlineWalker(hubo, rate=rate, joints=True, generator=generator)
+    walker.command(commands[0], wait=True)
+    pending, samples = commands[1:], []
+    for _ in range(len(pattern.time)):
+        if pending and walker.queued is None and walker.checking is None:
+            walker.command(pending.pop(0))
+        samples.append(walker.tick())
+    assert not pending and walker.rejection is None and not walker.walking
+    np.testing.assert_allclose([_rows(s) for s in samples], _pattern_rows(pattern), atol=TOL, rtol=0)
+    np.testing.assert_allclose([s.joint_angles for s in samples], joints.angles, atol=1e-9, rtol=0)
+    np.testing.assert_allclose([s.joint_velocities for s in samples], joints.velocities, atol=1e-9, rtol=0)
+
+
+@pytest.mark.parametrize("rate", [100.0, 1000.0])
 def test_a_command_given_as_the_step_before_starts_is_checked_before_its_own_step(hubo, rate, monkeypatch):
-    """The check is paced by its parts (at least its share of the parts left per tick), not only by time: a
-    command given as the step before it starts, or from standstill, is checked before its step begins, so no
-    tick runs the rest of a check at once. With no time budget at all (as on a machine too slow for any part
-    to fit in it), so that the pacing by parts alone is tested."""
-    monkeypatch.setattr("zmpwalk.online.WORK_FRACTION", 0.0)
+    """A command given as the step before it starts, or from standstill, is checked before its step begins,
+    in ticks whose parts fit the budget: on a clock where every part takes a fifth of the budget (the check
+    ends after about a third of the step at 1 kHz, in a few ticks at 100 Hz)."""
+    from zmpwalk.online import work_budget
+
+    counting_clock(monkeypatch, work_budget(rate) / 5)
     steps = [StepCommand(0.8, 0.2), StepCommand(0.7, 0.15), StepCommand(0.7, 0.1, turn=0.1),
              StepCommand(0.8, side=0.05), StepCommand(0.95, 0.1), StepCommand(0.7, 0.2)]
     walker = OnlineWalker(hubo, rate=rate, joints=True)
@@ -303,7 +348,10 @@ def test_a_command_given_as_the_step_before_starts_is_checked_before_its_own_ste
         job = walker._job
         if job is not None:
             assert walker._index < job.start  # unfinished only before its step begins
+            parts = job.parts
         walker.tick()
+        if job is not None and walker._job is job:
+            assert 1 <= job.parts - parts <= 5  # the budget's worth of parts, at least one
     assert checks == 6 and not steps and walker.rejection is None and not walker.walking
 
 
@@ -322,18 +370,97 @@ def test_a_command_that_fails_its_check_is_kept_as_the_rejection_and_changes_not
     assert walker.checking is None and not walker.walking
 
 
-def test_a_command_given_in_the_last_tick_of_a_step_is_still_taken(hubo):
-    walker = OnlineWalker(hubo, rate=1000, joints=True)
-    walker.command(StepCommand(0.8, 0.1), wait=True)
-    while walker.queued is not None or walker._current is None:  # the first step under way
+def _step_under_way(walker):
+    """Tick until the walker's first step is under way; the index of the tick its step ends at."""
+    while walker.queued is not None or walker._current is None:
         walker.tick()
     current = walker._current
-    while walker._index < current.first_index + len(current.rows) - 1:
+    return current.first_index + len(current.rows)
+
+
+@pytest.mark.parametrize("rate", [100.0, 1000.0])
+@pytest.mark.parametrize("joints", [False, True])
+def test_a_command_given_in_the_last_tick_of_a_step_follows_the_closing_stop(hubo, rate, joints, monkeypatch):
+    """The rule for a check not complete when its step would begin (module docstring): the walker takes the
+    closing stop of the step under way, no tick runs the rest of the check (each tick runs its budget's worth
+    of parts), and the command walks after the stop, exactly as the same command given right after the
+    stop's first tick: sample for sample, joints included."""
+    from zmpwalk.online import work_budget
+
+    counting_clock(monkeypatch, work_budget(rate) / 3)  # three parts a tick
+    late, reference = (OnlineWalker(hubo, rate=rate, joints=joints) for _ in range(2))
+    for walker in (late, reference):
+        walker.command(StepCommand(0.8, 0.1), wait=True)
+    end = _step_under_way(late)
+    assert _step_under_way(reference) == end
+    while late._index < end - 1:
+        late.tick()
+        reference.tick()
+    command = StepCommand(0.8, 0.15)
+    late.command(command)  # in the last tick of the step
+    row = _sample_row if joints else _rows
+    rows = [row(late.tick())]
+    assert late._current is None or not late._current.command.stop  # the step still under way
+    rows_reference = [row(reference.tick())]
+    parts = 0
+    for tick in range(round(8.0 * rate)):
+        job = late._job
+        rows.append(row(late.tick()))
+        rows_reference.append(row(reference.tick()))
+        if tick == 0:
+            assert late._current.command.stop and late.checking == command  # the closing stop; still checking
+            reference.command(command)  # right after the stop's first tick
+        if job is not None and late._job is job:
+            assert job.parts - parts <= 3  # no tick finishes a check at once
+        parts = late._job.parts if late._job is not None else 0
+    np.testing.assert_array_equal(np.array(rows), np.array(rows_reference))
+    assert late.rejection is None and not late.walking and late.checking is None
+    assert np.abs(rows[-1][:3] - rows[0][:3]).max() > 0.1  # it walked the 0.15 m step after the stop
+
+
+def test_a_command_checked_late_after_a_queued_one_follows_the_queued_step(hubo, monkeypatch):
+    """A queued command walks when its step comes even while a later command is still under check (the
+    walk takes what was checked); the later command follows it, a step later."""
+    counting_clock(monkeypatch, 20e-6)
+    walker = OnlineWalker(hubo, rate=1000, joints=True)
+    walker.command(StepCommand(0.8, 0.1), wait=True)
+    end = _step_under_way(walker)
+    walker.command(StepCommand(0.7, 0.05), wait=True)  # queued
+    while walker._index < end - 3:
         walker.tick()
-    walker.command(StepCommand(0.8, 0.15))  # one tick before its step begins: checked in that tick
-    walker.tick()
-    walker.tick()
-    assert walker._current.command == StepCommand(0.8, 0.15) and walker.rejection is None
+    walker.command(StepCommand(0.8, 0.2))  # too late for this step: checked while the queued one walks
+    for _ in range(4):
+        walker.tick()
+    assert walker._current.command == StepCommand(0.7, 0.05) and walker.checking == StepCommand(0.8, 0.2)
+    while walker.checking is not None:
+        walker.tick()
+    assert walker.queued == StepCommand(0.8, 0.2) and walker.rejection is None
+    while walker.queued is not None:
+        walker.tick()
+    assert walker._current.command == StepCommand(0.8, 0.2)
+
+
+@pytest.mark.parametrize("rate", [100.0, 250.0])
+def test_a_walk_from_standstill_not_checked_by_its_start_starts_later(hubo, rate, monkeypatch):
+    """On a machine too slow for the budget (every part spends it: one part a tick), the walk from standstill
+    whose check is not done by its start is checked again with time for one part a tick, and walks."""
+    from zmpwalk.online import work_budget
+
+    counting_clock(monkeypatch, 2 * work_budget(rate))
+    walker = OnlineWalker(hubo, rate=rate, joints=True)
+    walker.command(StepCommand(0.8, 0.1))
+    first = walker._job
+    started = None
+    for tick in range(round(30 * rate)):
+        job = walker._job
+        before = job.parts if job is not None else 0
+        walker.tick()
+        if job is not None and walker._job is job:
+            assert job.parts - before == 1  # one part a tick
+        if started is None and walker._current is not None:
+            started = tick
+    assert walker._job is None and walker.rejection is None and not walker.walking
+    assert started is not None and started > first.start  # later than START_DELAY after the command
 
 
 def test_stop_while_walking_takes_the_stop_planned_with_the_step(hubo):
@@ -486,3 +613,89 @@ def test_a_walk_after_a_stop_is_the_same_whenever_in_the_settle_it_is_commanded(
     np.testing.assert_allclose(walk, reference, atol=1e-9, rtol=0)
     if len(standing):  # standing still until it starts, where the walk starts
         np.testing.assert_allclose(standing, np.broadcast_to(reference[0], standing.shape), atol=1e-9, rtol=0)
+
+
+class _Watch:
+    """What became of each command given to a walker: queued, walked (its step under way), or replaced by a later
+    command or stop() before it walked (the walker's rule: a later command replaces one not yet walking)."""
+
+    def __init__(self, walker):
+        self.walker = walker
+        self.given: list[StepCommand] = []
+        self.queued: dict[int, int] = {}  # id of a command -> the index of the last action when it was queued
+        self.walked: set[int] = set()
+        self.rejected: set[int] = set()
+        self.actions = 0
+
+    def give(self, command, stop=False):
+        self.actions += 1
+        if stop:
+            self.walker.stop()
+        else:
+            self.given.append(command)
+            self.walker.command(command)
+
+    def tick(self):
+        walker = self.walker
+        job, pending = walker._job, walker._pending
+        sample = walker.tick()  # never raises
+        if walker.queued is not None:
+            self.queued.setdefault(id(walker.queued), self.actions)
+        if walker._current is not None:
+            self.walked.add(id(walker._current.command))
+        if job is not None and walker._job is None and walker._pending is pending:  # the check refused it
+            self.rejected.add(id(job.command))
+            assert isinstance(walker._rejection.error, ZmpwalkError)
+        return job, sample
+
+    def replaced(self, command):
+        """Whether a later command or stop() came after ``command`` was queued (or given)."""
+        return self.queued.get(id(command), self.given.index(command) + 1) < self.actions
+
+
+@pytest.mark.parametrize("joints", [False, True])
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(rate=st.sampled_from([100.0, 250.0, 1000.0]), part=st.sampled_from([0.05, 0.3, 1.0, 3.0]),
+       actions=st.lists(st.tuples(st.one_of(st.floats(0.0, 1.0), st.floats(0.95, 1.0)), command_strategy),
+                        min_size=1, max_size=8))
+def test_a_check_not_complete_when_its_step_begins_never_finishes_in_a_tick(hubo, joints, rate, part, actions,
+                                                                             monkeypatch):
+    """Commands at random ticks of random steps (late ones too: in the last ticks of a step), a part costing
+    5 % to 3 times the tick's budget: every tick runs at most its budget's worth of parts (at least one), a
+    check not complete when its step would begin goes on after it while the walk takes what was checked (the
+    queued command or the closing stop), and every command queued walks unless a later one replaced it."""
+    from dataclasses import replace
+
+    from zmpwalk.online import work_budget
+
+    counting_clock(monkeypatch, part * work_budget(rate))
+    most = int(1.0 / part) + 1  # parts a tick may run: up to the budget's end, at least one
+    walker = OnlineWalker(hubo, rate=rate, joints=joints)
+    watch = _Watch(walker)
+    for fraction, action in [*actions, (None, None)]:
+        current = walker._current  # the action at ``fraction`` of what is left of the step under way
+        left = current.first_index + len(current.rows) - walker._index if current is not None else 0.9 * rate
+        ticks = round(3.0 * rate) if fraction is None else int(fraction * left)
+        for _ in range(ticks):
+            queued, current, job = walker._pending, walker._current, walker._job
+            parts = job.parts if job is not None else 0
+            watch.tick()
+            if job is not None and walker._job is job:  # still under check: at most its budget's worth of parts
+                assert 1 <= job.parts - parts <= most
+            if job is not None and walker._index > job.start and walker._job is not None \
+                    and walker._job.command is job.command:  # its step was to begin: it waits
+                event("a check not complete when its step was to begin")
+                assert walker._current is queued or walker._current is (current.closing if current else None) \
+                    or walker._current is None
+        if action is None:
+            break
+        watch.give(replace(action) if action != "stop" else None, stop=action == "stop")
+    for _ in range(round(40 * rate)):  # until every check ended and the walk stopped
+        watch.tick()
+        if walker.checking is None and not walker.walking:
+            break
+    assert walker.checking is None and not walker.walking
+    for command in watch.given:
+        if watch.replaced(command) or id(command) in watch.rejected:
+            continue
+        assert id(command) in watch.walked, command  # queued (or the last given) and not replaced: it walked

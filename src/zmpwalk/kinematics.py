@@ -522,23 +522,9 @@ def joint_trajectory_in_parts(
                                                                               time, axis=0)
         position_pelvis_in_world = base
     if robot.legs is None:  # closed form, written row by row into (12, n) and returned transposed
-        rows_angles, rows_rates = np.empty((12, n)), np.empty((12, n))
-        for index, (side, (position, yaw, velocity, yaw_rate)) in enumerate(zip((1, -1), feet, strict=True)):
-            yield
-            rx, ry = position[:, 0] - position_pelvis_in_world[:, 0], position[:, 1] - position_pelvis_in_world[:, 1]
-            vx = velocity[:, 0] - velocity_pelvis_in_world[:, 0] + yaw_rate_pelvis * ry  # in the rotating frame
-            vy = velocity[:, 1] - velocity_pelvis_in_world[:, 1] - yaw_rate_pelvis * rx
-            rows = slice(6 * index, 6 * index + 6)
-            yield
-            ankle = (c * rx + s * ry, c * ry - s * rx, position[:, 2] - position_pelvis_in_world[:, 2],
-                     yaw - yaw_pelvis_in_world)
-            ankle_rates = (c * vx + s * vy, c * vy - s * vx, velocity[:, 2] - velocity_pelvis_in_world[:, 2],
-                           yaw_rate - yaw_rate_pelvis)
-            yield
-            excess = yield from _leg_ik_yaw_rates_in_parts(Leg.of(robot, side), *ankle, ankle_rates, knee_forward,
-                                                           rows_angles[rows], rows_rates[rows])
-            _check_reach(excess, time, "left" if side > 0 else "right", "inverse kinematics")
-        angles, velocities = rows_angles.T, rows_rates.T
+        angles, velocities = yield from _closed_form_legs_in_parts(
+            time, position_pelvis_in_world, (c, s), yaw_pelvis_in_world, velocity_pelvis_in_world, yaw_rate_pelvis,
+            feet, robot, knee_forward)
     else:  # an imported robot's legs: angles from _base_under_com, rates from J q' = twist
         for index, (side, (position, _, velocity, yaw_rate)) in enumerate(zip((1, -1), feet, strict=True)):
             rel = position - position_pelvis_in_world
@@ -562,6 +548,35 @@ def joint_trajectory_in_parts(
 
 
 joint_trajectory = whole(joint_trajectory_in_parts, "joint_trajectory")  # the same, run whole
+
+
+def _closed_form_legs_in_parts(
+    time: Array, position_pelvis_in_world: Array, heading: tuple[Array, Array], yaw_pelvis_in_world: Array,
+    velocity_pelvis_in_world: Array, yaw_rate_pelvis: Array,
+    feet: tuple[tuple[Array, Array, Array, Array], tuple[Array, Array, Array, Array]], robot: RobotModel,
+    knee_forward: bool,
+) -> Parts[tuple[Array, Array]]:
+    """The closed-form legs of :func:`joint_trajectory_in_parts` (``heading``: cos and sin of the pelvis yaw),
+    each leg in parts: its ankle in the pelvis frame, the angles, the rates. Angles and rates, (n, 12) each."""
+    c, s = heading
+    n = len(time)
+    rows_angles, rows_rates = np.empty((12, n)), np.empty((12, n))
+    for index, (side, (position, yaw, velocity, yaw_rate)) in enumerate(zip((1, -1), feet, strict=True)):
+        yield
+        rx, ry = position[:, 0] - position_pelvis_in_world[:, 0], position[:, 1] - position_pelvis_in_world[:, 1]
+        vx = velocity[:, 0] - velocity_pelvis_in_world[:, 0] + yaw_rate_pelvis * ry  # in the rotating frame
+        vy = velocity[:, 1] - velocity_pelvis_in_world[:, 1] - yaw_rate_pelvis * rx
+        rows = slice(6 * index, 6 * index + 6)
+        yield
+        ankle = (c * rx + s * ry, c * ry - s * rx, position[:, 2] - position_pelvis_in_world[:, 2],
+                 yaw - yaw_pelvis_in_world)
+        ankle_rates = (c * vx + s * vy, c * vy - s * vx, velocity[:, 2] - velocity_pelvis_in_world[:, 2],
+                       yaw_rate - yaw_rate_pelvis)
+        yield
+        excess = yield from _leg_ik_yaw_rates_in_parts(Leg.of(robot, side), *ankle, ankle_rates, knee_forward,
+                                                       rows_angles[rows], rows_rates[rows])
+        _check_reach(excess, time, "left" if side > 0 else "right", "inverse kinematics")
+    return rows_angles.T, rows_rates.T
 
 
 def _check_reach(excess: Array, time: Array, label: str, detail: str) -> None:

@@ -23,12 +23,22 @@ Behaviour:
   of tens of microseconds (:mod:`zmpwalk.slices`): the footsteps, each stage (with the hyperbolic generator
   each stage's pendulum), then blocks of :data:`SLICE_ROWS` samples, each in parts (the swing ankle, each
   pelvis axis, the sway, each foot; each leg's angles and rates in parts; the joint ranges). A tick runs
-  parts for :data:`WORK_FRACTION` of the control period (20 us at 1 kHz), so its cost is bounded by that
-  budget plus one part. When the check completes the command is :attr:`~OnlineWalker.queued`; when it
-  fails the reason is kept in :attr:`~OnlineWalker.rejection` and the walk goes on as if the command had
-  not been given (no tick ever raises). A walk commanded from standstill starts :data:`START_DELAY`
-  later, by which time it is checked. Should a step end before the check of the next command is done (a
-  command given in the last ticks of a step), the rest of the check runs in that tick.
+  parts while the next one, taken as long as the mean of the tick's so far, ends within its budget
+  (:func:`work_budget`: :data:`WORK_BUDGET`, 50 us, or :data:`WORK_FRACTION` of the control period where
+  that is longer, 100 us at 100 Hz), at least one, and none begins after the budget is spent: a tick's work
+  is bounded by its budget and one part, whenever commands come. So a check ends as early as the budget
+  allows (a few hundred ticks at 1 kHz), and most ticks have nothing to do. When the check completes the
+  command is :attr:`~OnlineWalker.queued`; when it fails the reason is kept in
+  :attr:`~OnlineWalker.rejection` and the walk goes on as if the command had not been given (no tick ever
+  raises).
+* **A check that is not complete when its step would begin never finishes inside a tick.** The walk takes
+  what was checked: the command queued before it, if any, else the closing stop of the step under way
+  (checked with that step, as when no command comes). The command is checked again, in parts, from where
+  that leaves the walk: after the queued step, or, after the stop, as a walk from standstill commanded
+  right after the stop's first tick (the rule below: it starts when the settle has ended and
+  :data:`START_DELAY` after the stop began). A walk from standstill whose check is not complete when it was
+  to start (a machine too slow for the budget) starts later: checked again, with time for one part a tick.
+  A command given in the last ticks of a step is thus walked a step later; none is dropped for coming late.
 * ``command(step, wait=True)`` runs the same check whole in the call (milliseconds: scripts, tests,
   loops without a hard deadline): a rejected command raises and leaves the walker exactly as it was (the
   queued command, if any, stays), and a walk from standstill starts at once.
@@ -54,6 +64,7 @@ from __future__ import annotations
 
 import math
 import time
+from array import array
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -74,15 +85,13 @@ from zmpwalk.kinematics import (
     joint_trajectory_in_parts,
     leg_ik_scalar,
 )
+from zmpwalk.patterns.evaluation import Samples, StageTable, evaluate_in_parts
 from zmpwalk.patterns.polynomial import (
     STRIDE_CAUSES,
     Boundary,
-    Samples,
     Stage,
-    StageTable,
     check_pelvis,
     closing_command,
-    evaluate_in_parts,
     first_sample_at,
     hyperbolic_stages,
     infeasible_command,
@@ -105,7 +114,7 @@ _ZMP, _SUPPORT = slice(12, 14), 14
 _JOINTS, _JOINT_RATES = slice(15, 27), slice(27, 39)
 _WIDTH = 15
 _WIDTH_WITH_JOINTS = 39
-SLICE_ROWS = 200  # samples per block of a command's check (each block's pattern and legs in parts of tens of us)
+SLICE_ROWS = 400  # samples per block of a command's check (each block's pattern and legs in parts of tens of us)
 START_DELAY = 0.6  # [s] a walk commanded from standstill starts this much later (its check is done by then)
 
 
@@ -180,17 +189,21 @@ class _Plan:
     first_index: int
     closing: _Plan | None = None  # the automatic stop after this plan, planned and checked with it
     standing: Array | None = None  # the row of standing still after it, where it ends at rest
-    scalars: list[list[float]] = field(default_factory=list)  # per row: support code, 3 yaws
+    scalars: Scalars = field(default_factory=lambda: _scalars(np.empty((0, _WIDTH))))  # per row (:func:`_scalars`)
 
 
 _SUPPORT_OF_CODE = {float(code): name for code, name in enumerate(SUPPORT_NAMES)}
+Scalars = tuple["array[float]", "array[float]", "array[float]", "array[float]"]
+_SCALAR_COLUMNS = (_SUPPORT, _PELVIS_YAW, _LEFT_YAW, _RIGHT_YAW)
 
 
-def _scalars(rows: Array) -> list[list[float]]:
-    """Each row's support code and pelvis, left and right yaws as Python floats (a tick reads them as they are;
-    :data:`_SUPPORT_OF_CODE` names the support)."""
-    result: list[list[float]] = rows[:, [_SUPPORT, _PELVIS_YAW, _LEFT_YAW, _RIGHT_YAW]].tolist()
-    return result
+def _scalars(rows: Array) -> Scalars:
+    """The rows' support codes and pelvis, left and right yaws, each column an ``array("d")``: a tick reads Python
+    floats from it without numpy's scalar conversion (:data:`_SUPPORT_OF_CODE` names the support), and a plan
+    dropped in a tick frees four buffers (lists of Python floats, one per value, took 0.3 ms to free)."""
+    support, pelvis, left, right = (array("d", np.ascontiguousarray(rows[:, column]).tobytes())
+                                    for column in _SCALAR_COLUMNS)
+    return support, pelvis, left, right
 
 
 @dataclass
@@ -205,13 +218,51 @@ class _Job:
     origin: tuple[Stance, Boundary]  # the walker's end of plan when given: the job is stale once it changes
     expected: int  # parts its check is expected to take
     given: int  # index of the tick at which it was commanded
+    buffers: list[Array]  # the rows its planning took (:class:`_RowBuffers`), given back if it does not end a plan
     parts: int = 0  # parts run so far
 
 
+POOL_BUFFERS = 8  # row buffers kept for the next checks (a walker holds at most six plans' at a time)
+
+
+class _RowBuffers:
+    """Row buffers reused from plan to plan. A plan's rows freed in a tick (at every step change) made the C
+    allocator give the top of its heap back to the system: 0.1-0.3 ms, measured; given back here instead, a
+    buffer is kept for a later check (each at most once: :meth:`OnlineWalker._release`)."""
+
+    def __init__(self, width: int) -> None:
+        self.width = width
+        self.free: list[Array] = []
+
+    def take(self, count: int) -> Array:
+        """``count`` rows: a view of the smallest kept buffer that holds them, else of a new one (a quarter
+        larger, for a longer step later)."""
+        best = -1
+        for number, buffer in enumerate(self.free):
+            if len(buffer) >= count and (best < 0 or len(buffer) < len(self.free[best])):
+                best = number
+        buffer = self.free.pop(best) if best >= 0 else np.empty((count + count // 4 + 1, self.width))
+        return buffer[:count]
+
+    def give(self, rows: Array) -> None:
+        """Keep the buffer of ``rows`` (a view :meth:`take` gave, or an array of its own) for a later check."""
+        buffer: Array = rows if rows.base is None else rows.base
+        if len(self.free) < POOL_BUFFERS and buffer.ndim == 2 and buffer.shape[1] == self.width:
+            self.free.append(buffer)
+
+
 _UNFINISHED = object()
-WORK_FRACTION = 0.02  # [-] a tick runs parts of a command's check for this fraction of the control period
-PARTS_PER_BLOCK = 40  # parts of a block of SLICE_ROWS samples (a first guess of a check's length, before one has run)
+_clock = time.perf_counter  # [s] the clock of the budget (a test replaces it with one that counts parts)
+WORK_BUDGET = 50e-6  # [s] a tick runs parts of a check while the next one is expected to end within this
+WORK_FRACTION = 0.01  # [-] ... or within this fraction of the control period, where that is longer (below 200 Hz)
+PARTS_PER_BLOCK = 45  # parts of a block of SLICE_ROWS samples (a first guess of a check's length, before one has run)
 FINISH_EARLY = 0.95  # [-] a check is paced to end within this fraction of the ticks before its step begins
+
+
+def work_budget(rate: float) -> float:
+    """The time [s] a tick at ``rate`` [Hz] spends on a check's parts: :data:`WORK_BUDGET`, or
+    :data:`WORK_FRACTION` of the control period where that is longer."""
+    return max(WORK_BUDGET, WORK_FRACTION / rate)
 
 
 @dataclass
@@ -235,17 +286,18 @@ def _step(planning: Parts[_Plan | None]) -> object:
 
 
 def _slices(job: _Job, budget: float, quota: int) -> object:
-    """Parts of a job's planning: at least ``quota``, and more while the next one, as long as the mean of
-    this tick's, ends within ``budget`` [s]; the planning's result when done, else :data:`_UNFINISHED`."""
-    begin = time.perf_counter()
+    """Parts of a job's planning: one, then more while the next one, taken as long as the mean of this tick's,
+    ends within ``budget`` [s], or (up to ``quota``) while ``budget`` is not spent: no part begins after it, so a
+    tick's work is bounded by ``budget`` and one part. The planning's result when done, else :data:`_UNFINISHED`."""
+    begin = _clock()
     count = 0
     while True:
         result = _step(job.planning)
         count += 1
         if result is not _UNFINISHED:
             break
-        elapsed = time.perf_counter() - begin
-        if count >= quota and elapsed * (count + 1) > budget * count:
+        elapsed = _clock() - begin
+        if elapsed >= budget or (count >= quota and elapsed * (count + 1) > budget * count):
             break
     job.parts += count
     return result
@@ -289,6 +341,7 @@ class OnlineWalker:
         self._job: _Job | None = None
         self._rejection: _Rejection | None = None
         self._check_parts = 0  # parts the last completed check took
+        self._buffers = _RowBuffers(self._width)
         self._set_standing(self._standing_row(self._stance))
 
     @property
@@ -324,9 +377,12 @@ class OnlineWalker:
         """Give ``command`` for after the step under way, replacing one given before it started.
 
         Only the command's type is checked here (microseconds); its whole check runs in parts, a few per
-        :meth:`tick` (module docstring). When it completes the command is :attr:`queued`; when it fails
-        the reason is in :attr:`rejection` and the walker goes on as if the command had not been given. A
-        later command replaces one still being checked.
+        :meth:`tick` within the tick's budget (module docstring). When it completes the command is
+        :attr:`queued`; when it fails the reason is in :attr:`rejection` and the walker goes on as if the
+        command had not been given. A later command replaces one still being checked. A check not complete
+        when its step would begin is never finished inside a tick: the walk takes the command queued before
+        it, or else its closing stop, and the command follows that, a step later (after a stop, as a walk
+        from standstill commanded right after the stop's first tick).
 
         Args:
             command: The step.
@@ -344,30 +400,37 @@ class OnlineWalker:
             raise InvalidParameterError("command", command, "a StepCommand")
         self._submit(command, self._index, wait)
 
-    def _submit(self, command: StepCommand, given: int, wait: bool) -> None:
-        """:meth:`command` given at tick ``given`` (a check restarted when the walk it follows changed keeps the
-        tick of the command)."""
+    def _submit(self, command: StepCommand, given: int, wait: bool, retry: int = 0) -> None:
+        """:meth:`command` given at tick ``given``; ``retry``: the parts a check of it from standstill ran without
+        ending before its walk was to start (its walk then starts later: :meth:`_work`)."""
         stance, boundary = self._stance, self._boundary
         origin = (stance, boundary)
+        # parts to expect: as many as the last check took, at least a guess from the samples (the step, its
+        # stop and the settle, and from standstill the start stage; blocks of SLICE_ROWS), more than a late one ran
+        blocks = math.ceil((3.0 if self._current is not None else 4.0) * command.duration * self.rate / SLICE_ROWS)
+        expected = max(self._check_parts, PARTS_PER_BLOCK * blocks, retry + retry // 8 + 1)
         if boundary.at_rest:
-            boundary = self._rest_start(boundary, given + (0 if wait else start_delay_ticks(self.rate)))
+            delay = 0 if wait else start_delay_ticks(self.rate)
+            if retry:  # time enough for one part a tick
+                delay = max(delay, math.ceil(expected / FINISH_EARLY) + 1)
+            boundary = self._rest_start(boundary, given + delay)
         if wait:
             try:
                 plan = run_to_end(self._checked(command, stance, boundary, self.rate))
             except ZmpwalkError as error:
                 raise self._rejected(command, stance, boundary, error) from None
-            self._job = None  # a command given now supersedes one still being checked
+            self._drop_job()  # a command given now supersedes one still being checked
             self._rejection = None
-            self._pending = plan  # None: a stop while standing
+            dropped, self._pending = self._pending, plan  # None: a stop while standing
+            self._release(dropped)
             return
         self._rejection = None
         start = first_sample_at(boundary.time, self.rate)
-        # parts to expect: as many as the last check took, at least a guess from the samples (the step, its
-        # stop and the settle, and from standstill the start stage; blocks of SLICE_ROWS)
-        blocks = math.ceil((3.0 if self._current is not None else 4.0) * command.duration * self.rate / SLICE_ROWS)
-        expected = max(self._check_parts, PARTS_PER_BLOCK * blocks)
+        self._drop_job()
+        buffers: list[Array] = []
         self._job = _Job(command, stance, boundary, start,
-                         self._checked(command, stance, boundary, self.rate, sliced=True), origin, expected, given)
+                         self._checked(command, stance, boundary, self.rate, buffers), origin, expected, given,
+                         buffers)
 
     def _rest_start(self, rest: Boundary, earliest: int) -> Boundary:
         """Where a walk from standstill starts: from the standing state (the pelvis at rest above the middle of
@@ -404,48 +467,73 @@ class OnlineWalker:
             rejection.named = True
         return rejection.error
 
-    def _work(self, finish: bool) -> None:
-        """One slice of the given command's check (all of it when ``finish``)."""
+    def _work(self) -> None:
+        """A few parts of the given command's check (:data:`WORK_BUDGET`, at least its share of the parts left,
+        never its rest at once: the rule of the module docstring for a check not complete when its step begins)."""
         job = self._job
         if job is None:
             return
         if job.origin[0] is not self._stance or job.origin[1] is not self._boundary:
-            # the step it was to follow has changed (a queued command started meanwhile): check it again from
-            # the new end of the walk
-            self._submit(job.command, job.given, wait=False)
+            # the step it was to follow has begun or changed (the walk took what was checked: the queued command,
+            # or the closing stop): check it again from the new end of the walk, after a stop as given now
+            self._submit(job.command, self._index if self._boundary.at_rest else job.given, wait=False)
             job = self._job
-            if job is None:  # pragma: no cover - command() always sets a job
-                return
+        elif job.start < self._index:  # a walk from standstill not checked by its start (this tick's): later
+            self._submit(job.command, self._index, wait=False, retry=job.parts)
+            job = self._job
+        if job is None:  # pragma: no cover - _submit always sets a job
+            return
+        ticks_left = max(int(FINISH_EARLY * (job.start - self._index)), 1)
+        expected = max(job.expected, job.parts + job.parts // 8 + 1)  # a longer check than expected
+        quota = -(-(expected - job.parts) // ticks_left)  # its share of the parts left
         plan: object
         try:
-            if finish:  # every part left, counted
-                plan = _slices(job, math.inf, 0)
-            else:  # paced so that the check ends before its step begins: at least its share of the parts left
-                ticks_left = max(int(FINISH_EARLY * (job.start - self._index)), 1)
-                expected = max(job.expected, job.parts + job.parts // 8 + 1)  # a longer check than expected
-                quota = -(-(expected - job.parts) // ticks_left)
-                plan = _slices(job, WORK_FRACTION / self.rate, quota)
+            plan = _slices(job, work_budget(self.rate), quota)
         except ZmpwalkError as error:
-            self._job = None
+            self._drop_job()
             self._rejection = _Rejection(job.command, error, job.stance, job.boundary)
             return
         if plan is _UNFINISHED:
             return
         self._check_parts = job.parts
-        self._job = None
+        self._job = None  # its buffers are the plan's rows now
         self._rejection = None
-        self._pending = plan if isinstance(plan, _Plan) else None
+        dropped, self._pending = self._pending, plan if isinstance(plan, _Plan) else None
+        self._release(dropped)
+
+    def _drop_job(self) -> None:
+        """Drop the check under way, if any, and keep the rows its planning took."""
+        if self._job is not None:
+            for rows in self._job.buffers:
+                self._buffers.give(rows)
+            self._job = None
+
+    def _release(self, *plans: _Plan | None) -> None:
+        """Keep the rows of ``plans`` and their stops for later checks, where the walker holds them no more (as
+        the step under way, the queued command, or their stops); each once, and a released plan keeps no rows."""
+        held = [plan for plan in (self._current, self._pending) if plan is not None]
+        held += [plan.closing for plan in held if plan.closing is not None]
+        for plan in plans:
+            for part in (plan, plan.closing) if plan is not None else ():
+                if part is not None and len(part.rows) and not any(part is other for other in held):
+                    self._buffers.give(part.rows)
+                    part.rows = part.rows[:0]
 
     def _checked(self, command: StepCommand, stance: Stance, boundary: Boundary, rate: float,
-                 sliced: bool = False) -> Parts[_Plan | None]:
+                 buffers: list[Array] | None = None) -> Parts[_Plan | None]:
         """Plan a command and the stop it leads to when no other follows, sampled (and the legs solved) at
         ``rate``, yielding between slices: planned and checked together, so that no accepted command can make
-        a later tick fail, and no tick plans. Returns None for a stop while standing."""
-        plan = yield from self._plan(command, stance, boundary, rate, sliced)
+        a later tick fail, and no tick plans. Returns None for a stop while standing.
+
+        Args:
+            buffers: For :meth:`command`'s check, in slices: the rows are taken from the walker's buffers
+                (:class:`_RowBuffers`) and listed here. None: in one pass, in rows of their own."""
+        plan = yield from self._plan(command, stance, boundary, rate, buffers)
         if plan is not None and not command.stop:
+            yield
             try:
                 plan.closing = yield from self._plan(closing_command(command), plan.stance, plan.boundary, rate,
-                                                     sliced)
+                                                     buffers)
             except ZmpwalkError as error:
                 raise error.in_context("the closing step this command would end with (when no other follows)") \
                     from None
@@ -477,7 +565,7 @@ class OnlineWalker:
         return error
 
     def _plan(self, command: StepCommand, stance: Stance, boundary: Boundary, rate: float,
-              sliced: bool) -> Parts[_Plan | None]:
+              buffers: list[Array] | None) -> Parts[_Plan | None]:
         """Plan, sample (and solve the legs of) one command from a stance at ``rate`` [Hz], yielding after the
         plan and between the parts of every :data:`SLICE_ROWS` samples; None for a stop while standing.
 
@@ -496,21 +584,27 @@ class OnlineWalker:
         # the samples of these stages, split from the neighbours' exactly as the batch path splits them
         first_index = first_sample_at(stages[0].start, rate)
         stop_index = first_sample_at(next_boundary.time, rate)
-        rows = np.empty((max(stop_index - first_index, 0), self._width))
-        table = StageTable(stages)
+        count = max(stop_index - first_index, 0)
+        if buffers is None:
+            rows = np.empty((count, self._width))
+        else:
+            rows = self._buffers.take(count)
+            buffers.append(rows)
+        table = yield from StageTable.in_parts(stages)
         yield
         # in slices for command(); an imported robot's legs in one pass (its base velocities are differences
         # along the step)
-        size = SLICE_ROWS if sliced and self.robot.legs is None else max(len(rows), 1)
-        scalars: list[list[float]] = []
+        size = SLICE_ROWS if buffers is not None and self.robot.legs is None else max(len(rows), 1)
+        scalars = _scalars(rows[:0])
         for begin in range(0, len(rows), size):
             block = rows[begin:min(begin + size, len(rows))]
             times = np.arange(first_index + begin, first_index + begin + len(block)) / rate
             samples = yield from evaluate_in_parts(table, times, self.robot)
             yield
-            self._fill_pattern(block, samples)
+            yield from self._fill_pattern(block, samples)
             yield
-            scalars += _scalars(block)
+            for column, values in zip(scalars, _scalars(block), strict=True):
+                column.extend(values)
             yield
             if self.joints:
                 yield from self._fill_joints(block, samples)
@@ -532,14 +626,15 @@ class OnlineWalker:
         planned and checked with that step, so asking for it costs nothing. A command queued or being
         checked is dropped.
         """
-        self._job = None
-        current = self._current
+        self._drop_job()
+        current, dropped = self._current, self._pending
         if current is not None and not current.command.stop:
             self._pending = current.closing
         elif current is None and self._pending is not None and self._boundary.at_rest:
             self._pending = None  # a walk queued from standstill that has not started
         elif current is not None:
             self._pending = None  # the step under way is a stop already
+        self._release(dropped)
 
     def tick(self) -> WalkingSample:
         """The sample at :attr:`time`, then advance by one control period."""
@@ -553,9 +648,11 @@ class OnlineWalker:
             row, (code, pelvis_yaw, left_yaw, right_yaw) = self._standing.copy(), self._standing_scalars
         else:
             offset = index - current.first_index
-            row, (code, pelvis_yaw, left_yaw, right_yaw) = current.rows[offset].copy(), current.scalars[offset]
+            row, (codes, pelvis_yaws, left_yaws, right_yaws) = current.rows[offset].copy(), current.scalars
+            code, pelvis_yaw, left_yaw, right_yaw = codes[offset], pelvis_yaws[offset], left_yaws[offset], \
+                right_yaws[offset]
         if self._job is not None:
-            self._work(finish=False)
+            self._work()
         return WalkingSample(
             time=index / self.rate,
             support=_SUPPORT_OF_CODE[code],
@@ -571,14 +668,22 @@ class OnlineWalker:
         )
 
     def _advance(self, index: int) -> _Plan | None:
-        """Make the queued (or an automatic stop) command current; None when standing."""
-        if self._job is not None and index >= self._job.start:
-            self._work(finish=True)  # its step begins now: the rest of its check cannot wait
+        """Make the queued command (or the automatic stop) current; None when standing. A command still under
+        check waits (module docstring): no tick runs the rest of a check at once."""
+        dropped: list[_Plan | None] = []
+        try:
+            return self._next_plan(index, dropped)
+        finally:
+            self._release(*dropped)
+
+    def _next_plan(self, index: int, dropped: list[_Plan | None]) -> _Plan | None:
+        """:meth:`_advance`, listing the plans it drops in ``dropped``."""
         while True:
             if self._pending is None and not self._boundary.at_rest and self._current is not None:
                 # the automatic stop, planned and checked when its step was commanded
                 self._pending = self._current.closing
             plan = self._pending
+            dropped.append(self._current)
             if plan is None:
                 self._current = None
                 return None
@@ -593,11 +698,12 @@ class OnlineWalker:
             if index < plan.first_index + len(plan.rows):
                 return plan
 
-    def _fill_pattern(self, rows: Array, samples: Samples) -> None:
-        """Fill ``rows`` with the pattern's samples (the legs: :meth:`_fill_joints`)."""
+    def _fill_pattern(self, rows: Array, samples: Samples) -> Parts[None]:
+        """Fill ``rows`` with the pattern's samples (the legs: :meth:`_fill_joints`), in two parts."""
         rows[:, 0:2] = samples.pelvis_xy
         rows[:, 2] = self.robot.pelvis_height
         rows[:, _PELVIS_YAW] = samples.pelvis_yaw
+        yield
         rows[:, _LEFT] = samples.left_position
         rows[:, _LEFT_YAW] = samples.left_yaw
         rows[:, _RIGHT] = samples.right_position
@@ -619,7 +725,7 @@ class OnlineWalker:
 
     def _set_standing(self, row: Array) -> None:
         self._standing = row
-        self._standing_scalars = _scalars(row[None, :])[0]
+        self._standing_scalars = tuple(column[0] for column in _scalars(row[None, :]))  # Python floats
 
     def _standing_row(self, stance: Stance) -> Array:
         middle = np.array([(stance.left.x + stance.right.x) / 2, (stance.left.y + stance.right.y) / 2])

@@ -1,0 +1,192 @@
+"""The control loop's ticks under commands given at random times: per-tick CPU time of ``OnlineWalker``.
+
+Each configuration (1 kHz with joints, 1 kHz without, 100 Hz with joints) runs ``--ticks`` ticks of one
+:class:`~zmpwalk.OnlineWalker` (HUBO) with ``gc.collect(); gc.freeze()`` after setup, as the README's loop. In
+every step a command is given at a random tick, as an operator gives it (a seeded rng): mostly ordinary steps,
+and hostile ones among them: beyond the legs' reach, too fast for the foot speed limit, ``stop()`` and a zero
+step time (whose ``InvalidParameterError`` is caught, as a loop would). While the walker stands the next walk is
+commanded after a random wait. Timed, with ``time.thread_time_ns()`` (this thread's CPU time, so that the other
+processes on a shared machine do not count), is each loop iteration: the ``command()`` given in it, if any, and
+``tick()``. Counted: the commands given, those that walked (queued, then begun), rejected, ``stop()``, the zero
+step times caught, and the checks restarted in a tick because the walk took another step first (the queued
+command, or the closing stop) while they ran. Reading ``walker.rejection`` (which searches the largest stride
+that fits, tens of milliseconds) is outside the timing, as the README advises.
+
+A ``floor`` line times the same loop around a copy of a 39-float row and one object: what this machine
+gives any Python loop. ``--before DIR`` runs every configuration also against another source tree
+(``DIR/src`` on ``PYTHONPATH``, e.g. a ``git worktree`` of an older commit), in the same run, side by side.
+
+Run: ``python bench/bench_control_loop.py [--ticks 50000] [--seed 1] [--before /tmp/zmpwalk-before]``.
+Prints figures; asserts nothing. Goals (issue 33): max <= 200 us, median <= 10 us, no tick over 1 ms.
+"""
+
+from __future__ import annotations
+
+import argparse
+import gc
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+CONFIGURATIONS = {  # name: (rate [Hz], joints)
+    "1 kHz, joints": (1000.0, True),
+    "1 kHz, no joints": (1000.0, False),
+    "100 Hz, joints": (100.0, True),
+}
+HOSTILE_KINDS = ("reach", "fast", "stop", "zero")
+HOSTILE_SHARE = 0.2  # [-] of the commands
+
+
+def draw_command(rng: np.random.Generator) -> tuple[str, dict[str, float] | None]:
+    """A command as an operator or a policy gives it: its kind and the StepCommand's fields (None: stop())."""
+    duration = float(rng.uniform(0.7, 1.0))
+    if rng.random() < HOSTILE_SHARE:
+        kind = HOSTILE_KINDS[int(rng.integers(len(HOSTILE_KINDS)))]
+        if kind == "reach":
+            return kind, {"duration": duration, "forward": float(rng.choice([-1.0, 1.0]) * rng.uniform(0.5, 1.0))}
+        if kind == "fast":
+            return kind, {"duration": float(rng.uniform(0.1, 0.25)), "forward": float(rng.uniform(0.2, 0.3))}
+        if kind == "zero":
+            return kind, {"duration": 0.0, "forward": 0.1}
+        return kind, None
+    mode = int(rng.integers(3))
+    if mode == 0:
+        return "step", {"duration": duration, "forward": float(rng.uniform(-0.1, 0.2))}
+    if mode == 1:
+        return "step", {"duration": duration, "forward": float(rng.uniform(0.0, 0.1)),
+                        "side": float(rng.uniform(-0.05, 0.05))}
+    return "step", {"duration": duration, "forward": float(rng.uniform(0.0, 0.1)),
+                    "turn": float(rng.uniform(-0.15, 0.15))}
+
+
+def run_loop(rate: float, joints: bool, ticks: int, seed: int) -> dict[str, object]:
+    """The loop of the module docstring; per-tick CPU times [us] and counts."""
+    from zmpwalk import OnlineWalker, StepCommand, ZmpwalkError, load_robot
+
+    walker = OnlineWalker(load_robot("hubo"), rate=rate, joints=joints)
+    rng = np.random.default_rng(seed)
+    counts = dict.fromkeys(("given", "caught", "rejected", "walked", "restarted", "stops"), 0)
+    times = np.empty(ticks, dtype=np.int64)
+    support, give_at, since = "double", int(rng.integers(1, int(0.5 * rate) + 2)), 0
+    kind, fields = draw_command(rng)
+    command = StepCommand(**fields) if fields and kind != "zero" else None
+    rejection = queued = None
+    gc.collect()
+    gc.freeze()
+    clock = time.thread_time_ns
+    for index in range(ticks):
+        give = since == give_at
+        start = clock()
+        if give:
+            if command is not None:
+                walker.command(command)
+            elif kind == "stop":
+                walker.stop()
+        job = walker._job  # private: to count the checks restarted in this tick
+        sample = walker.tick()
+        times[index] = clock() - start
+        counts["restarted"] += job is not None and walker._job is not None and walker._job is not job
+        since += 1
+        if give:  # outside the timing: the operator's bookkeeping and the next command
+            counts["given"] += 1
+            counts["stops"] += kind == "stop"
+            if kind == "zero":
+                try:
+                    StepCommand(**fields)  # type: ignore[arg-type]
+                except ZmpwalkError:
+                    counts["caught"] += 1
+            kind, fields = draw_command(rng)
+            command = StepCommand(**fields) if fields and kind != "zero" else None
+            give_at = -1
+        if walker.queued is not queued:
+            counts["walked"] += queued is not None and walker.queued is None
+            queued = walker.queued
+        if walker.rejection is not rejection:  # names the rejection the first time (outside the timing)
+            rejection = walker.rejection
+            counts["rejected"] += rejection is not None
+        if sample.support != support:
+            if sample.support == "double" and support in ("left", "right"):  # a landing: a new step
+                give_at, since = int(rng.integers(1, int(0.8 * rate) + 1)), 0
+            support = sample.support
+        elif give_at < 0 and not walker.walking and walker.checking is None:  # standing: the next walk
+            give_at, since = int(rng.integers(1, int(0.5 * rate) + 2)), 0
+    gc.unfreeze()
+    return {"us": (times / 1e3).tolist(), **counts}
+
+
+def run_floor(ticks: int) -> dict[str, object]:
+    """The same timing around a copy of a 39-float row and one object per iteration."""
+    row = np.zeros(39)
+    times = np.empty(ticks, dtype=np.int64)
+    gc.collect()
+    gc.freeze()
+    clock = time.thread_time_ns
+    for index in range(ticks):
+        start = clock()
+        copy = row.copy()
+        sample = (float(copy[0]), copy[0:3], copy[15:27])
+        times[index] = clock() - start
+    del sample
+    gc.unfreeze()
+    return {"us": (times / 1e3).tolist()}
+
+
+def figures(us: np.ndarray) -> str:
+    return (f"median {np.median(us):6.2f}  p99 {np.percentile(us, 99):7.1f}  p99.9 {np.percentile(us, 99.9):7.1f}  "
+            f"max {us.max():8.1f}  >200us {int((us > 200).sum()):5d}  >1ms {int((us > 1000).sum()):3d}")
+
+
+def child(configuration: str, ticks: int, seed: int, source: str | None) -> dict[str, object]:
+    """One configuration in a fresh process (``source``: a src directory put first on PYTHONPATH)."""
+    environment = dict(os.environ)
+    if source is not None:
+        environment["PYTHONPATH"] = source + os.pathsep + environment.get("PYTHONPATH", "")
+    result = subprocess.run([sys.executable, __file__, "--child", configuration, "--ticks", str(ticks),
+                             "--seed", str(seed)], env=environment, capture_output=True, text=True, check=True)
+    data: dict[str, object] = json.loads(result.stdout.splitlines()[-1])
+    return data
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--ticks", type=int, default=50_000, help="ticks per configuration (default 50000)")
+    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--before", help="another checkout (its src/ is run too, side by side)")
+    parser.add_argument("--only", choices=[*CONFIGURATIONS, "floor"], action="append",
+                        help="run only these configurations")
+    parser.add_argument("--child", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.child:
+        if args.child == "floor":
+            result = run_floor(args.ticks)
+        else:
+            rate, joints = CONFIGURATIONS[args.child]
+            result = run_loop(rate, joints, args.ticks, args.seed)
+        import zmpwalk
+
+        result["source"] = str(Path(zmpwalk.__file__).parent.parent)
+        print(json.dumps(result))
+        return
+    trees: list[tuple[str, str | None]] = [("now", None)]
+    if args.before:
+        trees.insert(0, ("before", str(Path(args.before) / "src")))
+    print(f"per-iteration CPU time [us] (command() given in it, if any, and tick()), {args.ticks} ticks each, "
+          f"seed {args.seed}")
+    for configuration in args.only or ["floor", *CONFIGURATIONS]:
+        for name, source in trees if configuration != "floor" else [("", None)]:
+            result = child(configuration, args.ticks, args.seed, source)
+            counts = "" if configuration == "floor" else (
+                f"  ({result['given']} commands: {result['walked']} walked, {result['rejected']} rejected, "
+                f"{result['stops']} stop(), {result['caught']} errors caught; {result['restarted']} checks "
+                f"restarted, the walk having taken another step)")
+            label = f"{configuration} {name}".strip()
+            print(f"{label:26} {figures(np.array(result['us']))}{counts}", flush=True)
+
+
+if __name__ == "__main__":
+    main()
