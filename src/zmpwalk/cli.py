@@ -330,6 +330,28 @@ def _robot_parser(commands: argparse._SubParsersAction[_Parser]) -> None:
     robot_cmd.add_argument("--json", action="store_true", help="print JSON")
 
 
+def _export_parser(commands: argparse._SubParsersAction[_Parser]) -> None:
+    """The export command."""
+    export_cmd = commands.add_parser(
+        "export", help="reference motions for learning: walk a grid of commands in MuJoCo and export the clips",
+        description="Walk every command of a grid (forward, side, turn velocity; step time) through the walking "
+        "controller in MuJoCo with the stabilizer, and write the simulated and the planned motion, whole and cyclic, "
+        "in the model's joint names and order, as mjlab npz, LocoMuJoCo-style npz, AMP JSON and CSV, each replayed "
+        "from its file and checked, with manifest.json (docs/export.md). Exit status 3 when a clip fails its check.",
+        epilog="example: zmpwalk export --robot ../shared/robots/booster_t1/scene.xml --out t1-motions",
+    )
+    _robot_options(export_cmd)
+    export_cmd.add_argument("--out", type=Path, default=Path("zmpwalk-motions"),
+                            help="output folder (default: zmpwalk-motions)")
+    export_cmd.add_argument("--fps", type=float, default=50.0, help="frames per second of the clips (default: 50)")
+    export_cmd.add_argument("--grid", type=Path, help="a grid file (TOML: forward, side, turn, step_time lists)")
+    for name, unit in (("forward", "m/s"), ("side", "m/s"), ("turn", "rad/s"), ("step-time", "s")):
+        export_cmd.add_argument(f"--{name}", help=f"comma-separated values [{unit}] (instead of --grid)")
+    export_cmd.add_argument("--workers", type=int, help="commands walked at a time (default: one per core)")
+    export_cmd.add_argument("--dask", metavar="SCHEDULER", help=DASK_HELP)
+    export_cmd.add_argument("--json", action="store_true", help="print the manifest's summary as JSON")
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="zmpwalk",
@@ -344,6 +366,7 @@ def _parser() -> argparse.ArgumentParser:
     _report_parsers(commands)
     _batch_parsers(commands)
     _robot_parser(commands)
+    _export_parser(commands)
     return parser
 
 
@@ -586,6 +609,41 @@ def _robot_by_name(args: argparse.Namespace) -> None:
                           "--robot robot.toml")
 
 
+def _export(args: argparse.Namespace) -> int:
+    from zmpwalk.export import Grid, export_motions
+
+    _robot_by_name(args)
+    if args.workers is not None and args.workers < 1:
+        raise _UsageError(f"--workers = {args.workers} must be >= 1")
+    lists = {key: getattr(args, key) for key in ("forward", "side", "turn", "step_time")}
+    if args.grid is not None and any(v is not None for v in lists.values()):
+        raise _UsageError("give either --grid or --forward/--side/--turn/--step-time, not both")
+    grid = Grid.from_toml(args.grid) if args.grid is not None else Grid()
+    values: dict[str, tuple[float, ...]] = {}
+    for key, text in lists.items():
+        if text is not None:
+            try:
+                values[key] = tuple(float(v) for v in text.split(","))
+            except ValueError:
+                raise _UsageError(f"--{key.replace('_', '-')} = {text!r} must be comma-separated numbers") from None
+    grid = Grid(**{**vars(grid), **values})
+    show = None if args.json or not sys.stderr.isatty() else (lambda done, total: _progress("commands", done, total))
+    result = export_motions(args.robot, grid, args.out, fps=args.fps, workers=args.workers, scheduler=args.dask,
+                            progress=show)
+    failed = [c for c in result.clips if not c.verified]
+    if args.json:
+        print(json.dumps({"manifest": str(result.manifest), "clips": len(result.clips), "verified": result.verified,
+                          "seconds": result.seconds, "failed": [c.name for c in failed]}, indent=2))
+    else:
+        for c in result.clips:
+            check = "ok" if c.verified else "FAILED"
+            print(f"{c.name:<48} {c.verdict:<4} replay {check:<6} slide {1000 * c.replay.get('slide', math.nan):5.2f} "
+                  f"mm  penetration {1000 * c.replay.get('penetration', math.nan):5.2f} mm {c.error}")
+        print(f"{result.verified}/{len(result.clips)} clips verified, {result.seconds:.1f} s; manifest: "
+              f"{result.manifest}")
+    return 0 if not failed else EXIT_FAILED
+
+
 def _sweep(args: argparse.Namespace) -> int:
     import os
 
@@ -766,6 +824,8 @@ def _run(args: argparse.Namespace) -> int:
         return _simulate(args)
     if args.command == "sweep":
         return _sweep(args)
+    if args.command == "export":
+        return _export(args)
     if args.command == "tune":
         return _tune(args)
     if args.command == "robot":
