@@ -238,7 +238,8 @@ def _report_parsers(commands: argparse._SubParsersAction[_Parser]) -> None:
             name, help=help_text,
             description="Generate the pattern (1 kHz), check its ZMP, compute the joint angles, simulate the "
             "walk in MuJoCo and write a report folder: index.html (plots, actuator table, ZMP margin per step, "
-            "an animation of the simulated walk; self-contained, opens offline), figures, CSV and JSON files.",
+            "an interactive 3D replay of the simulated walk; self-contained, opens offline), figures, CSV and JSON "
+            "files.",
             epilog=example,
         )
         report_cmd.add_argument("steps", nargs="?", type=Path, help="steps file (TOML), as plan and simulate take it")
@@ -256,7 +257,11 @@ def _report_parsers(commands: argparse._SubParsersAction[_Parser]) -> None:
         default_out = Path("zmpwalk-demo" if name == "demo" else "zmpwalk-report")
         report_cmd.add_argument("--out", type=Path, default=default_out,
                                 help="report folder (default: ./zmpwalk-demo or ./zmpwalk-report)")
-        report_cmd.add_argument("--no-animation", action="store_true", help="skip the rendered animation")
+        report_cmd.add_argument("--no-animation", action="store_true",
+                                help="skip the interactive replay (and the GIF)")
+        report_cmd.add_argument("--gif", action="store_true",
+                                help="also render a GIF of the walk offscreen with MuJoCo (walk.gif, shown where the "
+                                "browser has no WebGL; slower)")
         report_cmd.add_argument("--json", action="store_true", help="print a JSON summary")
 
 
@@ -423,6 +428,7 @@ def _report(args: argparse.Namespace) -> int:
     with _source(str(args.steps) if args.steps else f"scenario {args.scenario}"):
         report = build_report(robot, commands, args.out, title=f"zmpwalk: {robot.name}, {name}",
                               generator=args.generator, animate=not args.no_animation,
+                              gif=args.gif and not args.no_animation,
                               progress=None if quiet else _progress, labels=labels,
                               balance=_balance(args), latency=args.latency, schedule=_schedule(args),
                               motors=_motors(args), pelvis=_pelvis(args))

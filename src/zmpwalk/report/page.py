@@ -1,7 +1,8 @@
 """The report folder: generate, check, simulate, plot, animate, and write one self-contained ``index.html``.
 
-Everything the page shows is embedded (PNG and GIF as data URIs), so it opens
-offline from any folder. The page marks ``<body data-images-loaded="yes">``
+Everything the page shows is embedded (PNG figures as data URIs; the interactive replay's data, script and
+three.js inline, see :mod:`zmpwalk.report.replay`; the GIF, only with ``gif=True``), so it opens offline from
+any folder. The page marks ``<body data-images-loaded="yes">``
 once every image has decoded, which the tests read in a headless browser.
 """
 
@@ -84,6 +85,7 @@ def build_report(
     title: str,
     generator: str = "polynomial",
     animate: bool = True,
+    gif: bool = False,
     progress: Progress | None = None,
     labels: Sequence[str] | None = None,
     balance: bool = True,
@@ -93,7 +95,8 @@ def build_report(
     pelvis: str = "cubic",
 ) -> Report:
     """Generate, check, simulate and report a walk into ``folder`` (``pelvis``: the polynomial
-    generator's pelvis curves, ``"cubic"`` or ``"quintic"``).
+    generator's pelvis curves, ``"cubic"`` or ``"quintic"``). ``animate``: the interactive replay (three.js);
+    ``gif``: also the offscreen-rendered GIF (``walk.gif``, shown where WebGL is missing).
 
     Raises:
         ZmpwalkError: The walk cannot be generated (the message says why).
@@ -134,11 +137,13 @@ def build_report(
     for index, payload in enumerate(images.values()):
         write_bytes(folder / f"figure{index + 1}.png", payload)
     done("plots")
-    animation, animation_note = _animation(robot, result, folder, progress) if animate else (None, "")
+    animation, animation_note = _animation(robot, result, folder, progress) if gif else (None, "")
+    replay = _replay(robot, pattern, result, animation, animation_note) if animate else ""
     done("animation")
     fits = motor_fits(result, motors) if motors else []
     report.summary = _summary(pattern, result, report.verdict, fits, generator)
-    page = _page(title, robot, report.summary, images, animation, animation_note, step_margins(pattern), rows,
+    movie = replay or _movie(animation, animation_note)
+    page = _page(title, robot, report.summary, images, movie, step_margins(pattern), rows,
                  report.verdict, fits, _step_list(commands, labels))
     write_text(report.index, page)
     write_text(folder / "summary.json", json.dumps(report.summary, indent=2))
@@ -179,6 +184,24 @@ def _animation(robot: RobotModel, result: SimulationResult, folder: Path,
         return None, f"The animation could not be rendered here: {error}. Set MUJOCO_GL=egl or osmesa."
     write_bytes(folder / "walk.gif", animation)
     return animation, ""
+
+
+def _movie(animation: bytes | None, note: str) -> str:
+    """The GIF as a figure, or the note why there is none (empty when none was asked for)."""
+    if animation:
+        return (f"<figure><img id='walk' src='{_data_uri('image/gif', animation)}' alt='the simulated walk'>"
+                f"<figcaption>The walk in MuJoCo, replayed from the simulation</figcaption></figure>")
+    return f"<p class='bad'>{html.escape(note)}</p>" if note else ""
+
+
+def _replay(robot: RobotModel, pattern: WalkingPattern, result: SimulationResult, animation: bytes | None,
+            note: str) -> str:
+    """The interactive replay's section, with the GIF (or a note) as its fallback where WebGL is missing."""
+    from zmpwalk.report.replay import replay_html, replay_payload
+
+    fallback = _movie(animation, note) or ("<p class='none'>This browser has no WebGL for the interactive replay; "
+                                           "<code>zmpwalk report --gif</code> adds a GIF of the walk.</p>")
+    return replay_html(replay_payload(robot, pattern, result), fallback)
 
 
 def _summary(pattern: WalkingPattern, result: SimulationResult, verdict: Verdict, fits: list[MotorFit],
@@ -280,7 +303,7 @@ def _fit_table(fits: list[MotorFit]) -> str:
 
 
 def _page(title: str, robot: RobotModel, summary: dict[str, Any], images: dict[str, bytes],
-          animation: bytes | None, animation_note: str, margins: list[tuple[int, str, str, float, float, float]],
+          movie: str, margins: list[tuple[int, str, str, float, float, float]],
           rows: list[ActuatorRow], verdict: Verdict, fits: list[MotorFit], steps: str) -> str:
     esc = html.escape
     margin_rows = "\n".join(
@@ -291,9 +314,6 @@ def _page(title: str, robot: RobotModel, summary: dict[str, Any], images: dict[s
     figures = "\n".join(
         f"<figure><img src='{_data_uri('image/png', payload)}' alt='{esc(caption)}'>"
         f"<figcaption>{esc(caption)}</figcaption></figure>" for caption, payload in images.items())
-    movie = (f"<figure><img id='walk' src='{_data_uri('image/gif', animation)}' alt='the simulated walk'>"
-             f"<figcaption>The walk in MuJoCo, replayed from the simulation</figcaption></figure>"
-             if animation else f"<p class='bad'>{esc(animation_note)}</p>")
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>{esc(title)}</title>
 {STYLE}</head>
