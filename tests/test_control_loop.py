@@ -169,3 +169,33 @@ def test_a_seeded_loop_on_the_machines_own_clock(hubo, rate, joints):
     largest = _loop(walker, actions, outcomes, lambda _: None)
     _check(walker, outcomes, largest, lambda _: None)
     assert outcomes.walked and outcomes.rejected  # both occur in this loop
+
+
+@settings(max_examples=200, deadline=None)
+@given(costs=st.lists(st.floats(0.0, 3.0), min_size=1, max_size=40), budget=st.floats(0.0, 5.0),
+       quota=st.integers(1, 10))
+def test_run_for_begins_no_part_after_its_budget_and_gives_the_same_result(costs, budget, quota):
+    """slices.run_for on a clock that each part advances by its cost: at least one part, none begun once the
+    budget is spent (so the time is at most the budget and one part), and, run until done, the result that
+    run_to_end gives."""
+    from zmpwalk.slices import UNFINISHED, Parts, run_for, run_to_end
+
+    now = [0.0]
+    begun: list[float] = []
+
+    def computation() -> Parts[int]:
+        for cost in costs:
+            begun.append(now[0])
+            now[0] += cost
+            yield
+        return len(costs)
+
+    parts, total, result = computation(), 0, UNFINISHED
+    while result is UNFINISHED:
+        start = now[0]
+        first = len(begun)
+        result, count = run_for(parts, budget, quota, lambda: now[0])
+        total += count
+        assert count >= 1 or result is not UNFINISHED
+        assert all(time - start < budget for time in begun[first + 1:])  # no part begun after the budget
+    assert result == run_to_end(computation()) == len(costs) and total == len(costs) + 1

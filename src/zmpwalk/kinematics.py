@@ -326,6 +326,7 @@ def _leg_ik_yaw_rates_in_parts(leg: Leg, px: Array, py: Array, pz: Array, yaw: A
         d_big_y, d_big_x = -a * cos4 * dq4, -a * sin4 * dq4
         dq5 = ((big_x * d_big_y - big_y * d_big_x) / (big_x * big_x + big_y * big_y)
                - (u_z * drx - rx * du) / (rx * rx + u_squared))
+    yield
     dq1 = w
     dq2 = np.where(flipped, dq6, -dq6)
     dq3 = -(dq4 + dq5)
@@ -541,9 +542,12 @@ def joint_trajectory_in_parts(
             order = list(chain.role_order)
             angles[:, 6 * index:6 * index + 6] = leg_angles[:, order]
             velocities[:, 6 * index:6 * index + 6] = rates[:, order]
-    if check_limits:
-        yield  # the joint ranges: a part of their own
-        check_joint_limits(time, angles, robot)
+    if check_limits:  # the joint ranges: parts of their own, each half of the samples (the first sample out
+        half = (n + 1) // 2  # of range is the first of the first half that has one, else of the second)
+        yield
+        check_joint_limits(time[:half], angles[:half], robot)
+        yield
+        check_joint_limits(time[half:], angles[half:], robot)
     return JointTrajectory(time, angles, velocities, position_base_in_world=base)
 
 

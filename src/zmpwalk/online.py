@@ -102,7 +102,7 @@ from zmpwalk.patterns.polynomial import (
 from zmpwalk.patterns.result import SUPPORT_NAMES, check_rate
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
-from zmpwalk.slices import Parts, run_to_end
+from zmpwalk.slices import UNFINISHED, Parts, run_for, run_to_end
 
 Array = NDArray[np.float64]
 
@@ -223,6 +223,9 @@ class _Job:
 
 
 POOL_BUFFERS = 8  # row buffers kept for the next checks (a walker holds at most six plans' at a time)
+READY_BUFFERS = 6  # of them made (and their pages touched) with the walker, each for READY_SECONDS of rows
+READY_SECONDS = 4.5  # [s] a plan's rows: from standstill the start stage, up to three stages and the stop and
+# settle after them fit in 4.5 step times; 4.5 s covers every step of up to 1 s (longer ones take new buffers)
 
 
 class _RowBuffers:
@@ -230,9 +233,11 @@ class _RowBuffers:
     allocator give the top of its heap back to the system: 0.1-0.3 ms, measured; given back here instead, a
     buffer is kept for a later check (each at most once: :meth:`OnlineWalker._release`)."""
 
-    def __init__(self, width: int) -> None:
+    def __init__(self, width: int, ready: int = 0, rows: int = 0) -> None:
+        """``ready`` buffers of ``rows`` rows are made now and written once: the system maps a page at its first
+        write (a page fault, 1-10 us each on a virtual machine: a block's first fill cost up to 0.4 ms)."""
         self.width = width
-        self.free: list[Array] = []
+        self.free: list[Array] = [np.full((rows, width), np.nan) for _ in range(ready)]
 
     def take(self, count: int) -> Array:
         """``count`` rows: a view of the smallest kept buffer that holds them, else of a new one (a quarter
@@ -251,7 +256,6 @@ class _RowBuffers:
             self.free.append(buffer)
 
 
-_UNFINISHED = object()
 _clock = time.perf_counter  # [s] the clock of the budget (a test replaces it with one that counts parts)
 WORK_BUDGET = 50e-6  # [s] a tick runs parts of a check while the next one is expected to end within this
 WORK_FRACTION = 0.01  # [-] ... or within this fraction of the control period, where that is longer (below 200 Hz)
@@ -274,33 +278,6 @@ class _Rejection:
     stance: Stance
     boundary: Boundary
     named: bool = False  # the parameter to fix is named (:meth:`OnlineWalker._rejected` has run)
-
-
-def _step(planning: Parts[_Plan | None]) -> object:
-    """One slice of a planning; its result when done, else :data:`_UNFINISHED`."""
-    try:
-        next(planning)
-    except StopIteration as done:
-        return done.value
-    return _UNFINISHED
-
-
-def _slices(job: _Job, budget: float, quota: int) -> object:
-    """Parts of a job's planning: one, then more while the next one, taken as long as the mean of this tick's,
-    ends within ``budget`` [s], or (up to ``quota``) while ``budget`` is not spent: no part begins after it, so a
-    tick's work is bounded by ``budget`` and one part. The planning's result when done, else :data:`_UNFINISHED`."""
-    begin = _clock()
-    count = 0
-    while True:
-        result = _step(job.planning)
-        count += 1
-        if result is not _UNFINISHED:
-            break
-        elapsed = _clock() - begin
-        if elapsed >= budget or (count >= quota and elapsed * (count + 1) > budget * count):
-            break
-    job.parts += count
-    return result
 
 
 class OnlineWalker:
@@ -341,7 +318,7 @@ class OnlineWalker:
         self._job: _Job | None = None
         self._rejection: _Rejection | None = None
         self._check_parts = 0  # parts the last completed check took
-        self._buffers = _RowBuffers(self._width)
+        self._buffers = _RowBuffers(self._width, READY_BUFFERS, math.ceil(READY_SECONDS * self.rate))
         self._set_standing(self._standing_row(self._stance))
 
     @property
@@ -488,12 +465,13 @@ class OnlineWalker:
         quota = -(-(expected - job.parts) // ticks_left)  # its share of the parts left
         plan: object
         try:
-            plan = _slices(job, work_budget(self.rate), quota)
+            plan, parts = run_for(job.planning, work_budget(self.rate), quota, _clock)
+            job.parts += parts
         except ZmpwalkError as error:
             self._drop_job()
             self._rejection = _Rejection(job.command, error, job.stance, job.boundary)
             return
-        if plan is _UNFINISHED:
+        if plan is UNFINISHED:
             return
         self._check_parts = job.parts
         self._job = None  # its buffers are the plan's rows now

@@ -1,14 +1,15 @@
 """Work in bounded slices, for a control loop that must never wait long.
 
 A computation written as a generator that yields between parts of bounded cost (``Parts[T]``, returning
-``T``) can run whole (:func:`run_to_end`: the batch paths) or a few parts per control tick
-(:class:`zmpwalk.online.OnlineWalker`), with the same code and the same result.
+``T``) can run whole (:func:`run_to_end`: the batch paths) or a few parts per control tick within a time
+budget (:func:`run_for`: :class:`zmpwalk.online.OnlineWalker`), with the same code and the same result.
 """
 
 from __future__ import annotations
 
 import functools
 import inspect
+import time
 from collections.abc import Callable, Generator
 from typing import ParamSpec, TypeVar
 
@@ -25,6 +26,33 @@ def run_to_end(parts: Parts[T]) -> T:
         except StopIteration as done:
             result: T = done.value
             return result
+
+
+UNFINISHED = object()  # what :func:`run_for` returns while the computation has parts left
+
+
+def run_for(parts: Parts[T], budget: float, quota: int = 1,
+            clock: Callable[[], float] = time.perf_counter) -> tuple[T | object, int]:
+    """Run parts of a sliced computation within ``budget`` [s] of ``clock``: one, then more while the next one,
+    taken as long as the mean of those run so far, ends within ``budget``, or (up to ``quota`` parts) while
+    ``budget`` is not spent. No part begins after ``budget`` is spent, so the time taken is bounded by
+    ``budget`` and one part, whatever the computation.
+
+    Returns:
+        Its result (:data:`UNFINISHED` while it has parts left), and the number of parts run.
+    """
+    begin = clock()
+    count = 0
+    while True:
+        try:
+            next(parts)
+        except StopIteration as done:
+            result: T = done.value
+            return result, count + 1
+        count += 1
+        elapsed = clock() - begin
+        if elapsed >= budget or (count >= quota and elapsed * (count + 1) > budget * count):
+            return UNFINISHED, count
 
 
 def whole(parts: Callable[P, Parts[T]], name: str) -> Callable[P, T]:

@@ -387,7 +387,12 @@ def _hyperbolic_pelvis(table: StageTable, k: NDArray[np.intp], elapsed: Array, r
     a = math.sqrt(robot.gravity / robot.pendulum_length)
     axes = []
     for starts, position, velocity, zmp in table.lipm_axes:
-        axes.append((yield from axis_at_in_parts(a, starts[k], position[k], velocity[k], zmp[k], elapsed)))
+        sample_starts, sample_positions = starts[k], position[k]  # each sample's stage's pieces, (n, PIECES)
+        yield
+        sample_velocities, sample_zmps = velocity[k], zmp[k]
+        yield
+        axes.append((yield from axis_at_in_parts(a, sample_starts, sample_positions, sample_velocities, sample_zmps,
+                                                 elapsed)))
         yield
     (u, du, ddu), (w, dw, ddw) = axes
     c, s = np.cos(table.lipm_yaw[k]), np.sin(table.lipm_yaw[k])  # the supporting foot's frame to world

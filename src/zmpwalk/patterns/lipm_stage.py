@@ -249,6 +249,7 @@ def lipm_pelvis_in_parts(plan: StagePlan, position: tuple[float, float], velocit
             target_p, target_v = ankles_middle, np.zeros(2)
         else:  # a steady step of Fig. 3 towards this command's steady state
             steady = solve_step(a, 2.0 * plan.forward, T, d, robot.hip_spacing / 2)
+            yield  # the steady step, then the target's: a part each
             along_pieces = [(d / 2, COAST), (steady.t1, 0), (steady.t2, COAST), (steady.t3, 1), (d / 2, COAST)]
             across_pieces = [(d / 2, COAST), ((T - d) / 2, 0), ((T - d) / 2, 1), (d / 2, COAST)]
             centring = 0.5 * (steady.zmp1 + steady.zmp2)
@@ -282,7 +283,7 @@ lipm_pelvis = whole(lipm_pelvis_in_parts, "lipm_pelvis")  # the same, run whole
 def axis_at_in_parts(a: float, axis_starts: Array, position: Array, velocity: Array, zmp: Array, elapsed: Array
                      ) -> Parts[tuple[Array, Array, Array]]:
     """Position [m], velocity [m/s] and acceleration [m/s^2] of axes at ``elapsed`` [s] from their stage start.
-    In two parts (each sample's piece, then the pendulum; :mod:`zmpwalk.slices`).
+    In parts (each sample's piece, its start state, then the pendulum; :mod:`zmpwalk.slices`).
 
     Args:
         a: ``sqrt(g / z_b)`` [1/s].
@@ -292,6 +293,7 @@ def axis_at_in_parts(a: float, axis_starts: Array, position: Array, velocity: Ar
     # a sample at a piece's start (to PHASE_TIME_TOL, whatever the rounding) is in that piece, as the support
     # phases count it (WalkingPattern.zmp_margin): the ZMP jumps there, and the sample shows the new one
     index = np.clip(np.sum(elapsed[:, None] >= axis_starts - PHASE_TIME_TOL, axis=1) - 1, 0, PIECES - 1)
+    yield
     rows = np.arange(len(elapsed))
     tau = elapsed - axis_starts[rows, index]
     x0, v0, c = position[rows, index], velocity[rows, index], zmp[rows, index]
@@ -313,11 +315,12 @@ def _zmp_margin(plan: StagePlan, along: LipmAxis, across: LipmAxis, robot: Robot
     T, d = plan.duration, plan.parameters.dsp_time
     grounded = plan.kind in GROUNDED_KINDS
     support = foot_corners(plan.support_pose, -plan.swing, robot)
-    polygons = [[(float(x), float(y)) for x, y in polygon] for polygon in (
-        support,
-        convex_hull(np.vstack([support, foot_corners(plan.swing_start, plan.swing, robot)])),
-        convex_hull(np.vstack([support, foot_corners(plan.swing_end, plan.swing, robot)])))]
-    single, before, after = polygons
+    polygons = [support]
+    for swing in (plan.swing_start, plan.swing_end):  # the double supports' polygons, a part each
+        yield
+        polygons.append(convex_hull(np.vstack([support, foot_corners(swing, plan.swing, robot)])))
+    yield
+    single, before, after = ([(float(x), float(y)) for x, y in polygon] for polygon in polygons)
     breaks = sorted(t for t in {*along.starts, *across.starts, T} if t <= T + 1e-12)
     c, s = math.cos(plan.support_pose.yaw), math.sin(plan.support_pose.yaw)
     worst, where = math.inf, (0.0, 0.0, 0.0)
