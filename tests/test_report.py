@@ -10,12 +10,14 @@ import subprocess
 import tempfile
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from zmpwalk.cli import main
 
 ARTIFACTS = Path(__file__).resolve().parent.parent / "test-artifacts"
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+WEBGL_FLAGS = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"]  # software WebGL, no GPU needed
 CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                   "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 
@@ -29,15 +31,16 @@ def demo(tmp_path_factory):
 
 def test_demo_writes_the_report_folder(demo):
     names = {p.name for p in demo.iterdir()}
-    assert {"index.html", "walk.gif", "figure1.png", "figure4.png", "actuators.csv", "pattern.csv",
-            "summary.json"} <= names
+    assert {"index.html", "figure1.png", "figure4.png", "actuators.csv", "pattern.csv", "summary.json"} <= names
+    assert "walk.gif" not in names  # the GIF is opt-in (--gif): the page has the interactive replay
     summary = json.loads((demo / "summary.json").read_text())
     assert summary["fell"] is False and summary["min_zmp_margin"] > 0
     assert summary["balance"] is True  # the demo runs the stabilizer
     assert summary["verdict"]["passed"] is True  # and ends standing still where planned
     page = (demo / "index.html").read_text()
     assert "http://" not in page and "https://" not in page  # opens offline: everything is embedded
-    assert page.count("data:image/png;base64,") == 6 and page.count("data:image/gif;base64,") == 1
+    assert page.count("data:image/png;base64,") == 6 and page.count("data:image/gif;base64,") == 0
+    assert page.count('<section id="replay"') == 1 and "data:text/javascript;base64," in page
     assert "The stabilizer" in page
     assert "right_hip_roll" in page and "ZMP margin per step" in page
     header, *rows = _table_cells(page, "actuators")
@@ -60,7 +63,7 @@ def test_headless_browser_loads_every_image_and_the_animation(demo):
     dom = subprocess.run([CHROMIUM, *CHROMIUM_FLAGS, f"--user-data-dir={profile}", "--virtual-time-budget=10000",
                           "--dump-dom", (demo / "index.html").as_uri()],
                          capture_output=True, text=True, timeout=120, check=True).stdout
-    assert 'data-images-loaded="yes"' in dom and 'data-image-count="7"' in dom
+    assert 'data-images-loaded="yes"' in dom and 'data-image-count="6"' in dom
     # what a researcher looks for first: the verdict's criteria, both legs, the commanded steps, the data
     for text in ('id="criteria"', "feet where planned", "both soles loaded at the end", "CoP inside the loaded soles",
                  "Both legs", 'id="steps"', "[[steps]] 1, repeat 2 of 2", 'href="simulation.csv"'):
@@ -75,6 +78,67 @@ def test_headless_browser_loads_every_image_and_the_animation(demo):
                     f"--screenshot={shot}", (demo / "index.html").as_uri()],
                    capture_output=True, timeout=120, check=True)
     assert shot.stat().st_size > 10_000
+
+
+def _replay_dom(index: Path, fragment: str) -> dict[str, str]:
+    """The replay section's attributes after the page ran, opened at ``index.html#fragment``."""
+    dom = subprocess.run([CHROMIUM, *CHROMIUM_FLAGS, *WEBGL_FLAGS, f"--user-data-dir={tempfile.mkdtemp()}",
+                          "--virtual-time-budget=5000", "--dump-dom", f"{index.as_uri()}#{fragment}"],
+                         capture_output=True, text=True, timeout=120, check=True).stdout
+    section = re.search(r'<section id="replay"([^>]*)>', dom)
+    assert section is not None
+    return dict(re.findall(r'([\w-]+)="([^"]*)"', section.group(1)))
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed (.ci/run installs it)")
+def test_the_interactive_replay_draws_the_robot_moves_with_the_time_and_shows_the_footprints(demo):
+    from PIL import Image
+
+    summary = json.loads((demo / "summary.json").read_text())
+    start, later = _replay_dom(demo / "index.html", "t=0"), _replay_dom(demo / "index.html", "t=6")
+    assert start["data-ready"] == "yes" and later["data-ready"] == "yes"  # WebGL (software) and three.js ran
+    assert int(start["data-geoms"]) >= 7  # HUBO's boxes: torso, thighs, shanks, feet...
+    assert abs(float(start["data-time"]) - 0.0) < 1e-3 and abs(float(later["data-time"]) - 6.0) < 1e-3
+    assert int(later["data-frame"]) > int(start["data-frame"])
+    # the demo walks forward: at 6 s the base is well ahead of where it stood
+    assert float(later["data-base-x"]) - float(start["data-base-x"]) > 0.2
+    assert int(start["data-footprints-planned"]) == summary["swings"] + 2  # the first stance and every landing
+    assert summary["swings"] <= int(start["data-footprints-measured"]) <= summary["swings"] + 2
+    ARTIFACTS.mkdir(exist_ok=True)
+    shot = ARTIFACTS / "demo-replay.png"
+    subprocess.run([CHROMIUM, *CHROMIUM_FLAGS, *WEBGL_FLAGS, f"--user-data-dir={tempfile.mkdtemp()}",
+                    "--window-size=1000,760", "--virtual-time-budget=5000", f"--screenshot={shot}",
+                    f"{(demo / 'index.html').as_uri()}#replay&t=3"], capture_output=True, timeout=120, check=True)
+    with Image.open(shot) as image:
+        pixels = np.asarray(image.convert("RGB"), dtype=float)[40:440, 20:960]  # the 3D view (#replay alone)
+    background = np.array([0xE8, 0xEC, 0xF0])
+    drawn = np.abs(pixels - background).max(axis=2) > 30
+    coloured = (pixels.max(axis=2) - pixels.min(axis=2)) > 40  # the robot's torso, the red footprints
+    assert drawn.mean() > 0.05 and coloured.sum() > 300, (drawn.mean(), coloured.sum())
+
+
+def test_decimated_meshes_keep_their_shape_with_fewer_faces():
+    from zmpwalk.report.replay import decimate
+
+    u, v = np.meshgrid(np.linspace(0, np.pi, 80), np.linspace(0, 2 * np.pi, 120), indexing="ij")
+    vertices = np.column_stack([(np.sin(u) * np.cos(v)).ravel(), (np.sin(u) * np.sin(v)).ravel(), np.cos(u).ravel()])
+    index = np.arange(80 * 120).reshape(80, 120)
+    a, b, c, d = index[:-1, :-1].ravel(), index[1:, :-1].ravel(), index[1:, 1:].ravel(), index[:-1, 1:].ravel()
+    faces = np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
+    kept_vertices, kept_faces = decimate(vertices, faces, limit=2000)
+    assert 200 < len(kept_faces) <= 2000 and kept_faces.max() < len(kept_vertices)
+    assert np.abs(np.linalg.norm(kept_vertices, axis=1) - 1.0).max() < 1e-9  # vertices of the sphere, not moved
+    assert np.allclose(decimate(vertices, faces[:100], limit=2000)[1], faces[:100], atol=0)  # small: unchanged
+
+
+def test_the_gif_is_opt_in_and_is_the_replays_fallback(tmp_path):
+    steps = tmp_path / "walk.toml"
+    steps.write_text("[[steps]]\nduration = 0.8\nforward = 0.1\nrepeat = 2\n")
+    assert main(["report", str(steps), "--gif", "--out", str(tmp_path / "r")]) == 0
+    page = (tmp_path / "r" / "index.html").read_text()
+    assert (tmp_path / "r" / "walk.gif").stat().st_size > 10_000
+    fallback = page.split('<div id="replay-fallback" hidden>')[1].split("</div>")[0]
+    assert fallback.count("data:image/gif;base64,") == 1 and page.count("data:image/gif;base64,") == 1
 
 
 @pytest.mark.parametrize("argv, message", [

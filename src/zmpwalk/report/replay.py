@@ -26,7 +26,7 @@ from zmpwalk.sim.run import SimulationResult
 
 FPS = 40  # [1/s] frames of the replay
 MAX_MESH_FACES = 4000  # faces of one mesh after decimation
-SAME_PLACE = 0.02  # [m] a sole loaded again within this of its last footprint makes no new one
+MIN_SWING = 0.1  # [s] a sole unloaded for less (a flicker while the weight shifts) makes no new footprint
 VISIBLE_GROUPS = 3  # geom groups 0-2 are drawn (MuJoCo's default visual groups)
 KINDS = {mujoco.mjtGeom.mjGEOM_BOX: "box", mujoco.mjtGeom.mjGEOM_SPHERE: "sphere",
          mujoco.mjtGeom.mjGEOM_CAPSULE: "capsule", mujoco.mjtGeom.mjGEOM_CYLINDER: "cylinder",
@@ -121,9 +121,22 @@ def _pose(plant: Any, data: mujoco.MjData, result: SimulationResult, rotation: n
     mujoco.mj_kinematics(plant.model, data)
 
 
+def _landing_rows(time: np.ndarray, loaded: np.ndarray) -> list[int]:
+    """Rows 50 ms after a sole became loaded: at the start if loaded there, and after each unloaded spell of at
+    least :data:`MIN_SWING`."""
+    onsets = np.flatnonzero(loaded[1:] & ~loaded[:-1]) + 1
+    offsets = np.flatnonzero(~loaded[1:] & loaded[:-1]) + 1
+    rows = [0] if loaded[0] else []
+    for onset in onsets.tolist():
+        before = offsets[offsets < onset]
+        if len(before) and time[onset] - time[before[-1]] >= MIN_SWING:
+            rows.append(onset)
+    return [min(row + 50, len(time) - 1) for row in rows]
+
+
 def _footprints(plant: Any, pattern: WalkingPattern, result: SimulationResult) -> dict[str, Any]:
     """Planned soles (the first stance and every landing) and measured ones (each ankle where its sole became
-    loaded, 50 ms later, with the foot's yaw; once per place), as lists of four (x, y) corners, with the time each
+    loaded after a swing, 50 ms later, with the foot's yaw), as lists of four (x, y) corners, with the time each
     is placed."""
     robot = result.robot
     planned = [(0.0, foot_corners(pose, side, robot)) for pose, side in pattern.support_phases[0].feet]
@@ -137,16 +150,9 @@ def _footprints(plant: Any, pattern: WalkingPattern, result: SimulationResult) -
     weight = robot.mass * robot.gravity
     for foot, force in enumerate((result.force_left, result.force_right)):
         site = mujoco.mj_name2id(plant.model, mujoco.mjtObj.mjOBJ_SITE, ("left", "right")[foot] + "_ankle")
-        loaded = force > LOADED_FRACTION * weight
-        starts = ([0] if loaded[0] else []) + (np.flatnonzero(loaded[1:] & ~loaded[:-1]) + 1).tolist()
-        last = np.full(2, np.inf)
-        for start in starts:
-            i = min(int(start) + 50, len(force) - 1)
+        for i in _landing_rows(result.time, force > LOADED_FRACTION * weight):
             _pose(plant, data, result, rotation, i)
             x, y = data.site_xpos[site][:2]
-            if np.hypot(x - last[0], y - last[1]) < SAME_PLACE:
-                continue  # the sole unloaded and loaded again where it stood: one footprint
-            last = np.array([x, y])
             matrix = data.site_xmat[site].reshape(3, 3)
             yaw = math.atan2(float(matrix[1, 0]), float(matrix[0, 0]))
             measured.append((float(result.time[i]),
