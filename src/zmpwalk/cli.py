@@ -352,6 +352,8 @@ def _export_parser(commands: argparse._SubParsersAction[_Parser]) -> None:
     export_cmd.add_argument("--grid", type=Path, help="a grid file (TOML: forward, side, turn, step_time lists)")
     for name, unit in (("forward", "m/s"), ("side", "m/s"), ("turn", "rad/s"), ("step-time", "s")):
         export_cmd.add_argument(f"--{name}", help=f"comma-separated values [{unit}] (instead of --grid)")
+    export_cmd.add_argument("--swings", type=int, default=10, help="swings walked per command (default: 10; a side "
+                            "or turn step is two)")
     export_cmd.add_argument("--workers", type=int, help="commands walked at a time (default: one per core)")
     export_cmd.add_argument("--dask", metavar="SCHEDULER", help=DASK_HELP)
     export_cmd.add_argument("--json", action="store_true", help="print the manifest's summary as JSON")
@@ -635,7 +637,7 @@ def _export(args: argparse.Namespace) -> int:
     grid = Grid(**{**vars(grid), **values})
     show = None if args.json or not sys.stderr.isatty() else (lambda done, total: _progress("commands", done, total))
     result = export_motions(args.robot, grid, args.out, fps=args.fps, workers=args.workers, scheduler=args.dask,
-                            progress=show)
+                            progress=show, swings=args.swings)
     failed = [c for c in result.clips if not c.verified]
     if args.json:
         print(json.dumps({"manifest": str(result.manifest), "clips": len(result.clips), "verified": result.verified,

@@ -1,13 +1,18 @@
-"""LocoMuJoCo-style trajectory npz: the model's whole ``qpos`` and ``qvel`` with its joint names and frequency.
+"""LocoMuJoCo's trajectory npz (``loco_mujoco.trajectory.Trajectory.save`` / ``Trajectory.load``, v1.0).
 
-Arrays (n frames): ``qpos`` (n, nq) [m, rad; the free base's quaternion **w, x, y, z**], ``qvel`` (n, nv) (base
-linear velocity in world [m/s], base angular velocity in the base frame [rad/s], joint rates: MuJoCo's ``qvel``),
-``xpos`` (n, nbody, 3) [m] and ``xquat`` (n, nbody, 4) (w, x, y, z) of every body, the world's included (row 0),
-``joint_names`` (njnt,) (the free base first), ``body_names`` (nbody,) (the world first), ``frequency`` () [Hz],
-``split_points`` (2,) (one trajectory: frames 0 to n). These are the fields of LocoMuJoCo's ``TrajectoryInfo``
-(``joint_names``, ``frequency``, ``body_names``) and ``TrajectoryData`` (``qpos``, ``qvel``, ``xpos``, ``xquat``,
-``split_points``), written flat; loading them into a ``Trajectory`` is not checked here (LocoMuJoCo was not
-installed where this was written).
+The flat keys ``Trajectory.load`` sorts into its three parts, and only those (it refuses others):
+
+- ``TrajectoryInfo``: ``joint_names`` (njnt,) (every joint, the free base first, model order), ``frequency``
+  () [Hz], ``body_names`` (nbody,) (the world first);
+- ``TrajectoryModel``: ``njnt``, ``jnt_type`` (njnt,), ``nbody``, ``body_rootid``, ``body_weldid``,
+  ``body_mocapid``, ``body_pos`` [m], ``body_quat`` (w, x, y, z), ``body_ipos`` [m], ``body_iquat``: the model's;
+- ``TrajectoryData``: ``qpos`` (n, nq) [m, rad; the free base's quaternion **w, x, y, z**], ``qvel`` (n, nv)
+  (MuJoCo's: base linear velocity in world [m/s], base angular velocity in the base frame [rad/s], joint rates;
+  central differences of the frames), ``xpos`` (n, nbody, 3) [m] and ``xquat`` (n, nbody, 4) (w, x, y, z) of
+  every body (the world's row included), ``split_points`` (2,): one trajectory, frames 0 to n.
+
+The key set was taken from loco-mujoco 1.0.0's source; its loader was not run here (it pins mujoco 3.2.7 and
+numpy < 2).
 """
 
 from __future__ import annotations
@@ -34,9 +39,12 @@ def locomujoco_npz(model: mujoco.MjModel, qpos: Array, fps: float) -> bytes:
         xpos[i], xquat[i] = data.xpos, data.xquat
     buffer = io.BytesIO()
     world = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, 0) or "world"
+    structure = {"njnt": np.array(model.njnt), "jnt_type": model.jnt_type.copy(), "nbody": np.array(model.nbody),
+                 **{key: getattr(model, key).copy() for key in ("body_rootid", "body_weldid", "body_mocapid",
+                                                               "body_pos", "body_quat", "body_ipos", "body_iquat")}}
     np.savez(buffer, qpos=qpos, qvel=velocities(model, qpos, fps), xpos=xpos, xquat=xquat,
              joint_names=np.array(joint_names(model)), body_names=np.array([world, *body_names(model)]),
-             frequency=np.array(float(fps)), split_points=np.array([0, n], dtype=np.int64))
+             frequency=np.array(float(fps)), split_points=np.array([0, n], dtype=np.int64), **structure)
     return buffer.getvalue()
 
 

@@ -9,7 +9,8 @@ in the model's order):
 - ``body_pos_w`` (n, B, 3) [m] and ``body_quat_w`` (n, B, 4): each body's frame in world, quaternion
   **w, x, y, z** (MuJoCo's order, unit norm);
 - ``body_lin_vel_w`` (n, B, 3) [m/s] and ``body_ang_vel_w`` (n, B, 3) [rad/s]: each body frame origin's velocity
-  in world axes (:func:`mujoco.mj_objectVelocity`, world-oriented).
+  in world axes (mjlab's ``body_link_*_vel_w``: :func:`mujoco.mj_objectVelocity` moved from the body's centre of
+  mass to its frame origin).
 
 The free base is body 1 of the model (``body_pos_w[:, 0]``, ``body_quat_w[:, 0]``), so the clip's ``qpos`` is
 ``body_pos_w[:, 0], body_quat_w[:, 0], joint_pos``. Velocities are central differences of the frames.
@@ -44,7 +45,9 @@ def body_states(model: mujoco.MjModel, qpos: Array, qvel: Array) -> tuple[Array,
         position[i], quaternion[i] = data.xpos[1:], data.xquat[1:]
         for b in range(1, model.nbody):
             mujoco.mj_objectVelocity(model, data, mujoco.mjtObj.mjOBJ_BODY, b, twist, 0)
-            angular[i, b - 1], linear[i, b - 1] = twist[:3], twist[3:]
+            # the twist's linear part is at the body's centre of mass: moved to the body frame's origin
+            angular[i, b - 1] = twist[:3]
+            linear[i, b - 1] = twist[3:] + np.cross(twist[:3], data.xpos[b] - data.xipos[b])
     return position, quaternion, linear, angular
 
 

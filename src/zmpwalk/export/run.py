@@ -101,6 +101,7 @@ class ClipRecord:
         loop: First and last frame of the cyclic window in the whole clip, or None.
         loop_error: The window's loop-closure error (joints [rad], base height [m], tilt [rad], rates [rad/s]).
         verdict: The simulated walk's verdict (``PASS``, ``WARN``, ``FAIL``; a planned clip has its walk's).
+        failed: The verdict's failed criteria.
         zmp_margin: The plan's least ZMP margin [m].
         cop_margin: The measured CoP's least margin outside touchdowns [m].
         cop_rms: RMS of the measured CoP against the reference ZMP [m].
@@ -120,6 +121,7 @@ class ClipRecord:
     loop: tuple[int, int] | None = None
     loop_error: dict[str, float] = field(default_factory=dict)
     verdict: str = "FAIL"
+    failed: list[str] = field(default_factory=list)
     zmp_margin: float = math.nan  # [m]
     cop_margin: float = math.nan  # [m]
     cop_rms: float = math.nan  # [m]
@@ -149,16 +151,16 @@ class ExportResult:
         return sum(c.verified for c in self.clips)
 
 
-def _step(robot_spec: str, command: Command) -> tuple[StepCommand, int]:
-    """The step command of a velocity and how many of them make :data:`SWINGS` swings."""
+def _step(robot_spec: str, command: Command, swings: int) -> tuple[StepCommand, int]:
+    """The step command of a velocity and how many of them make ``swings`` swings."""
     from zmpwalk.control import velocity_command
     from zmpwalk.robots import loaded_robot
     from zmpwalk.schedule import Schedule
 
     step = velocity_command(Schedule.hubo(), loaded_robot(robot_spec), command.forward, command.side, command.turn,
                             command.step_time)
-    swings = 2 if (step.side != 0.0 or step.turn != 0.0) else 1
-    return step, max(1, math.ceil(SWINGS / swings))
+    per_step = 2 if (step.side != 0.0 or step.turn != 0.0) else 1
+    return step, max(1, math.ceil(swings / per_step))
 
 
 def _write_clip(model: mujoco.MjModel, clip: Clip, qpos: Array, cyclic: bool, out: Path,
@@ -184,8 +186,9 @@ def _write_clip(model: mujoco.MjModel, clip: Clip, qpos: Array, cyclic: bool, ou
     record.verified, record.replay = verified, worst
 
 
-def export_command(robot_spec: str, command: Command, out: str, fps: float) -> list[ClipRecord]:
-    """Walk one command and write its four clips (simulated and planned, whole and cyclic) to ``out``."""
+def export_command(robot_spec: str, command: Command, out: str, fps: float, swings: int = SWINGS) -> list[ClipRecord]:
+    """Walk one command (``swings`` swings of it) and write its four clips (simulated and planned, whole and
+    cyclic) to ``out``."""
     from zmpwalk.robots import loaded_robot
     from zmpwalk.sim.plant import build_plant
     from zmpwalk.sim.verdict import HOLD, cop_margin_outside_touchdowns, walk_verdict
@@ -193,14 +196,15 @@ def export_command(robot_spec: str, command: Command, out: str, fps: float) -> l
     robot, stem = loaded_robot(robot_spec), command.name()
     described = asdict(command)
     try:
-        step, count = _step(robot_spec, command)
+        step, count = _step(robot_spec, command, swings)
         run, simulated, planned = walk_clips(robot, step, count, fps)
     except ZmpwalkError as error:
         return [ClipRecord(stem, described, "simulated", "whole", error=str(error))]
     result = run.result
     described["step_time"] = step.duration
     stem = replace(command, step_time=step.duration).name()
-    walk = ClipRecord(stem, described, "simulated", "whole", verdict=walk_verdict(result, HOLD).state,
+    verdict = walk_verdict(result, HOLD)
+    walk = ClipRecord(stem, described, "simulated", "whole", verdict=verdict.state, failed=verdict.failed,
                       zmp_margin=result.plan_zmp_margin, cop_margin=cop_margin_outside_touchdowns(result),
                       cop_rms=result.cop_error_stats()[0], foot_slip=result.foot_slip)
     model = build_plant(robot).model
@@ -223,7 +227,7 @@ def export_command(robot_spec: str, command: Command, out: str, fps: float) -> l
 
 
 def export_motions(robot: str, grid: Grid | None = None, out: str | Path = "zmpwalk-motions", *, fps: float = 50.0,
-                   workers: int | None = None, scheduler: str | None = None,
+                   workers: int | None = None, scheduler: str | None = None, swings: int = SWINGS,
                    progress: Callable[[int, int], None] | None = None) -> ExportResult:
     """Walk every command of ``grid`` on ``robot`` (a name, robot file or model path) and export its clips.
 
@@ -233,6 +237,8 @@ def export_motions(robot: str, grid: Grid | None = None, out: str | Path = "zmpw
         out: The output folder (made if missing).
         fps: Frame rate of the clips [Hz], in (0, 1000].
         workers: Commands walked at a time (default: one per core).
+        swings: Swings walked per command (a side or turn step is two), at least 6 for a cyclic clip (two swings
+            of start, one gait cycle, two of stop).
         scheduler: A Dask scheduler's address or ``"local"`` (:func:`zmpwalk.sim.sweep.in_pool`).
         progress: Called with commands done and their number.
 
@@ -240,7 +246,8 @@ def export_motions(robot: str, grid: Grid | None = None, out: str | Path = "zmpw
         Every clip's record; the manifest at ``out/manifest.json``.
 
     Raises:
-        InvalidParameterError: ``workers`` < 1, ``fps`` outside (0, 1000] Hz, an empty grid.
+        InvalidParameterError: ``workers`` < 1, ``swings`` outside [1, 200], ``fps`` outside (0, 1000] Hz, an empty
+            grid.
         FileFormatError: ``out`` cannot be made.
     """
     from zmpwalk.robots import loaded_robot
@@ -250,6 +257,8 @@ def export_motions(robot: str, grid: Grid | None = None, out: str | Path = "zmpw
     workers = workers if workers is not None else (os.cpu_count() or 1)
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise InvalidParameterError("workers", workers, "an integer >= 1")
+    if isinstance(swings, bool) or not isinstance(swings, int) or not 1 <= swings <= 200:
+        raise InvalidParameterError("swings", swings, "an integer in [1, 200]")
     if not (math.isfinite(fps) and 0.0 < fps <= 1000.0):
         raise InvalidParameterError("fps", fps, "a frame rate in (0, 1000] Hz")
     commands = grid.commands()
@@ -268,7 +277,7 @@ def export_motions(robot: str, grid: Grid | None = None, out: str | Path = "zmpw
         if progress is not None:
             progress(len(results), len(commands))
 
-    in_pool(export_command, {i: (robot, c, str(folder), float(fps)) for i, c in enumerate(commands)}, workers,
+    in_pool(export_command, {i: (robot, c, str(folder), float(fps), swings) for i, c in enumerate(commands)}, workers,
             record, scheduler)
     clips = [c for i in range(len(commands)) for c in results[i]]
     seconds = time.perf_counter() - started

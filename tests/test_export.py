@@ -1,0 +1,164 @@
+"""zmpwalk export: reference motions in mjlab, LocoMuJoCo, AMP and CSV formats, each replayed and checked.
+
+One export (HUBO's box model, one command, six swings at 0.7 s: about 10 s) is shared by the tests.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import mujoco
+import numpy as np
+import pytest
+
+from zmpwalk.cli import main
+from zmpwalk.errors import InvalidParameterError
+from zmpwalk.export import Grid, export_motions, replay_check
+from zmpwalk.export.amp import read_amp
+from zmpwalk.export.locomujoco import read_locomujoco
+from zmpwalk.export.names import body_names, joint_names, qpos_names
+from zmpwalk.export.verify import MAX_PENETRATION, MAX_SLIDE
+from zmpwalk.robots import loaded_robot
+from zmpwalk.sim.plant import build_plant
+
+FPS = 50.0
+LOCOMUJOCO_KEYS = {"joint_names", "frequency", "body_names", "njnt", "jnt_type", "nbody", "body_rootid",
+                   "body_weldid", "body_mocapid", "body_pos", "body_quat", "body_ipos", "body_iquat", "qpos", "qvel",
+                   "xpos", "xquat", "split_points"}
+
+
+@pytest.fixture(scope="module")
+def exported(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:
+    out = tmp_path_factory.mktemp("motions")
+    status = main(["export", "--robot", "hubo", "--out", str(out), "--forward", "0.15", "--step-time", "0.7",
+                   "--swings", "6", "--workers", "1", "--json"])
+    assert status == 0
+    return out, json.loads((out / "manifest.json").read_text())
+
+
+@pytest.fixture(scope="module")
+def model() -> mujoco.MjModel:
+    return build_plant(loaded_robot("hubo")).model
+
+
+def _clip(manifest: dict[str, Any], kind: str, span: str) -> dict[str, Any]:
+    return next(c for c in manifest["clips"] if c["kind"] == kind and c["span"] == span)
+
+
+def test_manifest_lists_four_verified_clips(exported: tuple[Path, dict[str, Any]]) -> None:
+    out, manifest = exported
+    assert manifest["count"] == 4 and manifest["verified"] == 4
+    assert manifest["quaternion_order"] == "wxyz"
+    for clip in manifest["clips"]:
+        assert clip["verified"] and clip["verdict"] == "PASS"
+        assert clip["command"] == {"forward": 0.15, "side": 0.0, "turn": 0.0, "step_time": 0.7}
+        assert clip["replay"]["slide"] <= MAX_SLIDE and clip["replay"]["penetration"] <= MAX_PENETRATION
+        assert clip["cop_rms"] == pytest.approx(0.015, abs=0.015) and clip["zmp_margin"] > 0.0
+        assert set(clip["files"]) == {"mjlab", "locomujoco", "amp", "csv"}
+        assert all((out / name).is_file() for name in clip["files"].values())
+
+
+def test_cyclic_clip_closes_its_loop(exported: tuple[Path, dict[str, Any]]) -> None:
+    _, manifest = exported
+    planned, simulated = _clip(manifest, "planned", "cyclic"), _clip(manifest, "simulated", "cyclic")
+    assert planned["loop_error"]["joints"] == pytest.approx(0.0, abs=1e-6)
+    assert simulated["loop_error"]["joints"] == pytest.approx(0.0, abs=0.02)
+    assert simulated["loop_error"]["base_height"] == pytest.approx(0.0, abs=0.002)
+    first, last = simulated["loop"]
+    assert first == 0 and last == simulated["frames"] - 1
+    whole = _clip(manifest, "simulated", "whole")
+    assert whole["loop"][1] - whole["loop"][0] == last
+    assert last / FPS == pytest.approx(2 * 0.7, abs=1e-9)  # one gait cycle of two 0.7 s swings
+
+
+def test_mjlab_fields(exported: tuple[Path, dict[str, Any]], model: mujoco.MjModel) -> None:
+    out, manifest = exported
+    clip = _clip(manifest, "simulated", "whole")
+    files = clip["files"]
+    with np.load(out / files["mjlab"]) as npz:
+        n, joints, bodies = clip["frames"], model.njnt - 1, model.nbody - 1
+        assert int(npz["fps"][0]) == 50
+        assert list(npz["joint_names"]) == joint_names(model)[1:] and list(npz["body_names"]) == body_names(model)
+        assert npz["joint_pos"].shape == (n, joints) and npz["joint_vel"].shape == (n, joints)
+        for key, width in (("body_pos_w", 3), ("body_quat_w", 4), ("body_lin_vel_w", 3), ("body_ang_vel_w", 3)):
+            assert npz[key].shape == (n, bodies, width)
+        assert np.abs(np.linalg.norm(npz["body_quat_w"], axis=2) - 1.0).max() < 1e-5
+        qpos, _ = read_locomujoco(str(out / files["locomujoco"]))
+        assert np.abs(npz["body_pos_w"][:, 0] - qpos[:, 0:3]).max() < 1e-5  # the base is body 1
+        assert np.abs(npz["body_quat_w"][:, 0] - qpos[:, 3:7]).max() < 1e-5  # w, x, y, z, as qpos
+        assert np.abs(npz["joint_pos"] - qpos[:, 7:]).max() < 1e-5
+        speed = np.gradient(qpos[:, 0], 1.0 / FPS)
+        assert np.abs(npz["body_lin_vel_w"][:, 0, 0] - speed).max() < 1e-3  # [m/s], central differences
+
+
+def test_locomujoco_fields(exported: tuple[Path, dict[str, Any]], model: mujoco.MjModel) -> None:
+    out, manifest = exported
+    clip = _clip(manifest, "planned", "whole")
+    with np.load(out / clip["files"]["locomujoco"]) as npz:
+        assert set(npz.files) == LOCOMUJOCO_KEYS  # Trajectory.load refuses any other key
+        n = clip["frames"]
+        assert npz["qpos"].shape == (n, model.nq) and npz["qvel"].shape == (n, model.nv)
+        assert npz["xquat"].shape == (n, model.nbody, 4) and float(npz["frequency"]) == FPS
+        assert list(npz["joint_names"]) == joint_names(model) and list(npz["split_points"]) == [0, n]
+        assert list(npz["jnt_type"]) == list(model.jnt_type) and int(npz["njnt"]) == model.njnt
+        assert np.abs(np.linalg.norm(npz["qpos"][:, 3:7], axis=1) - 1.0).max() < 1e-9
+
+
+def test_amp_and_csv_fields(exported: tuple[Path, dict[str, Any]], model: mujoco.MjModel) -> None:
+    out, manifest = exported
+    for span, mode in (("whole", "None"), ("cyclic", "Wrap")):
+        clip = _clip(manifest, "simulated", span)
+        document = json.loads((out / clip["files"]["amp"]).read_text())
+        assert document["LoopMode"] == mode and document["QuaternionOrder"] == "wxyz"
+        assert document["FrameDuration"] == pytest.approx(1 / FPS, abs=1e-12)
+        assert document["FrameLayout"] == qpos_names(model)
+        frames = np.array(document["Frames"])
+        assert frames.shape == (clip["frames"], model.nq)
+        assert np.abs(np.linalg.norm(frames[:, 3:7], axis=1) - 1.0).max() < 1e-6
+        lines = (out / clip["files"]["csv"]).read_text().splitlines()
+        assert lines[0].split(",") == ["time", "root_x", "root_y", "root_z", "root_qw", "root_qx", "root_qy",
+                                       "root_qz", *joint_names(model)[1:]]
+        assert len(lines) == 1 + clip["frames"]
+        assert float(lines[2].split(",")[0]) == pytest.approx(1 / FPS, abs=1e-9)
+
+
+def test_replay_check_passes_a_good_clip_and_fails_a_corrupted_one(exported: tuple[Path, dict[str, Any]],
+                                                                    model: mujoco.MjModel) -> None:
+    out, manifest = exported
+    qpos, fps = read_amp(str(out / _clip(manifest, "planned", "whole")["files"]["amp"]))
+    good = replay_check(model, qpos, fps)
+    assert good.passed and good.phases >= 6 and good.slide <= MAX_SLIDE
+    drifting = qpos.copy()
+    drifting[:, 1] += np.linspace(0.0, 0.2, len(qpos))  # the base drifts 0.2 m sideways (25 mm/s): feet slide
+    slid = replay_check(model, drifting, fps)
+    assert not slid.passed and slid.slide > MAX_SLIDE
+    sunk = qpos.copy()
+    sunk[:, 2] -= 0.004  # 4 mm into the floor: still stance, too deep with the soft contact's own
+    sunk[len(qpos) // 2:, 2] -= 0.004
+    deep = replay_check(model, sunk, fps)
+    assert not deep.passed and deep.penetration == pytest.approx(0.008, abs=0.001)
+
+
+def test_grid_file_and_options(tmp_path: Path) -> None:
+    grid_file = tmp_path / "grid.toml"
+    grid_file.write_text("forward = [0.0, 0.1]\nside = [0.0, 0.05]\nturn = [0.0]\nstep_time = [0.8]\n")
+    grid = Grid.from_toml(grid_file)
+    assert len(grid.commands()) == 4 and grid.commands()[-1].side == 0.05
+    assert main(["export", "--robot", "hubo", "--grid", str(grid_file), "--forward", "0.1"]) == 2
+    with pytest.raises(InvalidParameterError) as error:
+        export_motions("hubo", grid, tmp_path, fps=0.0)
+    assert error.value.parameter == "fps"
+    with pytest.raises(InvalidParameterError) as error:
+        export_motions("hubo", grid, tmp_path, workers=0)
+    assert error.value.parameter == "workers"
+
+
+def test_locomujoco_loads_the_clip(exported: tuple[Path, dict[str, Any]]) -> None:
+    """LocoMuJoCo's own loader, where it is installed (it pins mujoco 3.2.7 and numpy < 2: not here)."""
+    trajectory = pytest.importorskip("loco_mujoco.trajectory")
+    out, manifest = exported
+    clip = _clip(manifest, "simulated", "cyclic")
+    loaded = trajectory.Trajectory.load(str(out / clip["files"]["locomujoco"]), backend=np)
+    assert loaded.info.frequency == FPS and loaded.data.qpos.shape[0] == clip["frames"]
