@@ -39,9 +39,18 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from zmpwalk.errors import InvalidParameterError, UnreachableError, ZmpwalkError
+from zmpwalk.errors import InvalidParameterError, UnreachableError
+from zmpwalk.joint_limits import (  # re-exported (__all__): the columns and their checks live there
+    JOINT_COLUMNS,
+    LEG_JOINTS,
+    JointLimitError,
+    check_joint_limits,
+    check_sole_roll,
+    joint_bounds,
+    virtual_columns,
+)
 from zmpwalk.leg_chain import LegChain
-from zmpwalk.robots.model import JOINT_NAMES, RobotModel
+from zmpwalk.robots.model import RobotModel
 from zmpwalk.slices import Parts, whole
 
 Array = NDArray[np.float64]
@@ -66,50 +75,6 @@ class SampledMotion(Protocol):
     yaw_right_foot_in_world: Array
     yaw_rate_right_foot: Array
     robot: RobotModel
-
-LEG_JOINTS = JOINT_NAMES  # hip_yaw, hip_roll, hip_pitch, knee, ankle_pitch, ankle_roll
-JOINT_COLUMNS = tuple(f"{side}_{joint}" for side in ("left", "right") for joint in LEG_JOINTS)
-
-
-class JointLimitError(ZmpwalkError, ValueError):
-    """A joint angle of a trajectory leaves the robot's joint range.
-
-    Attributes:
-        joint: Column name, e.g. ``"left_knee"``.
-        angle: The angle [rad].
-        time: When [s].
-        limits: (lower, upper) [rad].
-    """
-
-    def __init__(self, joint: str, angle: float, time: float, limits: tuple[float, float]) -> None:
-        self.joint, self.angle, self.time, self.limits = joint, angle, time, limits
-        super().__init__(
-            f"{joint} = {angle:.4f} rad at t = {time:.3f} s is outside its range "
-            f"[{limits[0]:.4f}, {limits[1]:.4f}] rad"
-        )
-
-
-class SoleRollError(JointLimitError):
-    """A five-joint leg's sole would roll further than its virtual ankle roll's range allows: the walk needs an
-    ankle roll the leg does not have (:func:`zmpwalk.leg_chain.sole_roll_bound`).
-
-    Attributes:
-        joint, angle, time, limits: As :class:`JointLimitError`; ``joint`` is the virtual column
-            (``"left_ankle_roll"``), ``angle`` the sole roll the five joints leave, ``limits`` the bound.
-        largest: The largest |sole roll| of the walk [rad].
-    """
-
-    def __init__(self, joint: str, angle: float, time: float, limits: tuple[float, float], largest: float) -> None:
-        super().__init__(joint, angle, time, limits)
-        self.largest = largest
-        leg = joint.split("_", 1)[0]
-        self.args = (
-            f"{joint}: the {leg} leg has 5 joints and no ankle roll; with the pelvis upright over it the walk leaves "
-            f"its sole rolled up to {largest:.4f} rad, beyond the bound [{limits[0]:.4f}, {limits[1]:.4f}] rad from "
-            f"t = {time:.3f} s ({angle:+.4f} rad there; the bound is asin of the sole's half width over the pendulum "
-            "length: the centre of mass moves sideways by l sin(roll), at most half the sole). What is missing: an "
-            "ankle roll joint, or a walk whose pelvis does not sway over its soles",)
-
 
 def rot_x(angle: Array) -> Array:
     """Rotation matrices about x, shape (n, 3, 3)."""
@@ -545,6 +510,7 @@ def joint_trajectory_in_parts(
     if check_limits:  # the joint ranges: parts of their own, each half of the samples (the first sample out
         half = (n + 1) // 2  # of range is the first of the first half that has one, else of the second)
         yield
+        check_sole_roll(time, angles, robot)  # a five-joint leg's sole roll over the whole walk (none: no work)
         check_joint_limits(time[:half], angles[:half], robot)
         yield
         check_joint_limits(time[half:], angles[half:], robot)
@@ -637,58 +603,6 @@ def _base_under_com(position_com_in_world: Array, yaw_pelvis_in_world: Array, fe
     return base, solutions
 
 
-_BOUNDS: dict[int, tuple[dict[str, tuple[float, float]], Array, Array]] = {}  # id(joint_limits) -> bounds
-
-
-def joint_bounds(robot: RobotModel) -> tuple[Array, Array]:
-    """Lower and upper ranges of the columns of :data:`JOINT_COLUMNS` [rad], each (12,) (made once per
-    robot's table of limits: the online check reads them in every block of samples)."""
-    limits = robot.joint_limits
-    cached = _BOUNDS.get(id(limits))
-    if cached is None or cached[0] is not limits:
-        if len(_BOUNDS) > 64:
-            _BOUNDS.clear()
-        cached = (limits, np.array([robot.limits_of(column)[0] for column in JOINT_COLUMNS]),
-                  np.array([robot.limits_of(column)[1] for column in JOINT_COLUMNS]))
-        _BOUNDS[id(limits)] = cached
-    return cached[1], cached[2]
-
-
-def check_joint_limits(time: Array, angles: Array, robot: RobotModel) -> None:
-    """Raise :class:`JointLimitError` for the first sample and joint outside the robot's ranges (a
-    :class:`SoleRollError` where that joint is a five-joint leg's virtual ankle roll)."""
-    lower, upper = joint_bounds(robot)
-    outside = (angles < lower) | (angles > upper)
-    if np.any(outside):
-        sample = int(np.argmax(outside.any(axis=1)))
-        column = int(np.argmax(outside[sample]))
-        limits = (float(lower[column]), float(upper[column]))
-        if column in virtual_columns(robot):
-            raise SoleRollError(JOINT_COLUMNS[column], float(angles[sample, column]), float(time[sample]), limits,
-                                float(np.abs(angles[:, column]).max()))
-        raise JointLimitError(JOINT_COLUMNS[column], float(angles[sample, column]), float(time[sample]), limits)
-
-
-def virtual_columns(robot: RobotModel) -> list[int]:
-    """The joint columns of five-joint legs' virtual ankle rolls (:mod:`zmpwalk.leg_chain`): their angle is the
-    sole roll the leg leaves; no motor turns them."""
-    return [6 * index + chain.virtual_column for index, chain in enumerate(robot.legs or ())
-            if chain.virtual_column is not None]
-
-
-def check_sole_roll(time: Array, angles: Array, robot: RobotModel) -> None:
-    """Raise :class:`SoleRollError` where a five-joint leg's sole roll (its virtual column of ``angles``, (n, 12)
-    [rad]) leaves its range, the first sample outside; nothing for six-joint legs."""
-    lower, upper = joint_bounds(robot)
-    for column in virtual_columns(robot):
-        roll = angles[:, column]
-        outside = (roll < lower[column]) | (roll > upper[column])
-        if np.any(outside):
-            sample = int(np.argmax(outside))
-            raise SoleRollError(JOINT_COLUMNS[column], float(roll[sample]), float(time[sample]),
-                                (float(lower[column]), float(upper[column])), float(np.abs(roll).max()))
-
-
 def pattern_joint_trajectory(pattern: SampledMotion, knee_forward: bool = True,
                              check_limits: bool = True) -> JointTrajectory:
     """Joint angles and velocities of a :class:`~zmpwalk.patterns.result.WalkingPattern` (any generator)."""
@@ -739,3 +653,11 @@ def rest_mass(robot: RobotModel) -> tuple[float, Array]:
     if robot.links:
         return robot.links["torso"].mass, np.array(robot.links["torso"].com)
     return robot.mass, np.zeros(3)
+
+
+__all__ = ["COM_ITERATIONS", "COM_TOLERANCE", "JOINT_COLUMNS", "LEG_JOINTS", "JointLimitError", "JointTrajectory",
+           "Leg", "LegSolution", "SampledMotion", "check_joint_limits", "check_leg_reach",
+           "check_sole_roll", "hip_positions_in_world", "joint_bounds", "joint_trajectory",
+           "joint_trajectory_in_parts", "leg_chains", "leg_fk", "leg_ik", "leg_ik_scalar", "leg_ik_yaw",
+           "leg_ik_yaw_rates", "leg_jacobian", "leg_reach_excess", "pattern_joint_trajectory", "rest_mass", "rot_x",
+           "rot_y", "rot_z", "virtual_columns"]

@@ -391,26 +391,6 @@ class LegChain:
         return _wrap(q), excess
 
 
-def sole_roll_bound(sole_width: float, pendulum_length: float) -> float:
-    r"""The largest sole roll a five-joint leg may leave (its virtual ankle roll's range) [rad].
-
-    A roll ``phi`` of the sole that the leg cannot give either stands the sole on an edge or, with the sole
-    pressed flat, rolls the body above it by ``phi``; either way the centre of mass, ``l`` above the sole, moves
-    sideways from its plan by ``l sin(phi)``. The stabilizer takes that up through the stance sole's centre of
-    pressure only while it stays within the sole's half width ``W / 2``:
-
-    .. math:: |\phi| \le \arcsin\frac{W}{2 l}
-
-    (Unitree H1: 60 mm soles, ``l`` = 0.951 m: 0.0316 rad). ``tests/test_five_joint_legs.py`` rolls a model about
-    its sole's centre line by the bound and finds its CoM moved by ``W / 2``.
-
-    Args:
-        sole_width: ``W`` [m].
-        pendulum_length: ``l``, the CoM's height in the ready posture [m].
-    """
-    return math.asin(min(1.0, sole_width / (2.0 * pendulum_length)))
-
-
 def _pick(solutions: list[tuple[Array, Array]], reference1: float, reference2: float) -> tuple[Array, Array]:
     """The solution pair nearest the reference angles, per sample."""
     cost = np.stack([np.abs(_wrap(a - reference1)) + np.abs(_wrap(b - reference2)) for a, b in solutions])
@@ -431,4 +411,4 @@ def _rotation_vector(rotation: Array) -> Array:
     return np.asarray(vee * scale[:, None], dtype=np.float64)
 
 
-__all__ = ["LegChain", "cross3", "sole_roll_bound"]
+__all__ = ["LegChain", "cross3"]

@@ -162,6 +162,19 @@ def tilt_rotation(roll: float, pitch: float) -> Array:
     return np.array([[cp, sp * sr, sp * cr], [0.0, cr, -sr], [-sp, cp * sr, cp * cr]])
 
 
+def sole_roll_bound(sole_width: float) -> float:
+    r"""The largest roll of a sole that it may be left with by a leg without an ankle roll (a five-joint leg's
+    virtual ankle roll's range) [rad]: the roll about its centre line that keeps the sole a sole, its points within
+    :data:`SOLE_BAND` of one another across its width ``W``,
+
+    .. math:: W \sin\phi \le \mathrm{SOLE\_BAND}, \qquad |\phi| \le \arcsin\frac{\mathrm{SOLE\_BAND}}{W}
+
+    (a sole rolled further stands on an edge: Unitree H1's 60 mm soles, 0.0333 rad). Why a walk needs more than
+    that of a five-joint leg: :mod:`zmpwalk.robots.legs`.
+    """
+    return math.asin(min(1.0, SOLE_BAND / sole_width))
+
+
 def foot_sole(points: Array, up: Array, rotation: Array, position: Array, ankle: Array) -> Sole:
     """The sole of one foot.
 

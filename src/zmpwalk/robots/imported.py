@@ -49,7 +49,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -57,10 +57,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk.errors import FileFormatError
-from zmpwalk.leg_chain import LegChain, sole_roll_bound
-from zmpwalk.robots.collision import collision_points, rigid_bodies
-from zmpwalk.robots.description import ModelPlant
-from zmpwalk.robots.legs import VIRTUAL_PREFIX, FootAtReference, build_leg, leg_joint_ids, segments
+from zmpwalk.leg_chain import LegChain
+from zmpwalk.robots.collision import Sole, collision_points, rigid_bodies, sole_roll_bound
+from zmpwalk.robots.description import Actuator, LegJoint, ModelPlant
+from zmpwalk.robots.legs import VIRTUAL_PREFIX, FootAtReference, Segments, build_leg, leg_joint_ids, segments
 from zmpwalk.robots.model import RobotModel, schedule_scale
 from zmpwalk.robots.pd import element_name, pd_layer
 from zmpwalk.robots.tree import find_feet, floating_base, keyframe_index
@@ -169,7 +169,6 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     base = floating_base(model, source)
     key_id = keyframe_index(model, keyframe, source)
     qpos_reference = model.key_qpos[key_id].copy() if key_id >= 0 else model.qpos0.copy()
-    ctrl_reference = model.key_ctrl[key_id].copy() if key_id >= 0 and model.nu else np.zeros(model.nu)
     data.qpos[:] = qpos_reference
     mujoco.mj_kinematics(model, data)
     foot_ids = find_feet(model, data, base, feet, source)
@@ -177,17 +176,9 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
                          for foot, label in zip(foot_ids, ("left", "right"), strict=True)]
     legs = leg_joint_ids(model, base, foot_ids, source)
     leg_joint_set = {j for leg in legs for j in leg}
-    # Zero pose of the legs, base at the origin: joint axes and anchors are then in the pelvis frame.
-    zero = qpos_reference.copy()
-    for j in leg_joint_set:
-        zero[model.jnt_qposadr[j]] = 0.0
     base_joint = int(model.body_jntadr[base])
     adr = int(model.jnt_qposadr[base_joint])
-    zero[adr:adr + 7] = (0, 0, 0, 1, 0, 0, 0)
-    data.qpos[:] = zero
-    mujoco.mj_kinematics(model, data)
-    base_rotation = data.xmat[base].reshape(3, 3).copy()
-    base_origin = data.xpos[base].copy()
+    base_rotation, base_origin = _zero_pose(model, data, qpos_reference, leg_joint_set, base, adr)
 
     def in_pelvis(point: Array) -> Array:
         return np.asarray(base_rotation.T @ (point - base_origin), dtype=np.float64)
@@ -198,83 +189,158 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
                                                                         strict=True)]
     chains = [chain for chain, _, _ in built]
     leg_joints = [joint for _, joints, _ in built for joint in joints]
-    polygon, right_polygon = built[0][2].polygon, built[1][2].polygon
-    ankle_height = built[0][2].ankle_height
-    # A five-joint leg keeps its sole flat under an upright pelvis only in its own plane: the feet stand there.
-    lateral = [chain.ankle[1] if chain.virtual is not None else chain.hip[1] for chain in chains]
-    hip_spacing = float(lateral[0] - lateral[1])
-    left_hip, right_hip = chains[0].hip, chains[1].hip
-    hip_x = float((left_hip[0] + right_hip[0]) / 2)
-    hip_drop = float(-(left_hip[2] + right_hip[2]) / 2)
-    thigh = float(np.linalg.norm(chains[0].knee_point - left_hip))
-    shank = float(np.linalg.norm(chains[0].ankle - chains[0].knee_point))
-    x_min, y_min = polygon.min(axis=0)
-    x_max, y_max = polygon.max(axis=0)
-    right_width = right_polygon.max(axis=0) - right_polygon.min(axis=0)
-    if abs(right_width[0] - (x_max - x_min)) > 0.01 or abs(right_width[1] - (y_max - y_min)) > 0.01:
-        raise FileFormatError(source, "the two soles differ by more than 10 mm in size; zmpwalk mirrors the "
-                              "left sole for the right foot")
+    geometry = _geometry(chains, (built[0][2], built[1][2]), source)
+    polygon, ankle_height, left_hip = built[0][2].polygon, geometry.ankle_height, chains[0].hip
+    hip_x, hip_spacing, hip_drop = geometry.hip_x, geometry.hip_spacing, geometry.hip_drop
+    thigh, shank = geometry.thigh, geometry.shank
     mass = float(np.sum(model.body_mass))
     values = dict(overrides or {})
-    # Ready posture: hip-to-ankle distance from the keyframe, at most READY_STRETCH of the straight leg.
-    data.qpos[:] = qpos_reference
-    mujoco.mj_kinematics(model, data)
-    key_hip = data.xpos[base] + data.xmat[base].reshape(3, 3) @ left_hip
-    key_foot_bottom = min(float(p[2]) for p in collision_points(model, data, rigid_bodies(model, foot_ids[0])))
-    key_distance = float(key_hip[2] - key_foot_bottom - ankle_height)
-    straight = thigh + shank
-    distance = min(key_distance if key_distance > 0 else straight, READY_STRETCH * straight)
-    height_scale = float(np.max(data.geom_xpos[:, 2]) - key_foot_bottom)
+    distance, height_scale = _reference_reach(model, data, qpos_reference, base, left_hip, foot_ids[0],
+                                              ankle_height, thigh + shank)
     model_name = model.names[:model.names.find(b"\0")].decode()
     robot_name = name or re.sub(r"[^A-Za-z0-9_.-]+", "-", model_name).strip("-") or path.stem
-    held = tuple(element_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in range(model.njnt)
-                 if j not in leg_joint_set and j != base_joint)
-    rest_com = masses.rest_com
-    plant = ModelPlant(path=path.resolve(), base_body=element_name(model, mujoco.mjtObj.mjOBJ_BODY, base),
-                       feet=(element_name(model, mujoco.mjtObj.mjOBJ_BODY, foot_ids[0]),
-                             element_name(model, mujoco.mjtObj.mjOBJ_BODY, foot_ids[1])),
-                       joints=tuple(leg_joints), qpos_reference=tuple(float(v) for v in qpos_reference),
-                       ctrl_reference=tuple(float(v) for v in ctrl_reference), package_paths=package_paths,
-                       sole_polygon=tuple((float(x), float(y)) for x, y in polygon), held_joints=held,
-                       keyframe=element_name(model, mujoco.mjtObj.mjOBJ_KEY, key_id) if key_id >= 0 else None,
-                       rest_mass=masses.rest_mass,
-                       rest_com=(float(rest_com[0]), float(rest_com[1]), float(rest_com[2])))
+    plant = _model_plant(model, path, base, foot_ids, key_id, leg_joint_set | {base_joint}, masses, polygon,
+                         package_paths)
     ready = _ready_posture(model, data, chains, legs, qpos_reference, adr, distance, hip_x, hip_spacing, hip_drop,
                            ankle_height, values.get("pelvis_height"), source)
     pelvis_height, pendulum, com_offset, chains_ready, qpos = ready
     # The joint PD layer: gains from the ready posture's inertia; a leg joint holds the robot, m g l.
     pd_joints = pd_layer(model, data, qpos, leg_joint_set, mass * float(np.linalg.norm(model.opt.gravity)) * pendulum,
                           pd_gains or {})
-    driven = dict(pd_joints)
-    leg_joints = [replace(joint, actuator=driven.get(joint.name, joint.actuator)) for joint in leg_joints]
-    # A five-joint leg's virtual ankle roll: the sole roll it may leave (zmpwalk.leg_chain.sole_roll_bound).
-    bound = sole_roll_bound(float(y_max - y_min), pendulum)
-    leg_joints = [replace(joint, limits=(-bound, bound)) if joint.name.startswith(VIRTUAL_PREFIX) else joint
-                  for joint in leg_joints]
+    leg_joints = _driven_joints(leg_joints, dict(pd_joints), geometry)
     plant = replace(plant, joints=tuple(leg_joints), pd_joints=pd_joints)
-    # The HUBO tables scaled to this robot (docs/robot-import.md): times with sqrt(l/g), strides and foot lift
-    # with the leg length, sway and V_y with the hip spacing.
-    time_scale, length_scale, lateral_scale = schedule_scale(pendulum, thigh + shank, hip_spacing)
+    return _robot_model(
+        name=robot_name, description=f"imported from {path.name} ({mass:.1f} kg)", mass=mass, height=height_scale,
+        geometry=geometry, pelvis_height=pelvis_height, pendulum=pendulum, gravity=float(-model.opt.gravity[2]),
+        overrides=values, leg_joints=leg_joints, com_offset=com_offset, legs=(chains_ready[0], chains_ready[1]),
+        plant=plant)
+
+
+def _zero_pose(model: Any, data: Any, qpos_reference: Array, leg_joints: set[int], base: int,
+               adr: int) -> tuple[Array, Array]:
+    """Put ``data`` at the zero pose of the legs, the base at the origin (the rest of the body at the reference):
+    joint axes and anchors are then in the pelvis frame. Returns the base's rotation and origin there."""
+    import mujoco
+
+    zero = qpos_reference.copy()
+    for j in leg_joints:
+        zero[model.jnt_qposadr[j]] = 0.0
+    zero[adr:adr + 7] = (0, 0, 0, 1, 0, 0, 0)
+    data.qpos[:] = zero
+    mujoco.mj_kinematics(model, data)
+    return data.xmat[base].reshape(3, 3).copy(), data.xpos[base].copy()
+
+
+def _reference_reach(model: Any, data: Any, qpos_reference: Array, base: int, hip: Array, foot: int,
+                     ankle_height: float, straight: float) -> tuple[float, float]:
+    """The ready posture's hip-to-ankle distance [m], the keyframe's, at most :data:`READY_STRETCH` of the
+    ``straight`` leg, and the robot's height above its sole in the reference posture [m] (``data`` left there)."""
+    import mujoco
+
+    data.qpos[:] = qpos_reference
+    mujoco.mj_kinematics(model, data)
+    key_hip = data.xpos[base] + data.xmat[base].reshape(3, 3) @ hip
+    key_foot_bottom = min(float(p[2]) for p in collision_points(model, data, rigid_bodies(model, foot)))
+    key_distance = float(key_hip[2] - key_foot_bottom - ankle_height)
+    distance = min(key_distance if key_distance > 0 else straight, READY_STRETCH * straight)
+    return distance, float(np.max(data.geom_xpos[:, 2]) - key_foot_bottom)
+
+
+def _driven_joints(joints: list[LegJoint], driven: dict[str, Actuator], geometry: _Geometry) -> list[LegJoint]:
+    """The leg joints with the PD layer's actuators where it drives them, and a five-joint leg's virtual ankle roll
+    with its range, the sole roll it may leave (:func:`zmpwalk.robots.collision.sole_roll_bound`)."""
+    bound = sole_roll_bound(geometry.sole_box[3] - geometry.sole_box[1])
+    joints = [replace(joint, actuator=driven.get(joint.name, joint.actuator)) for joint in joints]
+    return [replace(joint, limits=(-bound, bound)) if joint.name.startswith(VIRTUAL_PREFIX) else joint
+            for joint in joints]
+
+
+def _model_plant(model: Any, path: Path, base: int, feet: list[int], key_id: int, leg_joints: set[int],
+                 masses: Segments, polygon: Array, package_paths: tuple[Path, ...]) -> ModelPlant:
+    """What the simulation needs of the model (its leg joints and PD layer are filled in later): every joint but
+    ``leg_joints`` (the legs' and the base's) is held at the reference pose."""
+    import mujoco
+
+    def name(kind: Any, index: int) -> str:
+        return element_name(model, kind, index)
+
+    qpos = model.key_qpos[key_id] if key_id >= 0 else model.qpos0
+    ctrl = model.key_ctrl[key_id] if key_id >= 0 and model.nu else np.zeros(model.nu)
+    rest_com = masses.rest_com
+    return ModelPlant(
+        path=path.resolve(), base_body=name(mujoco.mjtObj.mjOBJ_BODY, base),
+        feet=(name(mujoco.mjtObj.mjOBJ_BODY, feet[0]), name(mujoco.mjtObj.mjOBJ_BODY, feet[1])), joints=(),
+        qpos_reference=tuple(float(v) for v in qpos), ctrl_reference=tuple(float(v) for v in ctrl),
+        package_paths=package_paths, sole_polygon=tuple((float(x), float(y)) for x, y in polygon),
+        held_joints=tuple(name(mujoco.mjtObj.mjOBJ_JOINT, j) for j in range(model.njnt) if j not in leg_joints),
+        keyframe=name(mujoco.mjtObj.mjOBJ_KEY, key_id) if key_id >= 0 else None, rest_mass=masses.rest_mass,
+        rest_com=(float(rest_com[0]), float(rest_com[1]), float(rest_com[2])))
+
+
+@dataclass(frozen=True)
+class _Geometry:
+    """The leg geometry and the sole that the robot model keeps (lengths [m]): the hips' mean x, spacing and
+    drop below the base origin, the left thigh and shank, the ankle height and the left sole's bounding
+    rectangle (x_min, y_min, x_max, y_max) in the sole frame."""
+
+    hip_x: float
+    hip_spacing: float
+    hip_drop: float
+    thigh: float
+    shank: float
+    ankle_height: float
+    sole_box: tuple[float, float, float, float]
+
+
+def _geometry(chains: list[LegChain], soles: tuple[Sole, Sole], source: str) -> _Geometry:
+    """:class:`_Geometry` of the two legs.
+
+    Raises:
+        FileFormatError: The two soles differ by more than 10 mm in length or width.
+    """
+    # A five-joint leg keeps its sole flat under an upright pelvis only in its own plane: the feet stand there.
+    lateral = [chain.ankle[1] if chain.virtual is not None else chain.hip[1] for chain in chains]
+    left_hip, right_hip = chains[0].hip, chains[1].hip
+    x_min, y_min = soles[0].polygon.min(axis=0)
+    x_max, y_max = soles[0].polygon.max(axis=0)
+    right_width = soles[1].polygon.max(axis=0) - soles[1].polygon.min(axis=0)
+    if abs(right_width[0] - (x_max - x_min)) > 0.01 or abs(right_width[1] - (y_max - y_min)) > 0.01:
+        raise FileFormatError(source, "the two soles differ by more than 10 mm in size; zmpwalk mirrors the "
+                              "left sole for the right foot")
+    return _Geometry(
+        hip_x=float((left_hip[0] + right_hip[0]) / 2), hip_spacing=float(lateral[0] - lateral[1]),
+        hip_drop=float(-(left_hip[2] + right_hip[2]) / 2), thigh=float(np.linalg.norm(chains[0].knee_point - left_hip)),
+        shank=float(np.linalg.norm(chains[0].ankle - chains[0].knee_point)), ankle_height=soles[0].ankle_height,
+        sole_box=(float(x_min), float(y_min), float(x_max), float(y_max)))
+
+
+def _robot_model(*, name: str, description: str, mass: float, height: float, geometry: _Geometry,
+                 pelvis_height: float, pendulum: float, gravity: float, overrides: dict[str, float],
+                 leg_joints: list[LegJoint], com_offset: Array, legs: tuple[LegChain, LegChain],
+                 plant: ModelPlant) -> RobotModel:
+    """The robot model: derived values (the robot file's ``overrides`` replacing them), the joint ranges by column,
+    and the HUBO tables scaled to this robot (docs/robot-import.md): times with sqrt(l/g), strides and foot lift
+    with the leg length, sway and V_y with the hip spacing."""
+    g = geometry
+    x_min, y_min, x_max, y_max = g.sole_box
+    time_scale, length_scale, lateral_scale = schedule_scale(pendulum, g.thigh + g.shank, g.hip_spacing)
     limits = {f"{'left' if i < 6 else 'right'}_{joint.role}": joint.limits for i, joint in enumerate(leg_joints)}
     fields_: dict[str, Any] = {
-        "name": robot_name,
-        "description": f"imported from {path.name} ({mass:.1f} kg)",
-        "mass": mass, "height": height_scale, "hip_spacing": hip_spacing, "hip_drop": hip_drop,
-        "thigh_length": thigh, "shank_length": shank, "ankle_height": ankle_height,
-        "foot_length": float(x_max - x_min), "foot_width": float(y_max - y_min),
-        "sole_center_x": float((x_max + x_min) / 2), "sole_center_y": float((y_max + y_min) / 2),
-        "pelvis_height": pelvis_height, "pendulum_length": pendulum, "min_knee": 0.05,
-        "dsp_time": 0.1 * time_scale, "foot_lift": 0.04 * length_scale, "lateral_velocity": 0.1 * lateral_scale,
-        "gravity": float(-model.opt.gravity[2]),
+        "name": name, "description": description, "mass": mass, "height": height, "hip_spacing": g.hip_spacing,
+        "hip_drop": g.hip_drop, "thigh_length": g.thigh, "shank_length": g.shank, "ankle_height": g.ankle_height,
+        "foot_length": x_max - x_min, "foot_width": y_max - y_min, "sole_center_x": (x_max + x_min) / 2,
+        "sole_center_y": (y_max + y_min) / 2, "pelvis_height": pelvis_height, "pendulum_length": pendulum,
+        "min_knee": 0.05, "dsp_time": 0.1 * time_scale, "foot_lift": 0.04 * length_scale,
+        "lateral_velocity": 0.1 * lateral_scale, "gravity": gravity,
     }
-    for key, value in values.items():
+    for key, value in overrides.items():
         if key in fields_:
             fields_[key] = value
     return RobotModel(
-        **fields_, joint_limits=limits, hip_x=hip_x, com_offset=(float(com_offset[0]), float(com_offset[1])),
-        legs=(chains_ready[0], chains_ready[1]), plant=plant,
-        schedule_scale=(time_scale, length_scale, lateral_scale),
-        foot_speed_limit=values.get("foot_speed_limit"), foot_acceleration_limit=values.get("foot_acceleration_limit"),
+        **fields_, joint_limits=limits, hip_x=g.hip_x, com_offset=(float(com_offset[0]), float(com_offset[1])),
+        legs=legs, plant=plant, schedule_scale=(time_scale, length_scale, lateral_scale),
+        foot_speed_limit=overrides.get("foot_speed_limit"),
+        foot_acceleration_limit=overrides.get("foot_acceleration_limit"),
     )
 
 

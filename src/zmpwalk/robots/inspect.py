@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from zmpwalk.kinematics import JOINT_COLUMNS
+from zmpwalk.robots.collision import tilt_of
 from zmpwalk.robots.description import PD_BANDWIDTH, PD_DAMPING_RATIO, PD_LOAD_STIFFNESS, Actuator
 from zmpwalk.robots.model import RobotModel
 
@@ -47,6 +48,9 @@ def robot_summary(robot: RobotModel, statics: StaticTorques | None = None) -> di
         summary["held_joints"] = list(plant.held_joints)
         summary["sole_polygon"] = [list(p) for p in plant.sole_polygon]
         summary["ik"] = {chain.label: ("closed form" if chain.closed_form else "numeric") for chain in robot.legs}
+        summary["sole_tilt"] = {chain.label: {"zero": list(tilt_of(chain.sole_rotation[:, 2])),
+                                              "reference": list(chain.sole_tilt_reference)} for chain in robot.legs}
+        summary["five_joint"] = {chain.label: chain.virtual is not None for chain in robot.legs}
         summary["hip_axes_offset"] = {chain.label: chain.hip_axes_offset for chain in robot.legs}
         summary["ankle_axes_offset"] = {chain.label: chain.ankle_axes_offset for chain in robot.legs}
         summary["joints"] = [
@@ -63,6 +67,29 @@ def robot_summary(robot: RobotModel, statics: StaticTorques | None = None) -> di
                                           "on_left": float(statics.on_left[i]), "on_right": float(statics.on_right[i])}
             summary["static_torque_over_limit"] = statics.over_limit
     return summary
+
+
+def _ankle_words(summary: dict[str, Any], leg: str) -> str:
+    """How far apart a leg's ankle axes are, or that it has none to roll (a five-joint leg, with the bound on
+    the sole roll it may leave)."""
+    if not summary["five_joint"][leg]:
+        return f"ankle {summary['ankle_axes_offset'][leg] * 1e3:.1f} mm"
+    column = next(joint for joint in summary["joints"] if joint["column"] == f"{leg}_ankle_roll")
+    return f"5 joints: no ankle roll, the sole roll the IK leaves within {column['limits'][1]:.4f} rad"
+
+
+def _tilt_line(summary: dict[str, Any]) -> str:
+    """The soles' tilt (roll, pitch) [rad] at zero joint angles and in the reference posture."""
+    tilts = summary["sole_tilt"]
+
+    def pair(values: list[float]) -> str:
+        return "(" + ", ".join(f"{round(v, 4) + 0.0:+.4f}" for v in values) + ")"  # no "-0.0000"
+
+    return ("sole tilt (roll, pitch) [rad]: at zero angles " + ", ".join(f"{leg} {pair(t['zero'])}" for leg, t in
+                                                                       tilts.items())
+            + f"; in the reference posture ({summary['keyframe'] or 'zero pose'}) "
+            + ", ".join(f"{leg} {pair(t['reference'])}" for leg, t in tilts.items())
+            + " (the IK keeps the sole frame level)")
 
 
 def _actuator_summary(actuator: Actuator) -> dict[str, Any]:
@@ -99,8 +126,9 @@ def robot_table(robot: RobotModel, statics: StaticTorques | None = None) -> str:
         "HUBO tables scaled by: time x{:.3f}, stride x{:.3f}, lateral x{:.3f}".format(*robot.schedule_scale),
     ]
     if "joints" in s:
-        lines.append("IK: " + ", ".join(f"{k} {v} (hip axes {s['hip_axes_offset'][k] * 1e3:.1f} mm apart, ankle "
-                                        f"{s['ankle_axes_offset'][k] * 1e3:.1f} mm)" for k, v in s["ik"].items()))
+        lines.append("IK: " + ", ".join(f"{k} {v} (hip axes {s['hip_axes_offset'][k] * 1e3:.1f} mm apart, "
+                                        + _ankle_words(s, k) + ")" for k, v in s["ik"].items()))
+        lines.append(_tilt_line(s))
         lines.append("")
         lines += _joint_lines(s["joints"], statics)
         if any(joint["actuator"] and joint["actuator"]["pd_layer"] for joint in s["joints"]) or s["pd_joints"]:

@@ -10,7 +10,38 @@ anchor, at the sole's mid-width), the line about which a foot that cannot roll a
 joints cannot give as its angle (:mod:`zmpwalk.leg_chain`); the sole's centre line stays where the pattern puts
 it, so a foot rolled on it stands where planned. The simulation and the stabilizer send nothing to it. Its joint
 column keeps zmpwalk's 12-column layout (left leg then right, role order), its range the sole roll a walk may
-leave (:func:`zmpwalk.leg_chain.sole_roll_bound`).
+leave (:func:`zmpwalk.robots.collision.sole_roll_bound`).
+
+**Why a five-joint leg cannot walk a pattern with a flat sole and an upright pelvis.** With the hip yaw at 0 the
+sole's rotation in the pelvis frame is ``R_x(q_2) R_y(q_3 + q_4 + q_5)``: a level sole under an upright pelvis
+needs ``q_2 = 0``, and the leg then hangs in its own vertical plane, the ankle a fixed ``d`` beside the hip roll
+axis (Unitree H1: 115.4 mm, its ankles 405.7 mm apart). The pelvis cannot move sideways over a sole: what the
+walking pattern asks (its CoM over the stance sole, the ZMP in it) needs one of
+
+(a) the pelvis rolled by ``phi``: the hip roll axis, ``h`` below the pelvis origin (H1: 174.2 mm), then moves the
+    origin by ``h sin(phi)`` over the fixed leg plane, so a sway ``s`` needs ``sin(phi) = s / h``, four to five
+    times the sole roll of (b). On H1's walks (the three example steps files): 0.45-0.50 rad in single support
+    with the polynomial generator, up to 0.9 rad with the preview generator, where some samples have none; in
+    double support the two legs need rolls up to 0.15-0.36 rad apart, so no pelvis roll keeps both soles flat;
+    the hip rolls' range is 0.43 rad. It does not fit;
+
+(b) the sole rolled by ``rho``, the leg inclined across: ``L sin(rho) = s`` with ``L`` the hip-to-sole height
+    (about 0.9 m): the inverse kinematics meets the sole's centre line, heading and pitch and leaves that roll, the
+    virtual joint's angle. On H1's walks: up to 0.110-0.146 rad (polynomial), 0.216-0.235 rad (preview).
+
+(b) is what zmpwalk computes: it needs the smaller angle and exists at every sample. A rolled sole stands on an
+edge, though: a walk is accepted only where the roll stays within the band that makes the sole a sole
+(:func:`~zmpwalk.robots.collision.sole_roll_bound`, H1: 0.0333 rad), and a walk beyond it raises
+:class:`~zmpwalk.kinematics.JointLimitError` (its ``sole_roll`` set), naming the ankle roll it lacks.
+
+Measured, with the bound lifted: H1 (whose heel-to-toe capsules let it roll on the sole's centre line) sways in
+double support with its soles rolled up to 0.2 rad and its torso within 0.003-0.016 rad of upright, and falls in
+all six walks once single supports begin: at 3.8-4.2 s with the polynomial generator (whose plan, HUBO's sway
+scaled to H1's 406 mm stance, also leaves the soles by 92-102 mm) and at 5.7-9.4 s with the preview generator
+(plan inside by 18-21 mm), CoP - ZMP RMS 136-217 mm: on the line it rolls on, its centre of pressure cannot move
+sideways, and nothing brakes the sway; a synthetic biped with flat 140 mm box soles keeps them flat and rolls its
+torso instead (0.058 rad for a 0.084 rad sole roll), its CoM never reaches the stance sole, and it falls at 4.6 s
+(``tests/test_five_joint_legs.py``).
 """
 
 from __future__ import annotations

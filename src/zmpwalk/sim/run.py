@@ -286,8 +286,8 @@ def simulate(
 
     Raises:
         InvalidParameterError: Mismatched inputs or a robot without simulation data.
-        SoleRollError: A five-joint leg's sole would roll beyond its bound (:func:`zmpwalk.kinematics.check_sole_roll`:
-            the walk needs an ankle roll the leg does not have).
+        JointLimitError: A five-joint leg's sole would roll beyond its bound (``sole_roll`` set:
+            :func:`zmpwalk.kinematics.check_sole_roll`; the walk needs an ankle roll the leg does not have).
     """
     if len(joints.time) != len(pattern.time) or len(pattern.time) < 2:
         raise InvalidParameterError("joints", len(joints.time), f"{len(pattern.time)} samples, as the pattern")
