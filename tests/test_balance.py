@@ -426,6 +426,7 @@ def test_stabilizer_carries_hubo_on_soft_servos() -> None:
     assert closed.end_attitude_range < 0.01  # [rad]
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not TALOS.is_file(), reason="../shared/robots is absent")
 def test_talos_walks_with_its_own_servos_and_the_stabilizer() -> None:
     from zmpwalk.sim import simulate
@@ -505,6 +506,7 @@ def test_servos_softer_than_kappa_m_g_l_get_an_encoder_loop_of_that_stiffness() 
     assert with_loop[3] - without[3] > 0.04  # [rad] the knee's target moves on, towards the sag's side
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not T1.is_file(), reason="../shared/robots is absent")
 def test_booster_t1_walks_ten_steps_on_its_own_servos_with_the_stabilizer() -> None:
     """Booster T1's 75 N m/rad servos, its own model: 10 steps of 10 cm at 0.9 s (the HUBO tables scaled),

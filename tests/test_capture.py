@@ -141,6 +141,7 @@ def test_a_backward_push_steps_back(hubo, walk):
     assert plan.dcm_touchdown[0] < plan.dcm_start[0] < plan.zmp_stance[0] + 1e-12
 
 
+@pytest.mark.slow
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(dx=st.floats(-0.25, 0.25), dy=st.floats(-0.2, 0.2))
 def test_any_capture_keeps_the_zmp_in_the_feet_and_the_legs_in_reach(hubo, walk, dx, dy):
@@ -184,6 +185,7 @@ def test_bad_input_is_rejected(hubo, walk):
         CaptureSettings(foot_speed=0.0)
 
 
+@pytest.mark.slow
 def test_a_backward_push_is_survived_with_a_capture_step_and_not_without(hubo, walk):
     """HUBO pushed backward with 36 N s mid single support (``bench/bench_robustness.py``'s case): with the
     stabilizer alone it falls; with capture steps it steps back, comes to rest and ends with its feet where the

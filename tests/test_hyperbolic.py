@@ -134,6 +134,7 @@ def test_paper_walk_agrees_with_numerical_integration_and_is_continuous(mju):
     assert zmps == pytest.approx([0.0625, 0.075, 0.1125, 0.125], abs=1e-12)
 
 
+@pytest.mark.slow
 @settings(max_examples=40, deadline=None)
 @given(st.lists(st.tuples(st.floats(0.0, 0.04), st.sampled_from([0.55, 0.6, 0.7, 0.8])), min_size=2, max_size=8))
 def test_random_stride_sequences_are_continuous_and_solve_the_pendulum(mju, steps):

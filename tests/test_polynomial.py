@@ -190,6 +190,7 @@ def assert_continuous(robot, stages):
     np.testing.assert_allclose(exact[1], right[1], atol=VELOCITY_TOL, rtol=0)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("pelvis", ["cubic", "hyperbolic"])
 @settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(step_commands(), min_size=10, max_size=16))
@@ -292,6 +293,7 @@ def _rigid(pose_from, pose_to):
     return pose_to[2] - pose_from[2], np.array([c * dx + s * dy, -s * dx + c * dy])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("stride, turn", [(0.2, 0.0), (0.0, 0.15), (0.1, 0.1)])
 def test_no_drift_after_ten_thousand_steps(hubo, schedule, stride, turn):
     """Every command repeats the same rigid motion of the stance, so step N is known in closed form."""
@@ -371,6 +373,7 @@ def _zmp_and_acceleration(samples):
     return np.hstack([samples.zmp_xy, samples.pelvis_acceleration_xy])
 
 
+@pytest.mark.slow
 @settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(step_commands(), min_size=10, max_size=16))
 def test_quintic_pelvis_keeps_the_cart_table_zmp_continuous_for_random_command_sequences(hubo, schedule,

@@ -219,6 +219,7 @@ def test_noisy_delayed_sensors_reach_the_stabilizer_and_bad_noise_is_rejected():
     assert not np.array_equal(runs[0].joint_angles, runs[2].joint_angles)  # the noise reaches the loop
 
 
+@pytest.mark.slow
 def test_a_sweep_on_two_processes_gives_the_walks_of_one():
     """zmpwalk.sim.sweep: the same figures whether the walks run in a process pool or one after the other."""
     from zmpwalk.sim.sweep import sweep
@@ -233,6 +234,7 @@ def test_a_sweep_on_two_processes_gives_the_walks_of_one():
         assert a.simulated > 5.0 and a.passed  # both walks stand at the end (verdict)
 
 
+@pytest.mark.slow
 def test_a_sweep_on_a_local_dask_cluster_gives_the_walks_of_one_process():
     """Past one machine the same jobs run on Dask (here a local cluster of two processes)."""
     pytest.importorskip("dask.distributed")
@@ -259,12 +261,13 @@ def test_a_bad_dask_scheduler_or_no_dask_is_one_clear_error(monkeypatch):
         sweep("hubo", ["fig10", "turn45"], workers=2, scheduler="local")
 
 
+@pytest.mark.slow
 def test_sweep_cli_exit_status_follows_the_verdicts(capsys):
     from zmpwalk.cli import EXIT_FAILED, main
 
     assert main(["sweep", "--scenario", "turn45", "--workers", "1"]) == 0
     assert "turn45" in capsys.readouterr().out
-    assert main(["sweep", "--scenario", "fig27", "--workers", "1", "--balance", "off"]) == EXIT_FAILED  # open loop falls
+    assert main(["sweep", "--scenario", "fig27", "--workers", "1", "--balance", "off"]) == EXIT_FAILED  # falls
     assert main(["sweep", "--scenario", "nope"]) == 2
     assert "unknown scenario 'nope'" in capsys.readouterr().err
 
@@ -277,6 +280,7 @@ def test_a_sweep_reports_a_walk_its_generator_cannot_plan_instead_of_failing():
     assert not result.passed and result.failed == ("planned",) and "ZMP" in result.error
 
 
+@pytest.mark.slow
 def test_a_sweep_walks_a_tuned_schedule_and_the_quintic_pelvis():
     from pathlib import Path
 

@@ -13,6 +13,8 @@ from zmpwalk.errors import ZmpwalkError
 from zmpwalk.schedule import Schedule
 from zmpwalk.tune import Condition, conditions_of, hubo_schedule_data, margins, row_values, schedule_toml, tune
 
+pytestmark = pytest.mark.slow  # every test here runs Optuna studies and MuJoCo walks
+
 SLOW_ROW = Condition("forward", 0.7, 0.2)  # Table 2's 0.7 s row: its ZMP leaves the sole with the paper's values
 
 

@@ -31,6 +31,7 @@ def test_a_too_long_stride_at_0_4_s_on_hubo_fails_and_exits_non_zero(tmp_path: P
     assert by_name["no fall"]["text"].startswith("fell after ")
 
 
+@pytest.mark.slow
 def test_the_small_biped_on_hubo_tables_fails_in_the_report(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """Open loop the small biped falls on HUBO's fig30 tables (its pattern leaves the soles by 18 mm); the
     report shows it red and exits 3. (With the stabilizer it now walks them: docs/simulation.md.)"""
@@ -119,6 +120,7 @@ FAST = "[[steps]]\nduration = 0.7\nforward = 0.2\nrepeat = 4\n"
 PAPER = ["--schedule", "paper"]  # Tables 2-3 as printed, V_y 0.1 m at 0.7 s: the plan leaves the soles
 
 
+@pytest.mark.slow
 def test_a_plan_outside_the_soles_fails_the_verdict_and_simulate_says_outside(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """The plan's cart-table ZMP is 12.7 mm outside the soles (zmpwalk plan, docs/zmp-margins.md): the verdict
@@ -201,6 +203,7 @@ def test_warnings_keep_a_passing_walk_off_green() -> None:
 T1 = Path(__file__).resolve().parents[2] / "shared" / "robots" / "booster_t1" / "scene.xml"
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not T1.is_file(), reason="../shared/robots is absent")
 def test_booster_t1_on_hubos_scaled_tables_is_not_a_pass(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """10 steps of 0.1 m at 0.9 s (docs/robot-import.md): it walks, but its plan's ZMP is 8.6 mm outside the
