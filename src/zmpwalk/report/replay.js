@@ -122,10 +122,45 @@
     return group;
   }
   function disc(color, z) {
-    var mesh = new THREE.Mesh(new THREE.CircleGeometry(0.018 * payload.height, 24),
+    var mesh = new THREE.Mesh(new THREE.CircleGeometry(0.025 * payload.height, 24),
                               new THREE.MeshBasicMaterial({ color: color, depthTest: false }));
     mesh.position.z = z; mesh.renderOrder = 2;
     return mesh;
+  }
+
+  function ground(scene) {  // the floor with a 10 cm grid, the planned and the measured footprints
+    var H = payload.height, lo = [Infinity, Infinity], hi = [-Infinity, -Infinity];
+    var prints = payload.footprints.planned.concat(payload.footprints.measured);
+    prints.forEach(function (p) { p.corners.forEach(function (c) {
+      lo = [Math.min(lo[0], c[0]), Math.min(lo[1], c[1])]; hi = [Math.max(hi[0], c[0]), Math.max(hi[1], c[1])];
+    }); });
+    var centre = [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2], span = Math.max(hi[0] - lo[0], hi[1] - lo[1], H) + 2 * H;
+    var floor = new THREE.Mesh(new THREE.PlaneGeometry(span, span), new THREE.MeshLambertMaterial({ color: 0xd9dde2 }));
+    floor.position.set(centre[0], centre[1], 0); scene.add(floor);
+    var grid = new THREE.GridHelper(span, Math.round(span / 0.1), 0xaab0b8, 0xc4c9cf);
+    grid.rotation.x = Math.PI / 2; grid.position.set(centre[0], centre[1], 0.0005); scene.add(grid);
+    payload.footprints.planned.forEach(function (p) { scene.add(sole(p.corners, 0.001, 0x666666, 0.25)); });
+    var landed = payload.footprints.measured.map(function (p) {  // shown from the time the sole landed there
+      var print = sole(p.corners, 0.002, 0xd62728, 0.2); print.userData.t = p.t; scene.add(print);
+      return print;
+    });
+    section.setAttribute("data-footprints-planned", String(payload.footprints.planned.length));
+    section.setAttribute("data-footprints-measured", String(payload.footprints.measured.length));
+    return { centre: centre, landed: landed };
+  }
+  function robot(scene) {  // a group per body holding its geoms at their local poses
+    var bodies = [];
+    for (var b = 0; b < nb; b++) { bodies.push(new THREE.Group()); scene.add(bodies[b]); }
+    payload.geoms.forEach(function (geom) {
+      var c = geom.rgba, material = new THREE.MeshLambertMaterial(
+        { color: new THREE.Color(c[0], c[1], c[2]), transparent: c[3] < 1, opacity: c[3] });
+      var mesh = new THREE.Mesh(geometry(geom), material);
+      mesh.position.set(geom.pos[0], geom.pos[1], geom.pos[2]);
+      mesh.quaternion.set(geom.quat[1], geom.quat[2], geom.quat[3], geom.quat[0]);
+      bodies[geom.body].add(mesh);
+    });
+    section.setAttribute("data-geoms", String(payload.geoms.length));
+    return bodies;
   }
 
   function makeView() {
@@ -138,40 +173,17 @@
     scene.background = new THREE.Color(0xe8ecf0);
     scene.add(new THREE.HemisphereLight(0xffffff, 0x888888, 1.6));
     var sun = new THREE.DirectionalLight(0xffffff, 1.4); sun.position.set(2, -3, 5); scene.add(sun);
-    var H = payload.height, lo = [Infinity, Infinity], hi = [-Infinity, -Infinity];
-    var prints = payload.footprints.planned.concat(payload.footprints.measured);
-    prints.forEach(function (p) { p.corners.forEach(function (c) {
-      lo = [Math.min(lo[0], c[0]), Math.min(lo[1], c[1])]; hi = [Math.max(hi[0], c[0]), Math.max(hi[1], c[1])];
-    }); });
-    var centre = [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2], span = Math.max(hi[0] - lo[0], hi[1] - lo[1], H) + 2 * H;
-    var floor = new THREE.Mesh(new THREE.PlaneGeometry(span, span), new THREE.MeshLambertMaterial({ color: 0xd9dde2 }));
-    floor.position.set(centre[0], centre[1], 0); scene.add(floor);
-    var grid = new THREE.GridHelper(span, Math.round(span / 0.1), 0xaab0b8, 0xc4c9cf);
-    grid.rotation.x = Math.PI / 2; grid.position.set(centre[0], centre[1], 0.0005); scene.add(grid);
-    payload.footprints.planned.forEach(function (p) { scene.add(sole(p.corners, 0.001, 0x666666, 0.25)); });
-    payload.footprints.measured.forEach(function (p) { scene.add(sole(p.corners, 0.002, 0xd62728, 0.2)); });
-    section.setAttribute("data-footprints-planned", String(payload.footprints.planned.length));
-    section.setAttribute("data-footprints-measured", String(payload.footprints.measured.length));
+    var H = payload.height, floor = ground(scene), landed = floor.landed, centre = floor.centre;
     var zmpDisc = disc(0x1f77b4, 0.003), copDisc = disc(0xd62728, 0.004);
     scene.add(zmpDisc); scene.add(copDisc);
-    var bodies = [];
-    for (var b = 0; b < nb; b++) { bodies.push(new THREE.Group()); scene.add(bodies[b]); }
-    payload.geoms.forEach(function (geom) {
-      var c = geom.rgba, material = new THREE.MeshLambertMaterial(
-        { color: new THREE.Color(c[0], c[1], c[2]), transparent: c[3] < 1, opacity: c[3] });
-      var mesh = new THREE.Mesh(geometry(geom), material);
-      mesh.position.set(geom.pos[0], geom.pos[1], geom.pos[2]);
-      mesh.quaternion.set(geom.quat[1], geom.quat[2], geom.quat[3], geom.quat[0]);
-      bodies[geom.body].add(mesh);
-    });
-    section.setAttribute("data-geoms", String(payload.geoms.length));
+    var bodies = robot(scene);
     var camera = new THREE.PerspectiveCamera(40, box.clientWidth / box.clientHeight, 0.01, 100);
     camera.up.set(0, 0, 1);
     var orbit = { azimuth: -1.2, elevation: 0.25, distance: 2.1 * H, target: new THREE.Vector3() };
     var frame = 0;
     function place() {
-      if (state.follow) orbit.target.set(base[3 * frame], base[3 * frame + 1], 0.5 * payload.pelvis_height);
-      else orbit.target.set(centre[0], centre[1], 0.5 * payload.pelvis_height);
+      if (state.follow) orbit.target.set(base[3 * frame], base[3 * frame + 1], 0.45 * H);
+      else orbit.target.set(centre[0], centre[1], 0.45 * H);
       var ce = Math.cos(orbit.elevation), d = orbit.distance;
       camera.position.set(orbit.target.x + d * ce * Math.cos(orbit.azimuth),
                           orbit.target.y + d * ce * Math.sin(orbit.azimuth), orbit.target.z + d * Math.sin(orbit.elevation));
@@ -204,6 +216,9 @@
         }
         zmpDisc.position.x = zmp[2 * k]; zmpDisc.position.y = zmp[2 * k + 1];
         copDisc.visible = isFinite(cop[2 * k]);
+        var shown = 0;
+        landed.forEach(function (print) { print.visible = print.userData.t <= time[k] + 1e-6; shown += print.visible; });
+        section.setAttribute("data-footprints-shown", String(shown));
         if (copDisc.visible) { copDisc.position.x = cop[2 * k]; copDisc.position.y = cop[2 * k + 1]; }
       },
       render: function () { place(); renderer.render(scene, camera); }

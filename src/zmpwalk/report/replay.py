@@ -26,7 +26,8 @@ from zmpwalk.sim.run import SimulationResult
 
 FPS = 40  # [1/s] frames of the replay
 MAX_MESH_FACES = 4000  # faces of one mesh after decimation
-MIN_SWING = 0.1  # [s] a sole unloaded for less (a flicker while the weight shifts) makes no new footprint
+MIN_SWING = 0.25  # [s] a sole unloaded for less makes no new footprint (flickers while the weight shifts and
+# bounces last up to 0.19 s on Booster T1's demo, swings 0.3 s and more)
 VISIBLE_GROUPS = 3  # geom groups 0-2 are drawn (MuJoCo's default visual groups)
 KINDS = {mujoco.mjtGeom.mjGEOM_BOX: "box", mujoco.mjtGeom.mjGEOM_SPHERE: "sphere",
          mujoco.mjtGeom.mjGEOM_CAPSULE: "capsule", mujoco.mjtGeom.mjGEOM_CYLINDER: "cylinder",
@@ -122,14 +123,14 @@ def _pose(plant: Any, data: mujoco.MjData, result: SimulationResult, rotation: n
 
 
 def _landing_rows(time: np.ndarray, loaded: np.ndarray) -> list[int]:
-    """Rows 50 ms after a sole became loaded: at the start if loaded there, and after each unloaded spell of at
-    least :data:`MIN_SWING`."""
+    """Rows 50 ms after a sole became loaded: first (at the start if loaded there) and after each unloaded spell
+    of at least :data:`MIN_SWING`."""
     onsets = np.flatnonzero(loaded[1:] & ~loaded[:-1]) + 1
     offsets = np.flatnonzero(~loaded[1:] & loaded[:-1]) + 1
     rows = [0] if loaded[0] else []
     for onset in onsets.tolist():
         before = offsets[offsets < onset]
-        if len(before) and time[onset] - time[before[-1]] >= MIN_SWING:
+        if not len(before) or time[onset] - time[before[-1]] >= MIN_SWING:  # first loaded, or after a swing
             rows.append(onset)
     return [min(row + 50, len(time) - 1) for row in rows]
 
@@ -195,9 +196,9 @@ def replay_html(payload: dict[str, Any], fallback: str) -> str:
 <label><input id="replay-follow" type="checkbox" checked> follow</label>
 </div>
 <canvas id="replay-plot" width="940" height="160" style="width:100%;height:160px;cursor:crosshair"></canvas>
-<p class="legend">The walk replayed from the simulation: drag to orbit, wheel to zoom; grey soles planned, red
-measured at each landing; blue disc: reference ZMP, red disc: measured CoP. Below: ZMP (blue) and CoP (red)
-x and y against time; click or drag there to set the time.</p>
+<p class="legend">The walk replayed from the simulation: drag to orbit, wheel to zoom; grey soles planned,
+red measured at each landing (shown once landed); blue disc: reference ZMP, red disc: measured CoP.
+Below: ZMP (blue) and CoP (red) x and y against time; click or drag there to set the time.</p>
 <div id="replay-fallback" hidden>{fallback}</div>
 </section>
 <script type="application/json" id="replay-data">{data}</script>
