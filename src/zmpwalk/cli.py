@@ -28,7 +28,7 @@ from zmpwalk.patterns.hyperbolic import HyperbolicGait
 from zmpwalk.patterns.polynomial import generate_chunks
 from zmpwalk.patterns.result import WalkingPattern, write_pieces_csv
 from zmpwalk.robots import list_robots, load_robot
-from zmpwalk.robots.model import RobotModel
+from zmpwalk.robots.model import BOX_MODEL_GENERATOR, OWN_MODEL_GENERATOR, RobotModel
 from zmpwalk.scenarios import list_scenarios, load_scenario_with_labels, load_steps_file_with_labels
 from zmpwalk.schedule import SCHEDULE_FILES, Schedule, schedule_path
 from zmpwalk.tables import condition_margins, margins_markdown, zmp_advice
@@ -111,10 +111,39 @@ DASK_HELP = ("run on a Dask cluster: its scheduler's address (tcp://host:8786), 
              '(pip install "zmpwalk[distributed]")')
 
 
+def _generator_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--generator", choices=GENERATORS, default=None,
+                        help="polynomial (HUBO, Park et al. 2008), hyperbolic (LIPM, Lim et al., stage by stage) or "
+                        f"preview (preview control, Kajita et al. 2003); default: the robot's, {OWN_MODEL_GENERATOR} "
+                        f"for a robot's own model (MJCF, URDF), {BOX_MODEL_GENERATOR} for the box models, or a robot "
+                        "file's [walking] generator")
+
+
+def _resolve_generator(args: argparse.Namespace, robot: RobotModel) -> str:
+    """--generator, or the robot's default (:attr:`RobotModel.default_generator`) where it is not given; what follows
+    reads ``args.generator``, and ``args.generator_given`` says which it was."""
+    args.generator_given = args.generator is not None
+    if args.generator is None:
+        args.generator = robot.default_generator
+    return str(args.generator)
+
+
+def _generator_words(args: argparse.Namespace, robot: RobotModel) -> str:
+    """Which generator runs and why: ``preview (the default for a robot's own model; --generator to choose)``."""
+    if getattr(args, "generator_given", True):
+        return f"{args.generator} (--generator)"
+    why = ("the robot file's [walking] generator" if robot.generator is not None else
+           "the default for a robot's own model" if robot.plant is not None else "the default for a box model")
+    return f"{args.generator} ({why}; --generator to choose)"
+
+
 def _pelvis(args: argparse.Namespace) -> str:
     pelvis = str(getattr(args, "pelvis", "cubic"))
-    if pelvis != "cubic" and getattr(args, "generator", "polynomial") != "polynomial":
-        raise _UsageError(f"--pelvis {pelvis} applies to the polynomial generator")
+    name = getattr(args, "generator", "polynomial")
+    if pelvis != "cubic" and name != "polynomial":
+        given = "" if getattr(args, "generator_given", True) else f"; this robot's default generator is {name}: give " \
+            "--generator polynomial"
+        raise _UsageError(f"--pelvis {pelvis} applies to the polynomial generator{given}")
     return pelvis
 
 
@@ -172,9 +201,7 @@ def _plan_parsers(commands: argparse._SubParsersAction[_Parser]) -> None:
                       help="samples per second [Hz] (default: 1000, as report and simulate)")
     plan.add_argument("--allow-outside", action="store_true",
                       help="exit 0 even when the ZMP leaves the support polygon (default: exit 3)")
-    plan.add_argument("--generator", choices=GENERATORS, default="polynomial",
-                      help="polynomial (HUBO, Park et al. 2008; default), hyperbolic (LIPM, Lim et al., stage by "
-                           "stage) or preview (preview control, Kajita et al. 2003: the baseline)")
+    _generator_option(plan)
     plan.add_argument("--out", type=Path, help="CSV file to write (without it nothing is written: the summary "
                       "says so)")
     plan.add_argument("--joints", action="store_true", help="append the 12 leg joint angles [rad] to the CSV")
@@ -211,7 +238,7 @@ def _simulate_parser(commands: argparse._SubParsersAction[_Parser]) -> None:
     simulate_cmd.add_argument("--pelvis", choices=("cubic", "quintic"), default="cubic",
                         help="pelvis curves: the paper's cubics, or quintics with a continuous cart-table ZMP")
     _balance_options(simulate_cmd)
-    simulate_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
+    _generator_option(simulate_cmd)
     simulate_cmd.add_argument("--mass-scale", type=float, default=1.0, help="multiply every mass (default 1)")
     simulate_cmd.add_argument("--zmp-correction", action="store_true",
                               help="move the pelvis until the multibody ZMP (Eq. 3) follows the planned ZMP "
@@ -253,7 +280,7 @@ def _report_parsers(commands: argparse._SubParsersAction[_Parser]) -> None:
         report_cmd.add_argument("--pelvis", choices=("cubic", "quintic"), default="cubic",
                             help="pelvis curves: the paper's cubics, or quintics with a continuous cart-table ZMP")
         _balance_options(report_cmd)
-        report_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
+        _generator_option(report_cmd)
         default_out = Path("zmpwalk-demo" if name == "demo" else "zmpwalk-report")
         report_cmd.add_argument("--out", type=Path, default=default_out,
                                 help="report folder (default: ./zmpwalk-demo or ./zmpwalk-report)")
@@ -289,7 +316,7 @@ def _batch_parsers(commands: argparse._SubParsersAction[_Parser]) -> None:
     sweep_cmd.add_argument("--dask", metavar="SCHEDULER", help=DASK_HELP)
     sweep_cmd.add_argument("--balance", choices=("on", "off"), default="on",
                            help="the stabilizer (default: on, for every robot; off: open loop, as the papers walk)")
-    sweep_cmd.add_argument("--generator", choices=GENERATORS, default="polynomial")
+    _generator_option(sweep_cmd)
     _schedule_option(sweep_cmd, " (e.g. from zmpwalk tune)")
     sweep_cmd.add_argument("--pelvis", choices=("cubic", "quintic"), default="cubic",
                            help="pelvis curves: the paper's cubics, or quintics with a continuous cart-table ZMP")
@@ -351,7 +378,8 @@ def _export_parser(commands: argparse._SubParsersAction[_Parser]) -> None:
     export_cmd.add_argument("--fps", type=float, default=50.0, help="frames per second of the clips (default: 50)")
     export_cmd.add_argument("--grid", type=Path, help="a grid file (TOML: forward, side, turn, step_time lists)")
     for name, unit in (("forward", "m/s"), ("side", "m/s"), ("turn", "rad/s"), ("step-time", "s")):
-        export_cmd.add_argument(f"--{name}", help=f"comma-separated values [{unit}] (instead of --grid)")
+        export_cmd.add_argument(f"--{name}", help=f"comma-separated values [{unit}] (instead of --grid; a list "
+                                f"that starts with a minus sign takes '=': --{name}=-0.1,0,0.1)")
     export_cmd.add_argument("--swings", type=int, default=10, help="swings walked per command (default: 10; a side "
                             "or turn step is two)")
     export_cmd.add_argument("--workers", type=int, help="commands walked at a time (default: one per core)")
@@ -426,6 +454,7 @@ def _report(args: argparse.Namespace) -> int:
     else:
         raise _UsageError("give --scenario NAME or a steps file (see 'zmpwalk scenarios')")
     robot = _load_robot(args)
+    _resolve_generator(args, robot)
     quiet = args.json or not sys.stderr.isatty()
     with _source(str(args.steps) if args.steps else f"scenario {args.scenario}"):
         report = build_report(robot, commands, args.out, title=f"zmpwalk: {robot.name}, {name}",
@@ -441,6 +470,7 @@ def _report(args: argparse.Namespace) -> int:
     else:
         s = report.summary
         state = f"FELL at t = {s['fall_time']:.2f} s" if s["fell"] else "no fall"
+        print(f"generator: {_generator_words(args, robot)}")
         print(f"{robot.name}, {name}: {verdict.state} ({state}); plan's min ZMP margin "
               f"{_margin_words(float(s['min_zmp_margin']))} -> {report.index}")
         _print_verdict(verdict)
@@ -451,6 +481,7 @@ def _simulated_pattern(args: argparse.Namespace, robot: RobotModel) -> tuple[Wal
     """The pattern ``simulate`` walks (the paper example, a steps file or a scenario) and its ZMP correction."""
     from zmpwalk.patterns.hyperbolic import paper_walk
 
+    _resolve_generator(args, robot)
     if args.paper_example:
         if args.steps or args.scenario:
             raise _UsageError("--paper-example takes no steps file or scenario")
@@ -508,7 +539,8 @@ def _simulate(args: argparse.Namespace) -> int:
         show(stages[3], 4, len(stages))
     rows = actuator_table(result)
     fits = motor_fits(result, motors) if motors else []
-    summary = {**_simulation_summary(result, verdict, rows, fits, correction), "balance": stabilizer is not None}
+    summary = {**_simulation_summary(result, verdict, rows, fits, correction), "balance": stabilizer is not None,
+               "generator": pattern.generator}
     if args.out:
         args.out.mkdir(parents=True, exist_ok=True)
         write_actuator_csv(rows, args.out / "actuators.csv")
@@ -517,6 +549,8 @@ def _simulate(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(_json_safe(summary), indent=2, allow_nan=False))
     else:
+        print("generator: " + ("hyperbolic (the paper example of Lim et al.)" if args.paper_example else
+                               _generator_words(args, robot)))
         _print_simulation(result, verdict, rows, fits, correction)
     return 0 if verdict.passed else EXIT_FAILED
 
@@ -667,6 +701,8 @@ def _sweep(args: argparse.Namespace) -> int:
     workers = args.workers or os.cpu_count() or 1
     show = None if args.json or not sys.stderr.isatty() else (lambda done, total: _progress("walks", done, total))
     balance = _balance(args)
+    if args.generator is None:
+        _resolve_generator(args, _load_robot(args))
     started, cpu = time.perf_counter(), time.process_time()
     schedule = _schedule(args)  # read here: a bad file is one error, not one per worker
     results = sweep(args.robot, names, balance=balance, workers=workers, progress=show, generator=args.generator,
@@ -676,7 +712,8 @@ def _sweep(args: argparse.Namespace) -> int:
     wall = time.perf_counter() - started
     walked = sum(r.seconds for r in results)
     if args.json:
-        print(json.dumps(_json_safe({"workers": workers, "wall_seconds": wall, "walk_seconds": walked,
+        print(json.dumps(_json_safe({"generator": args.generator, "workers": workers, "wall_seconds": wall,
+                                     "walk_seconds": walked,
                                      "results": [vars(r) for r in results]}), indent=2, allow_nan=False))
     else:
         width = max(len(name) for name in names)
@@ -687,7 +724,8 @@ def _sweep(args: argparse.Namespace) -> int:
             state = "PASS" if r.passed else "FAIL " + ", ".join(r.failed)
             print(f"{r.scenario:<{width}}  {r.simulated:5.1f} s simulated in {r.seconds:5.2f} s  "
                   f"distance {r.distance:6.3f} m  CoP RMS {r.cop_error_rms * 1e3:6.1f} mm  {state}")
-        print(f"{len(results)} walks, {sum(r.simulated for r in results):.1f} s simulated: {wall:.1f} s wall clock on "
+        print(f"{len(results)} walks with the {args.generator} generator, {sum(r.simulated for r in results):.1f} s "
+              f"simulated: {wall:.1f} s wall clock on "
               f"{workers} worker(s), {walked:.1f} s of walks ({walked / wall:.2f} walks at a time; "
               f"{time.process_time() - cpu:.1f} s CPU in this process)")
     return 0 if all(r.passed for r in results) else EXIT_FAILED
@@ -779,6 +817,7 @@ def _plan(args: argparse.Namespace) -> int:
     """``zmpwalk plan``: the pattern to --out (nothing written without it, and it says so) and its ZMP margin."""
     commands, labels = _commands(args)
     robot = _load_robot(args)
+    _resolve_generator(args, robot)
     make = generator(args.generator)
     schedule = _schedule(args)
     options = _pattern_options(args)
@@ -805,6 +844,7 @@ def _plan(args: argparse.Namespace) -> int:
         print(json.dumps(result, indent=2))
     else:
         margin = float(result["min_zmp_margin"])  # type: ignore[arg-type]
+        print(f"generator: {_generator_words(args, robot)}")
         print(f"{result['swings']} swings, {result['duration']:.3f} s, {result['samples']} samples at "
               f"{args.rate:g} Hz" + (f" -> {args.out}" if args.out else
                                      "; no CSV written (give --out FILE to write it)"))
