@@ -140,6 +140,12 @@ def test_the_gif_is_opt_in_and_is_the_replays_fallback(tmp_path):
     assert (tmp_path / "r" / "walk.gif").stat().st_size > 10_000
     fallback = page.split('<div id="replay-fallback" hidden>')[1].split("</div>")[0]
     assert fallback.count("data:image/gif;base64,") == 1 and page.count("data:image/gif;base64,") == 1
+    if CHROMIUM is not None:  # a browser without WebGL shows the GIF in the replay's place
+        dom = subprocess.run([CHROMIUM, *CHROMIUM_FLAGS, "--disable-3d-apis", f"--user-data-dir={tempfile.mkdtemp()}",
+                              "--virtual-time-budget=5000", "--dump-dom", (tmp_path / "r" / "index.html").as_uri()],
+                             capture_output=True, text=True, timeout=120, check=True).stdout
+        assert 'data-ready="no-webgl"' in dom and '<div id="replay-fallback">' in dom
+        assert 'data-images-loaded="yes"' in dom and 'data-image-count="7"' in dom  # six figures and the GIF
 
 
 @pytest.mark.parametrize("argv, message", [
