@@ -180,3 +180,44 @@ def test_the_motor_table_header_has_as_many_cells_as_each_row():
             ActuatorRow("left_hip_yaw", 5.0, 6.0, 2.0, 0.5, 2.0, 0.3, math.inf, math.nan)]
     cells = [re.findall(r"<t([hd])>", row) for row in actuator_html(rows).splitlines()]
     assert cells[0] == ["h"] * 9 and cells[1:] == [["d"] * 9] * 2
+
+
+SHAPES = """<mujoco><asset><mesh name="tetra" vertex="0 0 0  0.1 0 0  0 0.1 0  0 0 0.1"/></asset><worldbody>
+<geom type="plane" size="1 1 0.1"/>
+<body name="base" pos="0 0 0.5"><freejoint/>
+  <geom type="box" size="0.1 0.05 0.2" rgba="0.8 0.4 0.2 1"/>
+  <geom type="sphere" size="0.05" pos="0 0 0.3"/>
+  <geom type="capsule" size="0.03 0.1" pos="0.2 0 0" euler="0 90 0"/>
+  <geom type="cylinder" size="0.04 0.05" pos="-0.2 0 0"/>
+  <geom type="ellipsoid" size="0.05 0.08 0.03" pos="0 0.2 0"/>
+  <geom type="mesh" mesh="tetra" pos="0 -0.2 0"/>
+  <geom type="box" size="0.2 0.2 0.2" group="3"/>
+</body></worldbody></mujoco>"""
+
+
+def test_every_kind_of_geom_reaches_the_page_and_three_js_builds_it(tmp_path):
+    import mujoco
+
+    from zmpwalk.report.replay import _b64, _geoms, replay_html
+
+    model = mujoco.MjModel.from_xml_string(SHAPES)
+    geoms, bodies = _geoms(model)
+    assert [g["kind"] for g in geoms] == ["box", "sphere", "capsule", "cylinder", "ellipsoid", "mesh"]  # no plane,
+    assert bodies == [1] and geoms[0]["rgba"] == [0.8, 0.4, 0.2, 1.0]  # no collision-only geom (group 3)
+    assert np.allclose(geoms[0]["size"], [0.1, 0.05, 0.2], atol=1e-9)
+    vertices = np.frombuffer(__import__("base64").b64decode(geoms[-1]["vertices"]), dtype="<f4")
+    assert len(vertices) == 12  # the tetrahedron's 4 vertices
+    if CHROMIUM is None:
+        return
+    payload = {"robot": "shapes", "height": 1.0, "pelvis_height": 0.5, "fps": 40, "geoms": geoms, "start": 0.0,
+               "end": 0.025, "footprints": {"planned": [], "measured": []},
+               "frames": {"count": 2, "bodies": 1, "time": _b64(np.array([0.0, 0.025])),
+                          "position": _b64(np.array([[0, 0, 0.5], [0.1, 0, 0.5]])),
+                          "quaternion": _b64(np.array([[1, 0, 0, 0], [1, 0, 0, 0]])),
+                          "base": _b64(np.array([[0, 0, 0.5], [0.1, 0, 0.5]])), "zmp": _b64(np.zeros((2, 2))),
+                          "cop": _b64(np.full((2, 2), np.nan))}}
+    index = tmp_path / "index.html"
+    index.write_text(f"<!DOCTYPE html><html><body>{replay_html(payload, 'no WebGL')}</body></html>")
+    attributes = _replay_dom(index, "t=0.025")
+    assert attributes["data-ready"] == "yes" and attributes["data-geoms"] == "6", attributes
+    assert abs(float(attributes["data-base-x"]) - 0.1) < 1e-6 and attributes["data-frame"] == "1"

@@ -19,9 +19,9 @@
   var button = document.getElementById("replay-play"), plot = document.getElementById("replay-plot");
   var view = null;  // the 3D view, once WebGL works
 
-  function frameAt(t) {  // the last frame at or before t
+  function frameAt(t) {  // the last frame at or before t (times are float32: 1 µs slack)
     var lo = 0, hi = n - 1;
-    while (lo < hi) { var mid = (lo + hi + 1) >> 1; if (time[mid] <= t) lo = mid; else hi = mid - 1; }
+    while (lo < hi) { var mid = (lo + hi + 1) >> 1; if (time[mid] <= t + 1e-6) lo = mid; else hi = mid - 1; }
     return lo;
   }
   function setTime(t) {
@@ -134,6 +134,7 @@
     prints.forEach(function (p) { p.corners.forEach(function (c) {
       lo = [Math.min(lo[0], c[0]), Math.min(lo[1], c[1])]; hi = [Math.max(hi[0], c[0]), Math.max(hi[1], c[1])];
     }); });
+    if (!prints.length) { lo = [0, 0]; hi = [0, 0]; }
     var centre = [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2], span = Math.max(hi[0] - lo[0], hi[1] - lo[1], H) + 2 * H;
     var floor = new THREE.Mesh(new THREE.PlaneGeometry(span, span), new THREE.MeshLambertMaterial({ color: 0xd9dde2 }));
     floor.position.set(centre[0], centre[1], 0); scene.add(floor);
