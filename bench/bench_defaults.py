@@ -1,7 +1,8 @@
 """Defaults chosen by data: every generator on every handed-over robot's own model, on the three walks of
 examples/ (10 x 10 cm forward at 0.8 s, 4 x 5 cm side at 0.9 s, 3 x 15 deg turn at 1.0 s), each walked by
 ``zmpwalk simulate --robot MODEL --generator G STEPS --json`` with every other setting at its default (the
-stabilizer on, HUBO's tables scaled, 1 s settle, 2 s hold).
+stabilizer on, HUBO's tables scaled, 1 s settle, 2 s hold); and whether ``zmpwalk plan --joints`` (as ``report`` and
+``demo``, which check the planned joints against their ranges; ``simulate`` does not) plans it.
 
 Run: python bench/bench_defaults.py [--robot talos-servos ...] [--generator preview ...] [--walk turn ...]
 [--json FILE]. Prints a Markdown table (docs/design-log/defaults.md) and, per generator, how many walks pass;
@@ -68,6 +69,17 @@ def walk(model: Path, generator: str, steps: list[str]) -> dict[str, Any]:
     return row
 
 
+def plan_joints(model: Path, generator: str, steps: list[str], folder: Path) -> str:
+    """``zmpwalk plan --joints`` of the walk: "ok", or why it refuses (a joint outside its range, out of reach)."""
+    command = [sys.executable, "-m", "zmpwalk.cli", "plan", "--robot", str(model), "--generator", generator, *steps,
+               "--joints", "--allow-outside", "--out", str(folder / "plan.csv")]
+    done = subprocess.run(command, capture_output=True, text=True, check=False)
+    if done.returncode == 0:
+        return "ok"
+    last = done.stderr.strip().splitlines()[-1] if done.stderr.strip() else f"exit {done.returncode}"
+    return last.removeprefix("zmpwalk: error: ").split(": ", 1)[-1]  # without the steps file's path
+
+
 def _mm(value: float | None, signed: bool = False) -> str:
     if value is None or not math.isfinite(value):
         return "-"
@@ -93,21 +105,26 @@ def _verdict(row: dict[str, Any]) -> str:
 def table(rows: list[dict[str, Any]]) -> str:
     """The Markdown table: one line per robot, generator and walk."""
     lines = ["| robot | generator | walk | exit, verdict (failing criteria) | CoP - ZMP RMS [mm] | final feet [mm] "
-             "| plan's ZMP margin [mm] | CoP margin judged [mm] | joints: largest use (where) | wall [s] |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "| plan's ZMP margin [mm] | CoP margin judged [mm] | joints: largest use (where) "
+             "| planned joints in range | wall [s] |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         lines.append(f"| {r['robot']} | {r['generator']} | {r['walk']} | {_verdict(r)} | {_mm(r.get('cop_error_rms'))} "
                      f"| {_mm(r.get('final_feet_error'))} | {_mm(r.get('plan_min_zmp_margin'), True)} "
-                     f"| {_mm(r.get('min_cop_margin_judged'), True)} | {_joint(r)} | {r['seconds']:.0f} |")
+                     f"| {_mm(r.get('min_cop_margin_judged'), True)} | {_joint(r)} | {r.get('plan_joints', '-')} "
+                     f"| {r['seconds']:.0f} |")
     return "\n".join(lines)
 
 
 def tally(rows: list[dict[str, Any]]) -> str:
-    """Per generator: the walks that pass (exit 0) out of those walked, and which fail."""
+    """Per generator: the walks that pass (simulate's exit 0 and the planned joints in range, so that report and demo
+    walk them too) out of those walked, and which fail."""
     lines = []
     for name in dict.fromkeys(r["generator"] for r in rows):
         mine = [r for r in rows if r["generator"] == name]
-        failing = [f"{r['robot']} {r['walk']}" for r in mine if r["exit"] != 0]
+        failing = [f"{r['robot']} {r['walk']}" + ("" if r["exit"] == 0 else " (simulate)")
+                   + ("" if r.get("plan_joints", "ok") == "ok" else " (joint range)")
+                   for r in mine if r["exit"] != 0 or r.get("plan_joints", "ok") != "ok"]
         lines.append(f"{name}: {len(mine) - len(failing)} of {len(mine)} pass"
                      + (f"; fail: {', '.join(failing)}" if failing else ""))
     return "\n".join(lines)
@@ -128,13 +145,13 @@ def main() -> None:
         walks = {name: WALKS[name] for name in args.walk if name in WALKS}
         if args.harder:
             walks |= {name: [str(steps)] if words == ["STEPS"] else words for name, words in HARDER.items()}
-        rows = run(args, walks)
+        rows = run(args, walks, Path(folder))
     print(table(rows))
     print()
     print(tally(rows))
 
 
-def run(args: argparse.Namespace, walks: dict[str, list[str]]) -> list[dict[str, Any]]:
+def run(args: argparse.Namespace, walks: dict[str, list[str]], folder: Path) -> list[dict[str, Any]]:
     """Every robot x generator x walk, one at a time, in that order."""
     rows = []
     for robot in args.robot:
@@ -143,9 +160,10 @@ def run(args: argparse.Namespace, walks: dict[str, list[str]]) -> list[dict[str,
             continue
         for name in args.generator:
             for walk_name, words in walks.items():
-                row = {"robot": robot, "generator": name, "walk": walk_name, **walk(ROBOTS[robot], name, words)}
-                print(f"{robot} {name} {walk_name}: {_verdict(row)} ({row['seconds']:.0f} s)", file=sys.stderr,
-                      flush=True)
+                row = {"robot": robot, "generator": name, "walk": walk_name, **walk(ROBOTS[robot], name, words),
+                       "plan_joints": plan_joints(ROBOTS[robot], name, words, folder)}
+                print(f"{robot} {name} {walk_name}: {_verdict(row)}; planned joints {row['plan_joints']} "
+                      f"({row['seconds']:.0f} s)", file=sys.stderr, flush=True)
                 rows.append(row)
                 if args.json:  # after every walk: a long run stopped half-way keeps what it measured
                     args.json.write_text(json.dumps(rows, indent=2) + "\n")

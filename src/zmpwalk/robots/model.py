@@ -18,7 +18,7 @@ import math
 from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING, Any
 
-from zmpwalk.errors import FileFormatError, InvalidParameterError
+from zmpwalk.errors import FileFormatError, InvalidParameterError, UnknownNameError
 from zmpwalk.stabilizer_gains import StabilizerGains
 
 if TYPE_CHECKING:
@@ -32,6 +32,13 @@ HUBO_LEG_LENGTH = 0.60  # [m] HUBO's thigh plus shank (robots/data/hubo.toml)
 LINK_NAMES = ("torso", "thigh", "shank", "foot")
 FOOT_SPEED_FROUDE = 1.6  # [-] default swing-foot speed limit over sqrt(g l)
 FOOT_ACCELERATION_G = 5.0  # [-] default swing-foot acceleration limit over g
+# The pattern generators by name, kept here below zmpwalk.patterns (which must not be imported from robots/) so that a
+# robot file's choice is checked where it is read; zmpwalk.patterns.GENERATORS holds the same names (tested).
+GENERATOR_NAMES = ("polynomial", "hyperbolic", "preview")
+BOX_MODEL_GENERATOR = "polynomial"  # the papers' pattern, for the built-in box models and box robot files
+OWN_MODEL_GENERATOR = "hyperbolic"  # a robot built from its own MJCF/URDF: of the generators measured on TALOS (servos,
+# motors), Booster T1 and Fourier N1, the one that passes the most walks with its joints in range and runs online
+# (bench/bench_defaults.py, docs/design-log/defaults.md)
 
 
 @dataclass(frozen=True)
@@ -131,6 +138,9 @@ class RobotModel:
         foot_speed_limit: Fastest the swinging ankle may move [m/s]; None: :attr:`max_foot_speed`'s
             size-scaled default.
         foot_acceleration_limit: Largest acceleration of the swinging ankle [m/s^2]; None: 5 g.
+        stabilizer_gains: The robot file's own ``[stabilizer]`` gains, (name, value) pairs.
+        generator: The pattern generator a robot file chose (``[walking] generator``, one of
+            :data:`GENERATOR_NAMES`); None: the default of the robot's kind (:attr:`default_generator`).
     """
 
     name: str
@@ -165,6 +175,17 @@ class RobotModel:
     foot_speed_limit: float | None = None  # [m/s]
     foot_acceleration_limit: float | None = None  # [m/s^2]
     stabilizer_gains: tuple[tuple[str, float], ...] = ()  # the robot's own [stabilizer] gains (name, value)
+    generator: str | None = None  # the robot file's [walking] generator; None: default_generator's rule
+
+    @property
+    def default_generator(self) -> str:
+        """The pattern generator this robot walks with where none is named (``zmpwalk plan``, ``simulate``,
+        ``report``, ``demo``, ``sweep`` without ``--generator``): the robot file's ``[walking] generator``,
+        else :data:`OWN_MODEL_GENERATOR` for a robot built from its own model (it has a :attr:`plant`),
+        else :data:`BOX_MODEL_GENERATOR`."""
+        if self.generator is not None:
+            return self.generator
+        return OWN_MODEL_GENERATOR if self.plant is not None else BOX_MODEL_GENERATOR
 
     def hip_in_pelvis(self, side: int) -> tuple[float, float, float]:
         """Hip joint centre of the left (``side = +1``) or right (-1) leg relative to the pattern's pelvis
@@ -230,9 +251,10 @@ _SECTIONS: dict[str, dict[str, str]] = {
                 "min_knee": "min_knee"},
     "walking": {"dsp_time": "dsp_time", "foot_lift": "foot_lift",
                 "lateral_velocity": "lateral_velocity", "scale_schedule": "scale_schedule",
-                "foot_speed_limit": "foot_speed_limit", "foot_acceleration_limit": "foot_acceleration_limit"},
+                "foot_speed_limit": "foot_speed_limit", "foot_acceleration_limit": "foot_acceleration_limit",
+                "generator": "generator"},
 }
-_OPTIONAL = {"gravity", "hip_x", "scale_schedule", "foot_speed_limit", "foot_acceleration_limit"}
+_OPTIONAL = {"gravity", "hip_x", "scale_schedule", "foot_speed_limit", "foot_acceleration_limit", "generator"}
 _POSITIVE = {"mass", "height", "hip_spacing", "thigh_length", "shank_length", "ankle_height",
              "foot_length", "foot_width", "pelvis_height", "pendulum_length", "gravity",
              "dsp_time", "lateral_velocity", "foot_speed_limit", "foot_acceleration_limit"}
@@ -262,6 +284,17 @@ def schedule_scale(pendulum_length: float, leg_length: float, hip_spacing: float
         hip_spacing: [m].
     """
     return (math.sqrt(pendulum_length / HUBO_PENDULUM), leg_length / HUBO_LEG_LENGTH, hip_spacing / HUBO_HIP_SPACING)
+
+
+def checked_generator(value: object, source: str) -> str:
+    """A robot file's ``[walking] generator``: one of :data:`GENERATOR_NAMES`.
+
+    Raises:
+        FileFormatError: Not a string, or not a generator's name (lists the known ones).
+    """
+    if not isinstance(value, str) or value not in GENERATOR_NAMES:
+        raise FileFormatError(source, f"[walking] {UnknownNameError('generator', str(value), GENERATOR_NAMES)}")
+    return value
 
 
 def _table(kind: type[Any], table: object, name: str, source: str) -> Any:
@@ -352,6 +385,8 @@ def robot_from_dict(data: dict[str, Any], source: str = "<robot>") -> RobotModel
             if attribute in ("name", "description"):
                 if not isinstance(value, str):
                     raise FileFormatError(source, f"{key} must be a string")
+            elif attribute == "generator":
+                value = checked_generator(value, source)
             elif attribute == "scale_schedule":
                 if not isinstance(value, bool):
                     raise FileFormatError(source, f"[{section}] {key} = {value!r} must be true or false")

@@ -1,6 +1,7 @@
 """Robot files (``.toml``): a box model's own description (:func:`zmpwalk.robots.model.robot_from_dict`), or a
 ``[model]`` table naming the robot's own MJCF or URDF with what the file adds to it (written by
-``zmpwalk robot --write``): posture and walking overrides, the joint PD layer's gains (``[pd]``) and tuned
+``zmpwalk robot --write``): posture and walking overrides (``[walking] generator`` among them: the pattern generator
+the robot walks with by default), the joint PD layer's gains (``[pd]``) and tuned
 stabilizer gains (``[stabilizer]``), which every robot file may carry."""
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from typing import Any
 from zmpwalk.errors import FileFormatError, InvalidParameterError
 from zmpwalk.files import read_toml
 from zmpwalk.robots.imported import import_robot
-from zmpwalk.robots.model import RobotModel, robot_from_dict, stabilizer_gains
+from zmpwalk.robots.model import RobotModel, checked_generator, robot_from_dict, stabilizer_gains
 
 
 def robot_from_toml(path: Path) -> RobotModel:
@@ -44,14 +45,18 @@ def _robot_from_model_table(data: dict[str, Any], path: Path) -> RobotModel:
     if feet is not None and (not isinstance(feet, list) or len(feet) != 2 or not all(isinstance(f, str) for f in feet)):
         raise FileFormatError(source, "[model] feet must be two body names: [left, right]")
     overrides: dict[str, float] = {}
+    generator = None
     for section, names in _MODEL_OVERRIDES.items():
         values = data.get(section, {})
         if not isinstance(values, dict):
             raise FileFormatError(source, f"[{section}] must be a table")
         for key, value in values.items():
+            if section == "walking" and key == "generator":  # a name, not a number: kept on the model as it is
+                generator = checked_generator(value, source)
+                continue
             if key not in names:
                 raise FileFormatError(source, f"[{section}] unknown field {key!r} for a model robot; known: "
-                                      f"{', '.join(names)}")
+                                      f"{', '.join((*names, 'generator') if section == 'walking' else names)}")
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
                 raise FileFormatError(source, f"[{section}] {key} = {value!r} must be a number > 0")
             overrides[key] = float(value)
@@ -66,7 +71,9 @@ def _robot_from_model_table(data: dict[str, Any], path: Path) -> RobotModel:
                              overrides=overrides, pd_gains=_pd_table(data.get("pd"), source))
     except InvalidParameterError as error:
         raise FileFormatError(source, f"[pd] {error}") from None
-    return replace(robot, stabilizer_gains=gains) if gains else robot
+    if gains:
+        robot = replace(robot, stabilizer_gains=gains)
+    return robot if generator is None else replace(robot, generator=generator)
 
 
 def _pd_table(table: object, source: str) -> dict[str, tuple[float, float | None]]:
