@@ -183,7 +183,7 @@ def test_the_motor_table_header_has_as_many_cells_as_each_row():
 
 
 SHAPES = """<mujoco><asset><mesh name="tetra" vertex="0 0 0  0.1 0 0  0 0.1 0  0 0 0.1"/></asset><worldbody>
-<geom type="plane" size="1 1 0.1"/>
+<geom type="plane" size="1 1 0.1"/><geom type="box" size="0.2 0.2 0.02" pos="0.5 0 0.02"/>
 <body name="base" pos="0 0 0.5"><freejoint/>
   <geom type="box" size="0.1 0.05 0.2" rgba="0.8 0.4 0.2 1"/>
   <geom type="sphere" size="0.05" pos="0 0 0.3"/>
@@ -202,22 +202,23 @@ def test_every_kind_of_geom_reaches_the_page_and_three_js_builds_it(tmp_path):
 
     model = mujoco.MjModel.from_xml_string(SHAPES)
     geoms, bodies = _geoms(model)
-    assert [g["kind"] for g in geoms] == ["box", "sphere", "capsule", "cylinder", "ellipsoid", "mesh"]  # no plane,
-    assert bodies == [1] and geoms[0]["rgba"] == [0.8, 0.4, 0.2, 1.0]  # no collision-only geom (group 3)
-    assert np.allclose(geoms[0]["size"], [0.1, 0.05, 0.2], atol=1e-9)
+    # a static box on the floor, then the base's: no plane, no collision-only geom (group 3)
+    assert [g["kind"] for g in geoms] == ["box", "box", "sphere", "capsule", "cylinder", "ellipsoid", "mesh"]
+    assert bodies == [0, 1] and [g["body"] for g in geoms] == [0] + [1] * 6
+    assert geoms[1]["rgba"] == [0.8, 0.4, 0.2, 1.0] and np.allclose(geoms[1]["size"], [0.1, 0.05, 0.2], atol=1e-9)
     vertices = np.frombuffer(__import__("base64").b64decode(geoms[-1]["vertices"]), dtype="<f4")
     assert len(vertices) == 12  # the tetrahedron's 4 vertices
     if CHROMIUM is None:
         return
     payload = {"robot": "shapes", "height": 1.0, "pelvis_height": 0.5, "fps": 40, "geoms": geoms, "start": 0.0,
                "end": 0.025, "footprints": {"planned": [], "measured": []},
-               "frames": {"count": 2, "bodies": 1, "time": _b64(np.array([0.0, 0.025])),
-                          "position": _b64(np.array([[0, 0, 0.5], [0.1, 0, 0.5]])),
-                          "quaternion": _b64(np.array([[1, 0, 0, 0], [1, 0, 0, 0]])),
+               "frames": {"count": 2, "bodies": 2, "time": _b64(np.array([0.0, 0.025])),
+                          "position": _b64(np.array([[[0, 0, 0], [0, 0, 0.5]], [[0, 0, 0], [0.1, 0, 0.5]]])),
+                          "quaternion": _b64(np.array([[[1, 0, 0, 0]] * 2] * 2)),
                           "base": _b64(np.array([[0, 0, 0.5], [0.1, 0, 0.5]])), "zmp": _b64(np.zeros((2, 2))),
                           "cop": _b64(np.full((2, 2), np.nan))}}
     index = tmp_path / "index.html"
     index.write_text(f"<!DOCTYPE html><html><body>{replay_html(payload, 'no WebGL')}</body></html>")
     attributes = _replay_dom(index, "t=0.025")
-    assert attributes["data-ready"] == "yes" and attributes["data-geoms"] == "6", attributes
+    assert attributes["data-ready"] == "yes" and attributes["data-geoms"] == "7", attributes
     assert abs(float(attributes["data-base-x"]) - 0.1) < 1e-6 and attributes["data-frame"] == "1"

@@ -70,14 +70,15 @@ def decimate(vertices: np.ndarray, faces: np.ndarray, limit: int = MAX_MESH_FACE
 
 
 def _geoms(model: mujoco.MjModel) -> tuple[list[dict[str, Any]], list[int]]:
-    """The drawn geoms (JSON-able, ``body`` indexing the returned body list) and the model's body ids drawn."""
+    """The drawn geoms (JSON-able, ``body`` indexing the returned body list) and the model's body ids drawn
+    (the world body's geoms, obstacles of a scene, stay where they are)."""
     geoms: list[dict[str, Any]] = []
     bodies: list[int] = []
     for g in range(model.ngeom):
         kind = KINDS.get(int(model.geom_type[g]))
         rgba = model.mat_rgba[model.geom_matid[g]] if model.geom_matid[g] >= 0 else model.geom_rgba[g]
-        if kind is None or model.geom_group[g] >= VISIBLE_GROUPS or rgba[3] <= 0 or model.geom_bodyid[g] == 0:
-            continue
+        if kind is None or model.geom_group[g] >= VISIBLE_GROUPS or rgba[3] <= 0:
+            continue  # planes (the page draws its own floor), collision-only and invisible geoms
         body = int(model.geom_bodyid[g])
         if body not in bodies:
             bodies.append(body)
