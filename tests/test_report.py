@@ -87,7 +87,11 @@ def _replay_dom(index: Path, fragment: str) -> dict[str, str]:
                          capture_output=True, text=True, timeout=120, check=True).stdout
     section = re.search(r'<section id="replay"([^>]*)>', dom)
     assert section is not None
-    return dict(re.findall(r'([\w-]+)="([^"]*)"', section.group(1)))
+    attributes = dict(re.findall(r'([\w-]+)="([^"]*)"', section.group(1)))
+    cursor = re.search(r'class="replay-cursor" data-time="([-0-9.]+)" style="[^"]*left: ([-0-9.]+)%', dom)
+    if cursor:  # the time cursor on the ZMP-against-time figure: its time, and where it stands [% of the width]
+        attributes["cursor-time"], attributes["cursor-left"] = cursor.groups()
+    return attributes
 
 
 @pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed (.ci/run installs it)")
@@ -105,6 +109,10 @@ def test_the_interactive_replay_draws_the_robot_moves_with_the_time_and_shows_th
     assert int(start["data-footprints-planned"]) == summary["swings"] + 2  # the first stance and every landing
     assert int(start["data-footprints-measured"]) == summary["swings"] + 2  # one per landing, none per flicker
     assert int(start["data-footprints-shown"]) == 2 < int(later["data-footprints-shown"])  # shown once landed
+    # the replay's time on the figure of the ZMP against time: a cursor line where t = 6 s is on its time axis
+    axis = json.loads(re.search(r"data-time-axis='([^']*)'", (demo / "index.html").read_text()).group(1))
+    expected = axis["left"] + (axis["right"] - axis["left"]) * (6.0 - axis["t0"]) / (axis["t1"] - axis["t0"])
+    assert abs(float(later["cursor-time"]) - 6.0) < 1e-3 and abs(float(later["cursor-left"]) - 100 * expected) < 0.01
     ARTIFACTS.mkdir(exist_ok=True)
     shot = ARTIFACTS / "demo-replay.png"
     subprocess.run([CHROMIUM, *CHROMIUM_FLAGS, *WEBGL_FLAGS, f"--user-data-dir={tempfile.mkdtemp()}",

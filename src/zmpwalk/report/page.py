@@ -133,7 +133,7 @@ def build_report(
     write_actuator_csv(rows, folder / "actuators.csv")
     write_result_csv(result, folder / "simulation.csv")
     done("simulation")
-    images = _figures(pattern, result, motors)
+    images, time_axes = _figures(pattern, result, motors)
     for index, payload in enumerate(images.values()):
         write_bytes(folder / f"figure{index + 1}.png", payload)
     done("plots")
@@ -143,22 +143,27 @@ def build_report(
     fits = motor_fits(result, motors) if motors else []
     report.summary = _summary(pattern, result, report.verdict, fits, generator)
     movie = replay or _movie(animation, animation_note)
-    page = _page(title, robot, report.summary, images, movie, step_margins(pattern), rows,
-                 report.verdict, fits, _step_list(commands, labels))
+    page = _page(title, robot, report.summary, _figure_html(images, time_axes if replay else {}), movie,
+                 step_margins(pattern), rows, report.verdict, fits, _step_list(commands, labels))
     write_text(report.index, page)
     write_text(folder / "summary.json", json.dumps(report.summary, indent=2))
     done("page")
     return report
 
 
-def _figures(pattern: WalkingPattern, result: SimulationResult, motors: list[Motor] | None) -> dict[str, bytes]:
-    """The page's figures (PNG) by caption."""
+ZMP_TIME = "ZMP and measured CoP against time, with the support polygon's bounds (Figs. 21, 27-31)"
+
+
+def _figures(pattern: WalkingPattern, result: SimulationResult,
+             motors: list[Motor] | None) -> tuple[dict[str, bytes], dict[str, dict[str, float]]]:
+    """The page's figures (PNG) by caption, and where the time axis lies in those that have the replay's time
+    cursor (see :func:`zmpwalk.report.plots.zmp_time_axis`)."""
     from zmpwalk.report import plots
 
+    zmp_time, axis = plots.zmp_time_axis(pattern, result)
     images = {
         "ZMP over the footprints (Figs. 20-22 of Park et al.)": plots.zmp_path(pattern, result),
-        "ZMP and measured CoP against time, with the support polygon's bounds (Figs. 21, 27-31)":
-            plots.zmp_time(pattern, result),
+        ZMP_TIME: zmp_time,
         "Ankles relative to the pelvis (Figs. 10-11, 16-17)": plots.trajectories(pattern),
         "Both legs: joint angles, torques and powers in the simulation (Figs. 12-14 of Lim et al.)":
             plots.joints(result),
@@ -169,7 +174,20 @@ def _figures(pattern: WalkingPattern, result: SimulationResult, motors: list[Mot
     if motors:
         images["Torque-speed operating points against the motors' envelopes (joint side)"] = \
             plots.motor_envelopes(result, motors)
-    return images
+    return images, {ZMP_TIME: axis}
+
+
+def _figure_html(images: dict[str, bytes], time_axes: dict[str, dict[str, float]]) -> str:
+    """The figures as HTML; those in ``time_axes`` carry it (``data-time-axis``) for the replay's time cursor."""
+    esc = html.escape
+
+    def axis(caption: str) -> str:
+        where = time_axes.get(caption)
+        return f" data-time-axis='{json.dumps(where)}'" if where else ""
+
+    return "\n".join(
+        f"<figure><img src='{_data_uri('image/png', payload)}' alt='{esc(caption)}'{axis(caption)}>"
+        f"<figcaption>{esc(caption)}</figcaption></figure>" for caption, payload in images.items())
 
 
 def _animation(robot: RobotModel, result: SimulationResult, folder: Path,
@@ -302,7 +320,7 @@ def _fit_table(fits: list[MotorFit]) -> str:
             f"<th>held peak [% of envelope]</th><th>verdict</th></tr>\n{fit_rows}\n</table>" if fits else "")
 
 
-def _page(title: str, robot: RobotModel, summary: dict[str, Any], images: dict[str, bytes],
+def _page(title: str, robot: RobotModel, summary: dict[str, Any], figures: str,
           movie: str, margins: list[tuple[int, str, str, float, float, float]],
           rows: list[ActuatorRow], verdict: Verdict, fits: list[MotorFit], steps: str) -> str:
     esc = html.escape
@@ -311,9 +329,6 @@ def _page(title: str, robot: RobotModel, summary: dict[str, Any], images: dict[s
         f"<td class='{'good' if m >= 0 else 'bad'}'>{m * 1e3:+.1f}</td></tr>"
         for n, kind, swing, start, duration, m in margins)
     actuator_rows = actuator_html(rows)
-    figures = "\n".join(
-        f"<figure><img src='{_data_uri('image/png', payload)}' alt='{esc(caption)}'>"
-        f"<figcaption>{esc(caption)}</figcaption></figure>" for caption, payload in images.items())
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>{esc(title)}</title>
 {STYLE}</head>

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import io
+from collections.abc import Sequence
 
 import matplotlib
 
 matplotlib.use("Agg")  # no display needed; before pyplot is imported
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.patches import Polygon
 
@@ -79,6 +81,20 @@ def _landings(result: SimulationResult) -> np.ndarray:
 
 def zmp_time(pattern: WalkingPattern, result: SimulationResult | None) -> bytes:
     """ZMP (and CoP) against time with the support polygon's bounds (Figs. 21, 27-31)."""
+    return zmp_time_axis(pattern, result)[0]
+
+
+def _time_axis(figure: Figure, axes: Sequence[Axes]) -> dict[str, float]:
+    """Where the time axis of stacked ``axes`` lies in the image, as fractions from its left and top edges, and
+    its limits [s] (for the page's time cursor)."""
+    figure.tight_layout()
+    first, last = axes[0].get_position(), axes[-1].get_position()
+    t0, t1 = axes[0].get_xlim()
+    return {"left": first.x0, "right": first.x1, "top": 1 - first.y1, "bottom": 1 - last.y0, "t0": t0, "t1": t1}
+
+
+def zmp_time_axis(pattern: WalkingPattern, result: SimulationResult | None) -> tuple[bytes, dict[str, float]]:
+    """:func:`zmp_time` and where its time axis lies (:func:`_time_axis`)."""
     polygons = pattern.support_polygons()
     begins = np.array([p.begin for p in pattern.support_phases])
     which = np.clip(np.searchsorted(begins, pattern.time, side="right") - 1, 0, len(begins) - 1)
@@ -95,7 +111,8 @@ def zmp_time(pattern: WalkingPattern, result: SimulationResult | None) -> bytes:
     axes[0].legend(loc="upper left", fontsize=8)
     axes[1].set_xlabel("t [s]")
     axes[0].set_title("ZMP against time")
-    return _png(figure)
+    where = _time_axis(figure, axes)
+    return _png(figure), where
 
 
 def trajectories(pattern: WalkingPattern) -> bytes:

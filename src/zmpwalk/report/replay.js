@@ -35,6 +35,7 @@
     section.setAttribute("data-base-y", base[3 * k + 1].toFixed(4));
     if (view) view.show(k);
     drawPlot();
+    cursors.forEach(function (cursor) { cursor.show(state.t); });
   }
   function setPlaying(on) {
     state.playing = on; state.last = null;
@@ -95,6 +96,38 @@
     state.follow = e.target.checked;
     if (view) view.show(frameAt(state.t));
   });
+
+  // A time cursor on each report figure whose <img> carries data-time-axis (left, right, top, bottom as fractions
+  // of the image, t0 and t1 its time limits [s]); clicking on the figure sets the time.
+  var cursors = [];
+  function cursor(img) {
+    var axis = JSON.parse(img.getAttribute("data-time-axis")), holder = document.createElement("div");
+    holder.style.cssText = "position:relative;display:inline-block;max-width:100%";
+    img.parentNode.insertBefore(holder, img); holder.appendChild(img);
+    var line = document.createElement("div");
+    line.className = "replay-cursor";
+    line.style.cssText = "position:absolute;width:2px;margin-left:-1px;background:#000;opacity:0.7;pointer-events:none;" +
+      "top:" + (100 * axis.top) + "%;height:" + (100 * (axis.bottom - axis.top)) + "%";
+    holder.appendChild(line);
+    img.style.cursor = "crosshair";
+    img.addEventListener("click", function (e) {
+      var box = img.getBoundingClientRect(), x = (e.clientX - box.left) / box.width;
+      if (x < axis.left || x > axis.right) return;
+      setPlaying(false);
+      setTime(axis.t0 + (axis.t1 - axis.t0) * (x - axis.left) / (axis.right - axis.left));
+    });
+    return { show: function (t) {
+      var x = axis.left + (axis.right - axis.left) * (t - axis.t0) / (axis.t1 - axis.t0);
+      line.style.left = (100 * x).toFixed(3) + "%";
+      line.setAttribute("data-time", t.toFixed(3));
+    } };
+  }
+  function attachCursors() {  // the figures come after the replay in the page
+    cursors = Array.prototype.map.call(document.querySelectorAll("img[data-time-axis]"), cursor);
+    cursors.forEach(function (c) { c.show(state.t); });
+  }
+  if (document.readyState === "loading") document.addEventListener("DOMContentLoaded", attachCursors);
+  else attachCursors();
 
   function geometry(geom) {
     var s = geom.size, g;
