@@ -29,6 +29,7 @@ def demo(tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 def test_demo_writes_the_report_folder(demo):
     names = {p.name for p in demo.iterdir()}
     assert {"index.html", "figure1.png", "figure4.png", "actuators.csv", "pattern.csv", "summary.json"} <= names
@@ -57,6 +58,7 @@ def _table_cells(page: str, table_id: str) -> list[list[str]]:
     return [re.findall(r"<t[hd][^>]*>(.*?)</t[hd]>", row) for row in table.split("</tr>") if "<t" in row]
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed (.ci/run installs it)")
 def test_headless_browser_loads_every_image_and_the_animation(demo):
     profile = tempfile.mkdtemp()
@@ -94,6 +96,7 @@ def _replay_dom(index: Path, fragment: str) -> dict[str, str]:
     return attributes
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed (.ci/run installs it)")
 def test_the_interactive_replay_draws_the_robot_moves_with_the_time_and_shows_the_footprints(demo):
     from PIL import Image
@@ -140,6 +143,7 @@ def test_decimated_meshes_keep_their_shape_with_fewer_faces():
     assert np.allclose(decimate(vertices, faces[:100], limit=2000)[1], faces[:100], atol=0)  # small: unchanged
 
 
+@pytest.mark.slow
 def test_the_gif_is_opt_in_and_is_the_replays_fallback(tmp_path):
     steps = tmp_path / "walk.toml"
     steps.write_text("[[steps]]\nduration = 0.8\nforward = 0.1\nrepeat = 2\n")
@@ -168,6 +172,7 @@ def test_report_errors(tmp_path, capsys, argv, message):
     assert message in capsys.readouterr().err
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("argv", [["report", "STEPS"], ["demo", "STEPS"], ["report", "--steps", "STEPS"]])
 def test_report_and_demo_take_a_steps_file_as_plan_and_simulate_do(tmp_path, capsys, argv):
     steps = tmp_path / "walk.toml"
@@ -203,6 +208,7 @@ SHAPES = """<mujoco><asset><mesh name="tetra" vertex="0 0 0  0.1 0 0  0 0.1 0  0
 </body></worldbody></mujoco>"""
 
 
+@pytest.mark.slow
 def test_every_kind_of_geom_reaches_the_page_and_three_js_builds_it(tmp_path):
     import mujoco
 
