@@ -172,30 +172,34 @@ def test_a_seeded_loop_on_the_machines_own_clock(hubo, rate, joints):
 
 
 @settings(max_examples=200, deadline=None)
-@given(costs=st.lists(st.floats(0.0, 3.0), min_size=1, max_size=40), budget=st.floats(0.0, 5.0),
-       quota=st.integers(1, 10))
+@given(costs=st.lists(st.tuples(st.floats(0.0, 3.0), st.booleans()), min_size=1, max_size=40),
+       budget=st.floats(0.0, 5.0), quota=st.integers(1, 10))
 def test_run_for_begins_no_part_after_its_budget_and_gives_the_same_result(costs, budget, quota):
     """slices.run_for on a clock that each part advances by its cost: at least one part, none begun once the
-    budget is spent (so the time is at most the budget and one part), and, run until done, the result that
-    run_to_end gives."""
-    from zmpwalk.slices import UNFINISHED, Parts, run_for, run_to_end
+    budget is spent (so the time is at most the budget and one part), a part marked ALONE only while at most a
+    quarter of the budget is spent, and, run until done, the result that run_to_end gives."""
+    from zmpwalk.slices import ALONE, LONG_PART_START, UNFINISHED, Parts, run_for, run_to_end
 
     now = [0.0]
-    begun: list[float] = []
+    begun: list[tuple[float, bool]] = []  # when each part began, and whether it was marked ALONE
 
     def computation() -> Parts[int]:
-        for cost in costs:
-            begun.append(now[0])
+        alone = False
+        for cost, mark in costs:
+            begun.append((now[0], alone))
             now[0] += cost
-            yield
+            alone = mark
+            yield ALONE if mark else None
         return len(costs)
 
     parts, total, result = computation(), 0, UNFINISHED
     while result is UNFINISHED:
-        start = now[0]
-        first = len(begun)
+        start, first = now[0], len(begun)
         result, count = run_for(parts, budget, quota, lambda: now[0])
         total += count
-        assert count >= 1 or result is not UNFINISHED
-        assert all(time - start < budget for time in begun[first + 1:])  # no part begun after the budget
+        assert count >= 1
+        later = begun[first + 1:]  # the parts begun after the call's first one
+        assert all(time - start < budget for time, _ in later)
+        assert all(time - start <= LONG_PART_START * budget for time, alone in later if alone)
+    begun.clear()
     assert result == run_to_end(computation()) == len(costs) and total == len(costs) + 1

@@ -699,3 +699,25 @@ def test_a_check_not_complete_when_its_step_begins_never_finishes_in_a_tick(hubo
         if watch.replaced(command) or id(command) in watch.rejected:
             continue
         assert id(command) in watch.walked, command  # queued (or the last given) and not replaced: it walked
+
+
+@pytest.mark.parametrize("rate", [100.0, 1000.0])
+def test_the_tick_budget_can_be_given(hubo, rate, monkeypatch):
+    """OnlineWalker(budget=...) sets the time a tick spends on a check: on a clock where a part takes 10 us, a
+    tick runs at most budget / 10 us parts, fewer with a smaller budget, and the check still ends; a budget
+    that is not a positive time below the control period is refused."""
+    counting_clock(monkeypatch, 10e-6)
+    for budget, most in ((20e-6, 2), (60e-6, 6)):
+        walker = OnlineWalker(hubo, rate=rate, joints=True, budget=budget)
+        walker.command(StepCommand(0.8, 0.1))
+        largest = 0
+        while walker.checking is not None:
+            before = walker._job.parts
+            job = walker._job
+            walker.tick()
+            if walker._job is job:
+                largest = max(largest, job.parts - before)
+        assert largest == most and walker.queued == StepCommand(0.8, 0.1)
+    for budget in (0.0, -1e-5, math.nan, math.inf, 1.0 / rate, True, "5e-5"):
+        with pytest.raises(InvalidParameterError, match="budget"):
+            OnlineWalker(hubo, rate=rate, budget=budget)  # type: ignore[arg-type]

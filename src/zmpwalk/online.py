@@ -63,6 +63,7 @@ Behaviour:
 from __future__ import annotations
 
 import math
+import numbers
 import time
 from array import array
 from dataclasses import dataclass, field
@@ -102,7 +103,7 @@ from zmpwalk.patterns.polynomial import (
 from zmpwalk.patterns.result import SUPPORT_NAMES, check_rate
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
-from zmpwalk.slices import UNFINISHED, Parts, run_for, run_to_end
+from zmpwalk.slices import ALONE, UNFINISHED, Parts, run_for, run_to_end
 
 Array = NDArray[np.float64]
 
@@ -269,6 +270,17 @@ def work_budget(rate: float) -> float:
     return max(WORK_BUDGET, WORK_FRACTION / rate)
 
 
+def _checked_budget(budget: object, rate: float) -> float:
+    """``budget`` [s] as a float: a positive number below the control period at ``rate`` [Hz].
+
+    Raises:
+        InvalidParameterError: Anything else.
+    """
+    if isinstance(budget, bool) or not isinstance(budget, numbers.Real) or not 0.0 < budget < 1.0 / rate:
+        raise InvalidParameterError("budget", budget, f"a time in (0, {1.0 / rate:g}) s, the control period")
+    return float(budget)
+
+
 @dataclass
 class _Rejection:
     """A command refused by its check, where it was to start, and whether the error is the one to give."""
@@ -295,15 +307,22 @@ class OnlineWalker:
         generator: ``"polynomial"`` (the HUBO pattern, default) or ``"hyperbolic"`` (the linear inverted
             pendulum pattern of Lim et al., stage by stage: :mod:`zmpwalk.patterns.lipm_stage`; same
             footsteps, swings and continuity; a command whose ZMP would leave the feet is rejected).
+        budget: The time [s] a tick may spend on a command's check, one part over at most (default
+            :func:`work_budget`: 50 us, or 1 % of the control period where that is longer). Smaller: shorter
+            ticks, and checks that take more ticks, so that more commands come too late for the step they were
+            given in (and walk a step later: module docstring).
 
     Raises:
-        InvalidParameterError: An unknown ``pelvis`` or ``generator``, or ``pelvis="quintic"`` with the
-            hyperbolic generator (its pelvis is the pendulum's own motion).
+        InvalidParameterError: An unknown ``pelvis`` or ``generator``, ``pelvis="quintic"`` with the
+            hyperbolic generator (its pelvis is the pendulum's own motion), or a ``budget`` that is not a
+            positive number of seconds below the control period.
     """
 
     def __init__(self, robot: RobotModel, rate: float = 100.0, schedule: Schedule | None = None,
-                 joints: bool = False, pelvis: str = "cubic", generator: str = "polynomial") -> None:
+                 joints: bool = False, pelvis: str = "cubic", generator: str = "polynomial",
+                 budget: float | None = None) -> None:
         check_rate(rate)
+        self._budget = work_budget(rate) if budget is None else _checked_budget(budget, rate)
         self._pelvis = online_pelvis(pelvis, generator)
         self.robot = robot
         self.rate = float(rate)
@@ -465,7 +484,7 @@ class OnlineWalker:
         quota = -(-(expected - job.parts) // ticks_left)  # its share of the parts left
         plan: object
         try:
-            plan, parts = run_for(job.planning, work_budget(self.rate), quota, _clock)
+            plan, parts = run_for(job.planning, self._budget, quota, _clock)
             job.parts += parts
         except ZmpwalkError as error:
             self._drop_job()
@@ -568,6 +587,7 @@ class OnlineWalker:
         else:
             rows = self._buffers.take(count)
             buffers.append(rows)
+        yield ALONE  # the stage table's numbers: a long part (a Python loop over the stages' fields)
         table = yield from StageTable.in_parts(stages)
         yield
         # in slices for command(); an imported robot's legs in one pass (its base velocities are differences

@@ -73,7 +73,7 @@ from zmpwalk.footsteps import Pose2D, StagePlan, foot_corners
 from zmpwalk.patterns.hyperbolic import COAST, Piece, propagate, run_pieces, solve_step, solve_zmps
 from zmpwalk.patterns.result import PHASE_TIME_TOL
 from zmpwalk.robots.model import RobotModel
-from zmpwalk.slices import Parts, whole
+from zmpwalk.slices import ALONE, Parts, whole
 from zmpwalk.zmp import convex_hull, point_margin
 
 Array = NDArray[np.float64]
@@ -249,7 +249,7 @@ def lipm_pelvis_in_parts(plan: StagePlan, position: tuple[float, float], velocit
             target_p, target_v = ankles_middle, np.zeros(2)
         else:  # a steady step of Fig. 3 towards this command's steady state
             steady = solve_step(a, 2.0 * plan.forward, T, d, robot.hip_spacing / 2)
-            yield  # the steady step, then the target's: a part each
+            yield ALONE  # the steady step, then the target's: a long part each
             along_pieces = [(d / 2, COAST), (steady.t1, 0), (steady.t2, COAST), (steady.t3, 1), (d / 2, COAST)]
             across_pieces = [(d / 2, COAST), ((T - d) / 2, 0), ((T - d) / 2, 1), (d / 2, COAST)]
             centring = 0.5 * (steady.zmp1 + steady.zmp2)

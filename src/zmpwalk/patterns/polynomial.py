@@ -77,7 +77,7 @@ from zmpwalk.patterns.result import (
 )
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
-from zmpwalk.slices import Parts, whole
+from zmpwalk.slices import ALONE, Parts, whole
 
 Array = NDArray[np.float64]
 
@@ -315,12 +315,12 @@ def plan_next_in_parts(
     check_pelvis(pelvis)
     if boundary.at_rest and command.stop:
         return [], stance, boundary
-    yield
+    yield ALONE
     schedule.stage_parameters(command, robot)  # the tables' lookups, kept by the schedule: parts of their own
     if command.is_two_stage and stance.next_swing not in (0, command.leading_side):  # a plain step inserted
-        yield
+        yield ALONE
         schedule.stage_parameters(replace(command, side=0.0, turn=0.0), robot)
-    yield
+    yield ALONE
     plans, next_stance = plan_command(stance, command, robot, schedule)
     if boundary.at_rest:
         first = plans[0]
@@ -366,6 +366,7 @@ def hyperbolic_stage(stage: Stage, boundary: Boundary, robot: RobotModel, next_p
     if position is None:  # standing: above the middle of the ankles
         position = _pair(0.5 * (np.array([plan.support_pose.x, plan.support_pose.y])
                                 + [plan.swing_start.x, plan.swing_start.y]))
+    yield ALONE  # the pendulum's targets (a steady step solved): a long part
     pelvis, end_position, end_velocity = yield from lipm_pelvis_in_parts(plan, position, boundary.pelvis_velocity,
                                                                          robot, next_plan)
     end = Boundary(time=boundary.time + plan.duration, pelvis_velocity=end_velocity, at_rest=plan.stop,
