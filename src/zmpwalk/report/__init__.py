@@ -1,4 +1,5 @@
-"""Reports: paper-style plots, the offscreen animation of a simulated walk, and a self-contained HTML page."""
+"""Reports: paper-style plots, the interactive replay of a simulated walk (three.js), the optional offscreen GIF, and a
+self-contained HTML page."""
 
 from zmpwalk.report.page import Report, build_report
 
