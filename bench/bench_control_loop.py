@@ -1,22 +1,25 @@
 """The control loop's ticks under commands given at random times: per-tick CPU time of ``OnlineWalker``.
 
-Each configuration (1 kHz with joints, 1 kHz without, 100 Hz with joints) runs ``--ticks`` ticks of one
-:class:`~zmpwalk.OnlineWalker` (HUBO) with ``gc.collect(); gc.freeze()`` after setup, as the README's loop. In
-every step a command is given at a random tick, as an operator gives it (a seeded rng): mostly ordinary steps,
-and hostile ones among them: beyond the legs' reach, too fast for the foot speed limit, ``stop()`` and a zero
-step time (whose ``InvalidParameterError`` is caught, as a loop would). While the walker stands the next walk is
-commanded after a random wait. Timed, with ``time.thread_time_ns()`` (this thread's CPU time, so that the other
-processes on a shared machine do not count), is each loop iteration: the ``command()`` given in it, if any, and
-``tick()``. Counted: the commands given, those that walked (queued, then begun), rejected, ``stop()``, the zero
-step times caught, and the checks restarted in a tick because the walk took another step first (the queued
-command, or the closing stop) while they ran. Reading ``walker.rejection`` (which searches the largest stride
-that fits, tens of milliseconds) is outside the timing, as the README advises.
+Each configuration (1 kHz with joints, 1 kHz without, 100 Hz with joints, 1 kHz with joints and the hyperbolic
+generator) runs ``--ticks`` ticks of one :class:`~zmpwalk.OnlineWalker` (HUBO) with ``gc.collect();
+gc.freeze()`` after setup, as the README's loop. In every step a command is given at a random tick, as an
+operator gives it (a seeded rng): mostly ordinary steps, and hostile ones among them: beyond the legs' reach,
+too fast for the foot speed limit, ``stop()`` and a zero step time (whose ``InvalidParameterError`` is caught,
+as a loop would). While the walker stands the next walk is commanded after a random wait. Timed, with
+``time.thread_time_ns()`` (this thread's CPU time, so that the other processes on a shared machine do not
+count), is each loop iteration: the ``command()`` given in it, if any, and ``tick()``. Counted: the commands
+given, those that walked (queued, then begun), rejected, ``stop()``, the zero step times caught, and the checks
+restarted in a tick because the walk took another step first (the queued command, or the closing stop) while
+they ran. Reading ``walker.rejection`` (which searches the largest stride that fits, tens of milliseconds) is
+outside the timing, as the README advises.
 
 A ``floor`` line times the same loop around a copy of a 39-float row and one object: what this machine
 gives any Python loop. ``--before DIR`` runs every configuration also against another source tree
 (``DIR/src`` on ``PYTHONPATH``, e.g. a ``git worktree`` of an older commit), in the same run, side by side.
 
-Run: ``python bench/bench_control_loop.py [--ticks 50000] [--seed 1] [--before /tmp/zmpwalk-before]``.
+``--gc disable`` also turns Python's garbage collector off for the loop (after the freeze).
+
+Run: ``python bench/bench_control_loop.py [--ticks 50000] [--seed 1] [--before /tmp/zmpwalk-before] [--gc disable]``.
 Prints figures; asserts nothing. Goals (issue 33): max <= 200 us, median <= 10 us, no tick over 1 ms.
 """
 
@@ -33,10 +36,11 @@ from pathlib import Path
 
 import numpy as np
 
-CONFIGURATIONS = {  # name: (rate [Hz], joints)
-    "1 kHz, joints": (1000.0, True),
-    "1 kHz, no joints": (1000.0, False),
-    "100 Hz, joints": (100.0, True),
+CONFIGURATIONS = {  # name: (rate [Hz], joints, generator)
+    "1 kHz, joints": (1000.0, True, "polynomial"),
+    "1 kHz, no joints": (1000.0, False, "polynomial"),
+    "100 Hz, joints": (100.0, True, "polynomial"),
+    "1 kHz, joints, hyperbolic": (1000.0, True, "hyperbolic"),
 }
 HOSTILE_KINDS = ("reach", "fast", "stop", "zero")
 HOSTILE_SHARE = 0.2  # [-] of the commands
@@ -64,11 +68,13 @@ def draw_command(rng: np.random.Generator) -> tuple[str, dict[str, float] | None
                     "turn": float(rng.uniform(-0.15, 0.15))}
 
 
-def run_loop(rate: float, joints: bool, ticks: int, seed: int) -> dict[str, object]:
-    """The loop of the module docstring; per-tick CPU times [us] and counts."""
+def run_loop(rate: float, joints: bool, ticks: int, seed: int, generator: str = "polynomial",
+             collector: str = "freeze") -> dict[str, object]:
+    """The loop of the module docstring; per-tick CPU times [us] and counts. ``collector``: ``"freeze"``
+    (``gc.collect(); gc.freeze()`` after setup) or ``"disable"`` (and the collector off during the loop)."""
     from zmpwalk import OnlineWalker, StepCommand, ZmpwalkError, load_robot
 
-    walker = OnlineWalker(load_robot("hubo"), rate=rate, joints=joints)
+    walker = OnlineWalker(load_robot("hubo"), rate=rate, joints=joints, generator=generator)
     rng = np.random.default_rng(seed)
     counts = dict.fromkeys(("given", "caught", "rejected", "walked", "restarted", "stops"), 0)
     times = np.empty(ticks, dtype=np.int64)
@@ -78,6 +84,8 @@ def run_loop(rate: float, joints: bool, ticks: int, seed: int) -> dict[str, obje
     rejection = queued = None
     gc.collect()
     gc.freeze()
+    if collector == "disable":
+        gc.disable()
     clock = time.thread_time_ns
     for index in range(ticks):
         give = since == give_at
@@ -115,6 +123,7 @@ def run_loop(rate: float, joints: bool, ticks: int, seed: int) -> dict[str, obje
             support = sample.support
         elif give_at < 0 and not walker.walking and walker.checking is None:  # standing: the next walk
             give_at, since = int(rng.integers(1, int(0.5 * rate) + 2)), 0
+    gc.enable()
     gc.unfreeze()
     return {"us": (times / 1e3).tolist(), **counts}
 
@@ -141,13 +150,14 @@ def figures(us: np.ndarray) -> str:
             f"max {us.max():8.1f}  >200us {int((us > 200).sum()):5d}  >1ms {int((us > 1000).sum()):3d}")
 
 
-def child(configuration: str, ticks: int, seed: int, source: str | None) -> dict[str, object]:
+def child(configuration: str, ticks: int, seed: int, source: str | None, collector: str) -> dict[str, object]:
     """One configuration in a fresh process (``source``: a src directory put first on PYTHONPATH)."""
     environment = dict(os.environ)
     if source is not None:
         environment["PYTHONPATH"] = source + os.pathsep + environment.get("PYTHONPATH", "")
     result = subprocess.run([sys.executable, __file__, "--child", configuration, "--ticks", str(ticks),
-                             "--seed", str(seed)], env=environment, capture_output=True, text=True, check=True)
+                             "--seed", str(seed), "--gc", collector], env=environment, capture_output=True,
+                            text=True, check=True)
     data: dict[str, object] = json.loads(result.stdout.splitlines()[-1])
     return data
 
@@ -159,14 +169,17 @@ def main() -> None:
     parser.add_argument("--before", help="another checkout (its src/ is run too, side by side)")
     parser.add_argument("--only", choices=[*CONFIGURATIONS, "floor"], action="append",
                         help="run only these configurations")
+    parser.add_argument("--gc", choices=["freeze", "disable"], default="freeze",
+                        help="after setup gc.collect(); gc.freeze() (default, the README's loop), and with "
+                             "'disable' the collector off during the loop")
     parser.add_argument("--child", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
         if args.child == "floor":
             result = run_floor(args.ticks)
         else:
-            rate, joints = CONFIGURATIONS[args.child]
-            result = run_loop(rate, joints, args.ticks, args.seed)
+            rate, joints, generator = CONFIGURATIONS[args.child]
+            result = run_loop(rate, joints, args.ticks, args.seed, generator, args.gc)
         import zmpwalk
 
         result["source"] = str(Path(zmpwalk.__file__).parent.parent)
@@ -176,16 +189,16 @@ def main() -> None:
     if args.before:
         trees.insert(0, ("before", str(Path(args.before) / "src")))
     print(f"per-iteration CPU time [us] (command() given in it, if any, and tick()), {args.ticks} ticks each, "
-          f"seed {args.seed}")
+          f"seed {args.seed}, garbage collector: {args.gc}")
     for configuration in args.only or ["floor", *CONFIGURATIONS]:
         for name, source in trees if configuration != "floor" else [("", None)]:
-            result = child(configuration, args.ticks, args.seed, source)
+            result = child(configuration, args.ticks, args.seed, source, args.gc)
             counts = "" if configuration == "floor" else (
                 f"  ({result['given']} commands: {result['walked']} walked, {result['rejected']} rejected, "
                 f"{result['stops']} stop(), {result['caught']} errors caught; {result['restarted']} checks "
                 f"restarted, the walk having taken another step)")
             label = f"{configuration} {name}".strip()
-            print(f"{label:26} {figures(np.array(result['us']))}{counts}", flush=True)
+            print(f"{label:38} {figures(np.array(result['us']))}{counts}", flush=True)
 
 
 if __name__ == "__main__":

@@ -203,3 +203,39 @@ def test_run_for_begins_no_part_after_its_budget_and_gives_the_same_result(costs
         assert all(time - start <= LONG_PART_START * budget for time, alone in later if alone)
     begun.clear()
     assert result == run_to_end(computation()) == len(costs) and total == len(costs) + 1
+
+
+@pytest.mark.parametrize("rate", [100.0, 1000.0])
+def test_the_loop_leaves_no_reference_cycles(hubo, rate):
+    """A walker driven by random commands (rejections, late checks, stop(), walks from standstill) leaves no
+    cyclic garbage of its own: everything it drops is freed by its reference count, so a hard loop may run
+    with the garbage collector disabled (docs/speed.md) and leak nothing."""
+    import gc
+    import types
+
+    rng = np.random.default_rng(5)
+    actions: list[tuple[float, object]] = []
+    for _ in range(25):
+        kind = rng.random()
+        action: object = "stop" if kind < 0.1 else {"duration": 0.8, "forward": 0.9} if kind < 0.3 else {
+            "duration": float(rng.uniform(0.7, 1.0)), "forward": float(rng.uniform(-0.1, 0.2))}
+        actions.append((float(rng.uniform(0.0, 1.0)), action))
+    gc.collect()
+    enabled = gc.isenabled()
+    gc.disable()
+    gc.set_debug(gc.DEBUG_SAVEALL)
+    try:
+        walker = OnlineWalker(hubo, rate=rate, joints=True)
+        outcomes = Outcomes()
+        _loop(walker, actions, outcomes, lambda _: None)
+        assert outcomes.walked and outcomes.rejected
+        del walker, outcomes
+        gc.collect()
+        ours = [o for o in gc.garbage if type(o).__module__.startswith("zmpwalk")
+                or isinstance(o, types.GeneratorType | types.FrameType | np.ndarray | BaseException)]
+        assert not ours
+    finally:
+        gc.set_debug(0)
+        gc.garbage.clear()
+        if enabled:
+            gc.enable()

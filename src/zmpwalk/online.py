@@ -270,13 +270,25 @@ def work_budget(rate: float) -> float:
     return max(WORK_BUDGET, WORK_FRACTION / rate)
 
 
+def _bare(error: ZmpwalkError) -> ZmpwalkError:
+    """``error`` without its traceback and the errors it was raised in handling, to be kept as the rejection: a
+    traceback holds the frames of the failed check's generators, their arrays with them, until it is freed
+    (in the next command(), inside the loop)."""
+    cause: BaseException | None = error
+    while cause is not None:
+        following = cause.__cause__ or cause.__context__
+        cause.__traceback__ = cause.__cause__ = cause.__context__ = None
+        cause = following
+    return error
+
+
 def _checked_budget(budget: object, rate: float) -> float:
     """``budget`` [s] as a float: a positive number below the control period at ``rate`` [Hz].
 
     Raises:
         InvalidParameterError: Anything else.
     """
-    if isinstance(budget, bool) or not isinstance(budget, numbers.Real) or not 0.0 < budget < 1.0 / rate:
+    if isinstance(budget, bool) or not isinstance(budget, numbers.Real) or not 0.0 < float(budget) < 1.0 / rate:
         raise InvalidParameterError("budget", budget, f"a time in (0, {1.0 / rate:g}) s, the control period")
     return float(budget)
 
@@ -458,8 +470,8 @@ class OnlineWalker:
             return None
         rejection = self._rejection
         if not rejection.named:
-            rejection.error = self._rejected(rejection.command, rejection.stance, rejection.boundary,
-                                             rejection.error)
+            rejection.error = _bare(self._rejected(rejection.command, rejection.stance, rejection.boundary,
+                                                   rejection.error))
             rejection.named = True
         return rejection.error
 
@@ -488,7 +500,7 @@ class OnlineWalker:
             job.parts += parts
         except ZmpwalkError as error:
             self._drop_job()
-            self._rejection = _Rejection(job.command, error, job.stance, job.boundary)
+            self._rejection = _Rejection(job.command, _bare(error), job.stance, job.boundary)
             return
         if plan is UNFINISHED:
             return
