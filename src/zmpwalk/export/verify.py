@@ -24,7 +24,7 @@ from zmpwalk.export.clips import foot_bodies, lowest_sole_height
 
 Array = NDArray[np.float64]
 
-STANCE_HEIGHT = 0.005  # [m] lowest point of a foot in stance at most this high
+STANCE_HEIGHT = 0.002  # [m] lowest point of a foot in stance at most this high
 STANCE_SPEED = 0.05  # [m/s] horizontal speed of a foot in stance at most this (a swing: about 0.5-1 m/s)
 MIN_STANCE = 0.1  # [s] shortest stance phase judged
 MAX_SLIDE = 0.005  # [m]
