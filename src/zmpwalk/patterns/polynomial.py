@@ -54,15 +54,15 @@ from zmpwalk.errors import (
 )
 from zmpwalk.footsteps import GROUNDED_STRETCH, LEFT, Pose2D, StagePlan, Stance, grounded_stage, plan_command
 from zmpwalk.kinematics import JointLimitError, check_leg_reach
-from zmpwalk.patterns.evaluation import (  # the stages' evaluation; callers may import these from here
+from zmpwalk.patterns.evaluation import (
     QUINTIC_SHIFT_END_RATES,
     SHIFT_END_RATES,
     SHIFT_NONE,
     SHIFT_PROFILES,
-    Samples,
-    StageTable,
-    evaluate,
 )
+from zmpwalk.patterns.evaluation import Samples as Samples  # re-exported: other modules import these here
+from zmpwalk.patterns.evaluation import StageTable as StageTable
+from zmpwalk.patterns.evaluation import evaluate as evaluate
 from zmpwalk.patterns.evaluation import side_shift_profile as side_shift_profile  # docs/equations.md
 from zmpwalk.patterns.lipm_stage import LipmPelvis, lipm_pelvis_in_parts
 from zmpwalk.patterns.result import (
