@@ -220,6 +220,7 @@ def test_the_loop_leaves_no_reference_cycles(hubo, rate):
         action: object = "stop" if kind < 0.1 else {"duration": 0.8, "forward": 0.9} if kind < 0.3 else {
             "duration": float(rng.uniform(0.7, 1.0)), "forward": float(rng.uniform(-0.1, 0.2))}
         actions.append((float(rng.uniform(0.0, 1.0)), action))
+    actions.append((0.5, {"duration": 0.8, "forward": 0.9}))  # the last: nothing replaces it, its rejection is sure
     gc.collect()
     enabled = gc.isenabled()
     gc.disable()

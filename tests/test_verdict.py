@@ -206,14 +206,16 @@ T1 = Path(__file__).resolve().parents[2] / "shared" / "robots" / "booster_t1" / 
 @pytest.mark.slow
 @pytest.mark.skipif(not T1.is_file(), reason="../shared/robots is absent")
 def test_booster_t1_on_hubos_scaled_tables_is_not_a_pass(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """10 steps of 0.1 m at 0.9 s (docs/robot-import.md): it walks, but its plan's ZMP is 8.6 mm outside the
+    """10 steps of 0.1 m at 0.9 s on the polynomial generator (docs/robot-import.md): it walks, but its plan's ZMP
+    is 8.6 mm outside the
     soles (FAIL) and the right ankle roll is held at its 15 N m limit (saturated: WARN). The console, the page
     and the JSON say so, with
     the console's warning that the plan needs more than the actuators give."""
     steps = tmp_path / "t1.toml"
     steps.write_text("[[steps]]\nduration = 0.9\nforward = 0.1\nrepeat = 10\n", encoding="utf-8")
     out = tmp_path / "r"
-    assert main(["report", str(steps), "--robot", str(T1), "--no-animation", "--out", str(out)]) == EXIT_FAILED
+    assert main(["report", str(steps), "--robot", str(T1), "--generator", "polynomial", "--no-animation",
+                 "--out", str(out)]) == EXIT_FAILED
     printed = capsys.readouterr().out
     assert "plan's min ZMP margin -8.6 mm (OUTSIDE the support polygon)" in printed
     warning = "the plan itself needs more than the actuators give"
