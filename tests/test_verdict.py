@@ -94,8 +94,8 @@ def test_a_touchdown_starts_at_first_contact_not_when_the_sole_becomes_loaded() 
     import numpy as np
 
     from zmpwalk.robots import load_robot
-    from zmpwalk.sim.run import LOADED_FRACTION
-    from zmpwalk.sim.verdict import CONTACT_FRACTION, cop_margin_outside_touchdowns
+    from zmpwalk.sim.contact import CONTACT_FRACTION, LOADED_FRACTION
+    from zmpwalk.sim.verdict import cop_margin_outside_touchdowns
 
     robot = load_robot("hubo")
     time = np.arange(0.0, 1.0, 0.001)

@@ -34,18 +34,14 @@ from zmpwalk.footsteps import sole_corners
 from zmpwalk.kinematics import JOINT_COLUMNS
 from zmpwalk.online import START_DELAY, OnlineWalker
 from zmpwalk.robots.model import RobotModel
-from zmpwalk.sim.contact import LOADED_FRACTION
 from zmpwalk.sim.mujoco_plant import MujocoPlant
 from zmpwalk.sim.run import (
     AFTER_FALL,
     HOLD,
     Disturbances,
     SimulationResult,
-    _cop_margins,
-    _ground_reaction,
-    _rotation,
-    _rpy,
 )
+from zmpwalk.sim.soles import SoleMeasurements, foot_slip, rpy_from_quaternion, sole_measurements
 from zmpwalk.zmp import batch_hull_margin, edge_margin
 
 Array = NDArray[np.float64]
@@ -225,64 +221,14 @@ def _plan_margin(robot: RobotModel, log: _Log, n: int) -> float:
     return float(margin.min())
 
 
-@dataclass
-class _Soles:
-    """Per sample, as :func:`zmpwalk.sim.run.simulate` measures them: each sole's normal force (n, 2) [N], whether
-    it is loaded (n, 2), its CoP (n, 2, 2) [m] (nan unloaded), the total CoP (n, 2) [m] and its margin to the loaded
-    soles (n,) [m], the ankles (n, 2, 2) [m]."""
-
-    forces: Array
-    loaded: NDArray[np.bool_]
-    cop_feet: Array
-    cop: Array
-    margin: Array
-    ankles: Array
-
-
-def _soles(robot: RobotModel, plant: MujocoPlant, readings: Array) -> _Soles:
-    """The soles' forces and centres of pressure from the ankle sensors' rows (:class:`_Soles`)."""
-    sensors = plant.sensors
-    reactions = [_ground_reaction(sensors, readings, label, robot.ankle_height) for label in ("left", "right")]
-    forces = np.column_stack([r[0] for r in reactions])
-    loaded = forces > LOADED_FRACTION * plant.weight
-    cop_feet = np.stack([r[1] for r in reactions], axis=1)
-    cop_feet[~loaded] = np.nan
-    weights = np.where(loaded, forces, 0.0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        cop = np.nansum(cop_feet * weights[..., None], axis=1) / weights.sum(axis=1)[:, None]
-    cop[~loaded.any(axis=1)] = np.nan
-    corners, ankles = np.empty((len(readings), 2, 4, 2)), np.empty((len(readings), 2, 2))
-    half_length, half_width = robot.foot_length / 2, robot.foot_width / 2
-    for foot, (label, side) in enumerate((("left", 1), ("right", -1))):
-        rotation = _rotation(sensors.take(readings, f"{label}_ankle_quat"))
-        origin = sensors.take(readings, f"{label}_ankle_pos")
-        cx, cy, z = robot.sole_center_x, side * robot.sole_center_y, -robot.ankle_height
-        local = np.array([[cx - half_length, cy - half_width, z], [cx + half_length, cy - half_width, z],
-                          [cx + half_length, cy + half_width, z], [cx - half_length, cy + half_width, z]])
-        corners[:, foot] = (origin[:, None, :] + np.einsum("nij,cj->nci", rotation, local))[..., :2]
-        ankles[:, foot] = origin[:, :2]
-    return _Soles(forces, loaded, cop_feet, cop, _cop_margins(cop, corners, loaded), ankles)
-
-
-def _slip(loaded: NDArray[np.bool_], ankles: Array) -> float:
-    """The largest horizontal slide [m] of an ankle while its sole stays loaded."""
-    slip = 0.0
-    for foot in range(2):
-        starts = np.flatnonzero(loaded[:, foot] & ~np.concatenate([[False], loaded[:-1, foot]]))
-        stops = np.flatnonzero(loaded[:, foot] & ~np.concatenate([loaded[1:, foot], [False]]))
-        for a, b in zip(starts, stops, strict=True):
-            slip = max(slip, float(np.linalg.norm(ankles[a:b + 1, foot] - ankles[a, foot], axis=1).max()))
-    return slip
-
-
 def _result(robot: RobotModel, plant: MujocoPlant, log: _Log, n: int, fall: int | None, planned_end: float,
             hold: float) -> SimulationResult:
     """The run's :class:`~zmpwalk.sim.run.SimulationResult` from its first ``n`` ticks (row ``k``: the state at the end
     of tick ``k``, labelled with the tick's time ``k / rate``, as :func:`~zmpwalk.sim.run.simulate` labels it)."""
     sensors, readings = plant.sensors, log.readings[:n]
     time = np.arange(n) / plant.rate
-    pelvis, rpy = sensors.take(readings, "pelvis_pos"), _rpy(sensors.take(readings, "pelvis_quat"))
-    soles = _soles(robot, plant, readings)
+    pelvis, rpy = sensors.take(readings, "pelvis_pos"), rpy_from_quaternion(sensors.take(readings, "pelvis_quat"))
+    soles = sole_measurements(robot, plant.sensors, readings, plant.weight)
     angles, velocities, torques = (sensors.columns(readings, [f"{c}_{s}" for c in JOINT_COLUMNS])
                                    for s in ("q", "qd", "tau"))
     end = (math.nan,) * 5 if fall is not None else _end_figures(plant, log, n, soles, hold)
@@ -291,7 +237,7 @@ def _result(robot: RobotModel, plant: MujocoPlant, log: _Log, n: int, fall: int 
     return SimulationResult(
         robot=robot, time=time, torso_position=pelvis, torso_rpy=rpy, fell=fall is not None,
         fall_time=None if fall is None else float(time[fall]), distance=distance, average_speed=distance / walked,
-        foot_slip=_slip(soles.loaded, soles.ankles), cop_left=soles.cop_feet[:, 0], cop_right=soles.cop_feet[:, 1],
+        foot_slip=foot_slip(soles.loaded, soles.ankles), cop_left=soles.cop_feet[:, 0], cop_right=soles.cop_feet[:, 1],
         cop=soles.cop, force_left=soles.forces[:, 0], force_right=soles.forces[:, 1],
         reference_zmp=log.zmp[:n].copy(), cop_margin=soles.margin,
         joint_angles=angles, joint_velocities=velocities, joint_torques=torques, joint_power=torques * velocities,
@@ -303,7 +249,7 @@ def _result(robot: RobotModel, plant: MujocoPlant, log: _Log, n: int, fall: int 
         end_attitude_range=end[4])
 
 
-def _end_figures(plant: MujocoPlant, log: _Log, n: int, soles: _Soles,
+def _end_figures(plant: MujocoPlant, log: _Log, n: int, soles: SoleMeasurements,
                  hold: float) -> tuple[float, float, float, float, float]:
     """How the walk ends: the feet against the walker's final plan (largest distance [m] and yaw error [rad]), and
     over the last ``hold``: the least sole force [N], the base's largest speed [m/s] and the torso's attitude spread
@@ -312,10 +258,11 @@ def _end_figures(plant: MujocoPlant, log: _Log, n: int, soles: _Soles,
     time = np.arange(n) / plant.rate
     feet = soles.ankles[-1]
     feet_error = max(float(np.linalg.norm(feet[f] - log.ankles[n - 1, f, :2])) for f in range(2))
-    yaws = [_rpy(sensors.take(readings[-1:], f"{label}_ankle_quat"))[0, 2] for label in ("left", "right")]
+    yaws = [rpy_from_quaternion(sensors.take(readings[-1:], f"{label}_ankle_quat"))[0, 2]
+            for label in ("left", "right")]
     yaw_error = max(abs(float((yaws[f] - log.yaws[n - 1, f] + math.pi) % (2 * math.pi) - math.pi)) for f in range(2))
     window = time > time[-1] - max(hold, 1.0 / plant.rate)
-    pelvis, rpy = sensors.take(readings, "pelvis_pos"), _rpy(sensors.take(readings, "pelvis_quat"))
+    pelvis, rpy = sensors.take(readings, "pelvis_pos"), rpy_from_quaternion(sensors.take(readings, "pelvis_quat"))
     speed = np.linalg.norm(np.gradient(pelvis[:, :2], time, axis=0), axis=1)
     return (feet_error, yaw_error, float(soles.forces[window].min()), float(speed[window].max()),
             float(np.ptp(rpy[window, :2], axis=0).max()))

@@ -27,7 +27,8 @@ from zmpwalk.robots.pd import is_position_servo
 from zmpwalk.sim.mjcf import contact_mapping
 from zmpwalk.sim.plant import Plant as SimPlant
 from zmpwalk.sim.plant import build_plant, set_initial_state, static_feedforward
-from zmpwalk.sim.run import FALL_HEIGHT_FRACTION, FALL_TILT, Disturbances, _MeasurementReader, _Sensors
+from zmpwalk.sim.run import FALL_HEIGHT_FRACTION, FALL_TILT, Disturbances, _MeasurementReader
+from zmpwalk.sim.soles import SensorSlices
 
 Array = NDArray[np.float64]
 
@@ -187,7 +188,7 @@ class MujocoPlant:
         if disturbances is not None:
             disturbances.apply(model)
         self.model, self.data = model, mujoco.MjData(model)
-        self.sensors = _Sensors(model)
+        self.sensors = SensorSlices(model)
         self._reader = _MeasurementReader(self.sensors, None if disturbances is None else disturbances.floor_rotation)
         servos = plant.leg_actuators
         kp, gear = model.actuator_gainprm[servos, 0], model.actuator_gear[servos, 0]

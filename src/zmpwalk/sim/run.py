@@ -47,7 +47,6 @@ from zmpwalk.files import atomic_output
 from zmpwalk.kinematics import JOINT_COLUMNS, JointTrajectory, check_sole_roll, pattern_joint_trajectory
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
-from zmpwalk.sim.contact import LOADED_FRACTION
 from zmpwalk.sim.mjcf import contact_mapping
 from zmpwalk.sim.plant import (
     Plant,
@@ -58,7 +57,13 @@ from zmpwalk.sim.plant import (
     servo_torques,
     set_initial_state,
 )
-from zmpwalk.zmp import batch_hull_margin, edge_margin
+from zmpwalk.sim.soles import (
+    SensorSlices,
+    foot_slip,
+    rotation_from_quaternion,
+    rpy_from_quaternion,
+    sole_measurements,
+)
 
 Array = NDArray[np.float64]
 
@@ -158,80 +163,6 @@ class SimulationResult:
         if len(error) == 0:
             return math.nan, math.nan
         return float(np.sqrt(np.mean(error**2))), float(error.max())
-
-
-def _rpy(quaternion: Array) -> Array:
-    w, x, y, z = quaternion.T
-    roll = np.arctan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
-    pitch = np.arcsin(np.clip(2 * (w * y - z * x), -1, 1))
-    yaw = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
-    return np.column_stack([roll, pitch, yaw])
-
-
-def _rotation(quaternion: Array) -> Array:
-    """Rotation matrices (n, 3, 3) from unit quaternions (n, 4) ``w, x, y, z``."""
-    w, x, y, z = quaternion.T
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
-    ], -2)
-
-
-class _Sensors:
-    """Slices of ``sensordata`` by sensor name."""
-
-    def __init__(self, model: mujoco.MjModel) -> None:
-        self.slices: dict[str, slice] = {}
-        for i in range(model.nsensor):
-            name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_SENSOR, i)
-            start = int(model.sensor_adr[i])
-            self.slices[name] = slice(start, start + int(model.sensor_dim[i]))
-
-    def take(self, data: Array, name: str) -> Array:
-        return data[:, self.slices[name]]
-
-    def columns(self, data: Array, names: list[str]) -> Array:
-        return np.column_stack([data[:, self.slices[n]] for n in names])
-
-
-def _ground_reaction(sensors: _Sensors, data: Array, label: str, ankle_height: float) -> tuple[Array, Array]:
-    """Normal force [N] (n,) and centre of pressure in world [m] (n, 2) of one sole, from its ankle sensor.
-
-    The sensor gives the wrench between the foot and the leg in the foot frame; the ground's is its
-    opposite (the foot's own weight and inertia are not removed, as on the robot). With the reaction
-    ``R`` and torque ``T`` about the ankle and the sole ``ankle_height`` below it:
-    ``p_x = -(T_y + h R_x) / R_z``, ``p_y = (T_x - h R_y) / R_z``.
-    """
-    force = -sensors.take(data, f"{label}_force")
-    torque = -sensors.take(data, f"{label}_torque")
-    h = ankle_height
-    with np.errstate(invalid="ignore", divide="ignore"):
-        local = np.column_stack([-(torque[:, 1] + h * force[:, 0]) / force[:, 2],
-                                 (torque[:, 0] - h * force[:, 1]) / force[:, 2], np.full(len(force), -h)])
-    rotation = _rotation(sensors.take(data, f"{label}_ankle_quat"))
-    world = sensors.take(data, f"{label}_ankle_pos") + np.einsum("nij,nj->ni", rotation, local)
-    return force[:, 2], world[:, :2]
-
-
-def _cop_margins(cop: Array, corners: Array, loaded: NDArray[np.bool_]) -> Array:
-    """Signed distance of the CoP to the polygon of the loaded soles per sample [m] (NaN when none).
-
-    Single support is vectorised (the sole is a rectangle, already counter-clockwise); double
-    support takes the hull of the eight corners.
-    """
-    n = len(cop)
-    margin = np.full(n, np.nan)
-    single = loaded[:, 0] ^ loaded[:, 1]
-    if single.any():
-        foot = np.where(loaded[single, 0], 0, 1)
-        quad = corners[single][np.arange(int(single.sum())), foot]  # (m, 4, 2), counter-clockwise
-        edge = np.roll(quad, -1, axis=1) - quad
-        margin[single] = edge_margin(cop[single], quad, edge, np.ones(edge.shape[:2], dtype=bool))
-    both = loaded[:, 0] & loaded[:, 1]
-    if both.any():
-        margin[both] = batch_hull_margin(cop[both], corners[both].reshape(-1, 8, 2))
-    return margin
 
 
 def simulate(
@@ -336,7 +267,7 @@ def simulate(
     base_planned = (pattern.position_pelvis_in_world if joints.position_base_in_world is None
                     else joints.position_base_in_world)
     set_initial_state(plant, data, base_planned[0], float(pattern.yaw_pelvis_in_world[0]), reference[0], penetration)
-    sensors = _Sensors(model)
+    sensors = SensorSlices(model)
     n = len(time)
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     state = np.empty(mujoco.mj_stateSize(model, spec))
@@ -393,7 +324,7 @@ def simulate(
                                              None if capture is None else (capture.trigger, capture_tail))
     # --- measurements
     pelvis = sensors.take(readings, "pelvis_pos")
-    rpy = _rpy(sensors.take(readings, "pelvis_quat"))
+    rpy = rpy_from_quaternion(sensors.take(readings, "pelvis_quat"))
     touch = sensors.take(readings, "torso_touch")[:, 0] if "torso_touch" in sensors.slices else np.zeros(n)
     tilt = np.arccos(np.clip(np.cos(rpy[:, 0]) * np.cos(rpy[:, 1]), -1, 1))
     fallen = (touch > 0) | (tilt > FALL_TILT) | (pelvis[:, 2] < FALL_HEIGHT_FRACTION * robot.pelvis_height)
@@ -406,37 +337,10 @@ def simulate(
     angles = sensors.columns(readings, names_q)
     velocities = sensors.columns(readings, [f"{c}_qd" for c in JOINT_COLUMNS])
     torque = sensors.columns(readings, [f"{c}_tau" for c in JOINT_COLUMNS])
-    reactions = [_ground_reaction(sensors, readings, label, robot.ankle_height) for label in ("left", "right")]
-    forces = np.column_stack([r[0] for r in reactions])
-    loaded = forces > LOADED_FRACTION * weight
-    cop_feet = np.stack([r[1] for r in reactions], axis=1)
-    cop_feet[~loaded] = np.nan
-    weights = np.where(loaded, forces, 0.0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        cop_total = np.nansum(cop_feet * weights[..., None], axis=1) / weights.sum(axis=1)[:, None]
-    cop_total[~loaded.any(axis=1)] = np.nan
-    # sole corners in world from the ankle frames
-    corners = np.empty((len(time), 2, 4, 2))
-    half_length, half_width = robot.foot_length / 2, robot.foot_width / 2
-    ankles = np.empty((len(time), 2, 2))
-    for foot, (label, side) in enumerate((("left", 1), ("right", -1))):
-        rotation = _rotation(sensors.take(readings, f"{label}_ankle_quat"))
-        origin = sensors.take(readings, f"{label}_ankle_pos")
-        cx, cy = robot.sole_center_x, side * robot.sole_center_y
-        local = np.array([[cx - half_length, cy - half_width, -robot.ankle_height],
-                          [cx + half_length, cy - half_width, -robot.ankle_height],
-                          [cx + half_length, cy + half_width, -robot.ankle_height],
-                          [cx - half_length, cy + half_width, -robot.ankle_height]])
-        corners[:, foot] = (origin[:, None, :] + np.einsum("nij,cj->nci", rotation, local))[..., :2]
-        ankles[:, foot] = origin[:, :2]
-    margin = _cop_margins(cop_total, corners, loaded)
-    slip = 0.0
-    for foot in range(2):
-        starts = np.flatnonzero(loaded[:, foot] & ~np.concatenate([[False], loaded[:-1, foot]]))
-        stops = np.flatnonzero(loaded[:, foot] & ~np.concatenate([loaded[1:, foot], [False]]))
-        for a, b in zip(starts, stops, strict=True):
-            drift = np.linalg.norm(ankles[a:b + 1, foot] - ankles[a, foot], axis=1)
-            slip = max(slip, float(drift.max()))
+    soles = sole_measurements(robot, sensors, readings, weight)
+    forces, loaded, cop_feet, cop_total, margin, ankles = (soles.forces, soles.loaded, soles.cop_feet, soles.cop,
+                                                           soles.margin, soles.ankles)
+    slip = foot_slip(loaded, ankles)
     distance = float(np.linalg.norm(pelvis[-1, :2] - pelvis[0, :2]))
     # How the walk ends: the feet against the plan, and the last `hold` seconds (standing still?).
     feet_error = feet_yaw_error = math.nan
@@ -446,7 +350,8 @@ def simulate(
         planned = (final.position_left_ankle_in_world[-1], final.position_right_ankle_in_world[-1])
         planned_yaw = (final.yaw_left_foot_in_world[-1], final.yaw_right_foot_in_world[-1])
         feet_error = max(float(np.linalg.norm(ankles[-1, f] - planned[f][:2])) for f in range(2))
-        yaws = [_rpy(sensors.take(readings[-1:], f"{label}_ankle_quat"))[0, 2] for label in ("left", "right")]
+        yaws = [rpy_from_quaternion(sensors.take(readings[-1:], f"{label}_ankle_quat"))[0, 2]
+                for label in ("left", "right")]
         feet_yaw_error = max(abs(float((yaws[f] - planned_yaw[f] + math.pi) % (2 * math.pi) - math.pi))
                              for f in range(2))
         window = time > time[-1] - max(hold, 1.0 / CONTROL_RATE)
@@ -571,7 +476,7 @@ class _MeasurementReader:
     floor's rotation from level).
     """
 
-    def __init__(self, sensors: _Sensors, floor: Array | None = None) -> None:
+    def __init__(self, sensors: SensorSlices, floor: Array | None = None) -> None:
         def columns(*names: str) -> NDArray[np.intp]:
             return np.concatenate([np.arange(sensors.slices[n].start, sensors.slices[n].stop) for n in names])
 
@@ -590,7 +495,7 @@ class _MeasurementReader:
             pitch = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
             yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
         else:
-            level = self._floor @ _rotation(row[None, self._quaternion])[0]
+            level = self._floor @ rotation_from_quaternion(row[None, self._quaternion])[0]
             roll, pitch = math.atan2(level[2, 1], level[2, 2]), math.asin(max(-1.0, min(1.0, -level[2, 0])))
             yaw = math.atan2(level[1, 0], level[0, 0])
         return BalanceMeasurement(wrench_left=-row[self._left], wrench_right=-row[self._right],
@@ -644,7 +549,7 @@ def _controls(plant: Plant, pattern: WalkingPattern, joints: JointTrajectory, pa
 
 def _closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabilizer: Stabilizer | None,
                  pattern: WalkingPattern, pattern_time: Array, reference: Array, control: Array, zmp_ref: Array,
-                 steps_per_tick: int, sensors: _Sensors, latency: float, noise: SensorNoise | None,
+                 steps_per_tick: int, sensors: SensorSlices, latency: float, noise: SensorNoise | None,
                  progress: Callable[[float], None] | None = None, disturbances: Disturbances | None = None,
                  time: Array | None = None,
                  capture: tuple[float, Callable[[int, Stabilizer, int], dict[str, NDArray[np.generic]]]] | None = None,
