@@ -4,6 +4,9 @@
 :func:`zmpwalk.sim.loop.simulate_controller` (stabilizer and feedforward on) and records, at ``fps`` frames a
 second, the whole model's ``qpos`` in two ways:
 
+The walker plans with the robot's default generator (:attr:`~zmpwalk.robots.model.RobotModel.default_generator`:
+the polynomial pattern for HUBO, the hyperbolic one for a robot's own model) unless one is named.
+
 - **simulated**: the MuJoCo state after the control tick nearest each frame time;
 - **planned**: the walker's own pose of that tick (its 12 leg angles, the base upright at the pelvis yaw and placed
   so the legs put the ankles where planned, every other joint at the reference pose), lowered or raised once by a
@@ -25,7 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk.commands import StepCommand
-from zmpwalk.control import JointTargets
+from zmpwalk.control import JointTargets, WalkingController
 from zmpwalk.errors import InvalidParameterError
 from zmpwalk.online import START_DELAY
 from zmpwalk.robots.collision import collision_points, rigid_bodies
@@ -119,8 +122,10 @@ def foot_bodies(model: mujoco.MjModel) -> list[list[int]]:
     return [rigid_bodies(model, int(model.site_bodyid[site])) for site in _ankle_sites(model)]
 
 
-def walk_clips(robot: RobotModel, command: StepCommand, count: int, fps: float) -> tuple[ControllerRun, Clip, Clip]:
-    """Walk ``count`` copies of ``command`` through the controller; the simulated and the planned clips.
+def walk_clips(robot: RobotModel, command: StepCommand, count: int, fps: float,
+               generator: str | None = None) -> tuple[ControllerRun, Clip, Clip]:
+    """Walk ``count`` copies of ``command`` through the controller (``generator``: the pattern generator, default
+    the robot's :attr:`~zmpwalk.robots.model.RobotModel.default_generator`); the simulated and the planned clips.
 
     Raises:
         InvalidParameterError: ``fps`` outside (0, 1000] Hz.
@@ -129,7 +134,9 @@ def walk_clips(robot: RobotModel, command: StepCommand, count: int, fps: float) 
         raise InvalidParameterError("fps", fps, f"a frame rate in (0, {CONTROL_RATE:g}] Hz")
     every = CONTROL_RATE / fps
     plant = _RecordingPlant(robot, CONTROL_RATE, every)
-    run = simulate_controller(robot, [command] * count, rate=CONTROL_RATE, plant=plant)
+    controller = WalkingController(robot, CONTROL_RATE, generator=generator or robot.default_generator,
+                                   feedforward=plant.feedforward())
+    run = simulate_controller(robot, [command] * count, rate=CONTROL_RATE, plant=plant, controller=controller)
     states = np.asarray(plant.states)
     frames = np.arange(math.floor((len(states) - 1) / every) + 1)
     simulated = states[np.rint(frames * every).astype(int)]

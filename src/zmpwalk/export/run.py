@@ -287,7 +287,8 @@ def export_motions(robot: str, grid: Grid | None = None, out: str | Path = "zmpw
 
 
 def write_manifest(path: Path, robot: str, clips: Sequence[ClipRecord], fps: float, seconds: float) -> None:
-    """The manifest: the robot, the frame rate, the joint names, every clip's record (JSON; nan as null)."""
+    """The manifest: the robot, its pattern generator, the frame rate, the joint names, every clip's record (JSON;
+    nan as null)."""
     from zmpwalk.robots import loaded_robot
     from zmpwalk.sim.plant import build_plant
 
@@ -300,8 +301,9 @@ def write_manifest(path: Path, robot: str, clips: Sequence[ClipRecord], fps: flo
             return [finite(v) for v in value]
         return value
 
-    document = {"robot": robot, "fps": fps, "joint_names": joint_names(build_plant(loaded_robot(robot)).model),
-                "quaternion_order": "wxyz", "seconds": seconds,
+    model = loaded_robot(robot)
+    document = {"robot": robot, "generator": model.default_generator, "fps": fps,
+                "joint_names": joint_names(build_plant(model).model), "quaternion_order": "wxyz", "seconds": seconds,
                 "clips": [finite(asdict(c)) for c in clips],
                 "verified": sum(c.verified for c in clips), "count": len(clips)}
     write_text(path, json.dumps(document, indent=1, allow_nan=False) + "\n")
