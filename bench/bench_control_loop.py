@@ -20,7 +20,7 @@ gives any Python loop. ``--before DIR`` runs every configuration also against an
 ``--gc disable`` also turns Python's garbage collector off for the loop (after the freeze).
 
 Run: ``python bench/bench_control_loop.py [--ticks 50000] [--seed 1] [--before /tmp/zmpwalk-before] [--gc disable]``.
-Prints figures; asserts nothing. Goals (issue 33): max <= 200 us, median <= 10 us, no tick over 1 ms.
+Prints figures; asserts nothing. Goals: max <= 200 us, median <= 10 us, no tick over 1 ms.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The default pattern generator per robot (issue 36, item 6): a robot built from its own model walks with the
+"""The default pattern generator per robot: a robot built from its own model walks with the
 generator that passed every measured walk (bench/bench_defaults.py, docs/design-log/defaults.md), the box models
 keep the papers' polynomial pattern, a robot file may choose, and ``--generator`` always wins."""
 

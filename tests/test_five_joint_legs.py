@@ -1,4 +1,4 @@
-"""Legs of five joints without an ankle roll (issue 36, item 4; Unitree H1): the virtual ankle roll along the sole's
+"""Legs of five joints without an ankle roll (Unitree H1): the virtual ankle roll along the sole's
 centre line, what the inverse kinematics meets and the sole roll it leaves, why a flat sole fixes the hip roll, the
 stabilizer's 6 x 6 solve with the virtual joint's share dropped, the plant's do-nothing column, the bound on the sole
 roll, and H1's walks refused with the ankle roll named (zmpwalk.robots.legs derives why)."""

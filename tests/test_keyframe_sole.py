@@ -1,4 +1,4 @@
-"""The sole taken in the robot's reference posture (its keyframe), not at zero joint angles (issue 36, item 3): a
+"""The sole taken in the robot's reference posture (its keyframe), not at zero joint angles: a
 biped whose foot box is pitched 10 degrees at zero angles and level in its keyframe imports with its real sole,
 keeps that sole level in the inverse kinematics, plans and walks."""
 

@@ -1,5 +1,5 @@
 """Rejections that point at the right fix: the stride before the step time, limits in the user's directions,
-one way of numbering the steps (issue 34)."""
+one way of numbering the steps."""
 
 from __future__ import annotations
 
