@@ -255,3 +255,27 @@ def test_legs_of_other_shapes_are_refused(tmp_path: Path) -> None:
     no_yaw.write_text(five_joint_biped(("hip_roll", "hip_pitch", "knee", "ankle_pitch", "hip_yaw")), encoding="utf-8")
     with pytest.raises(FileFormatError, match=r"has 5 joints: .*an ankle pitch alone"):
         load_robot(no_yaw)
+
+
+@needs_h1
+def test_the_feedforward_of_a_five_joint_robot_reads_its_real_columns() -> None:
+    """The per-tick feedforward and the base placement take the 12 walker columns and write only the real joints
+    (a five-joint leg's virtual ankle roll has no qpos): the reference pose's angles give the reference pose."""
+    from zmpwalk.online import WalkingSample
+    from zmpwalk.sim.mujoco_plant import ModelFeedforward
+    from zmpwalk.sim.plant import build_plant
+
+    robot = load_robot(H1)
+    plant = build_plant(robot)
+    feedforward = ModelFeedforward(plant, 1000.0)
+    half = robot.hip_spacing / 2
+    sample = WalkingSample(0.0, "double", np.array([0.0, 0.0, robot.pelvis_height]), 0.0,
+                           np.array([0.0, half, robot.ankle_height]), 0.0,
+                           np.array([0.0, -half, robot.ankle_height]), 0.0, np.zeros(2))
+    held = ModelFeedforward(plant, 1000.0).torques(sample)  # no joint angles in the sample: the reference pose's
+    angles = np.zeros(12)  # the walker's 12 columns at the reference pose, the virtual ankle rolls at 0
+    angles[plant.leg_columns] = plant.qpos_hold[plant.leg_qpos]
+    sample.joint_angles = angles
+    given = feedforward.torques(sample)
+    assert given.shape == (12,) and np.all(np.isfinite(given))
+    assert given == pytest.approx(held, abs=1e-9)  # [N m] the same pose either way

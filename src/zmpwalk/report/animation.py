@@ -50,7 +50,7 @@ def render_gif(robot: RobotModel, result: SimulationResult, fps: int = FPS,
             progress(i / len(result.time))
         data.qpos[0:3] = result.torso_position[i]
         data.qpos[3:7] = rotation[i]
-        data.qpos[plant.leg_qpos] = result.joint_angles[i]
+        data.qpos[plant.leg_qpos] = result.joint_angles[i][plant.leg_columns]
         mujoco.mj_kinematics(model, data)
         views = []
         for camera in (side, front):

@@ -44,6 +44,13 @@ def _ankle_sites(model: mujoco.MjModel) -> tuple[int, int]:
     return int(left), int(right)
 
 
+def _held_angles(plant: SimPlant) -> Array:
+    """The 12 leg joint columns [rad] at the reference pose (a five-joint leg's virtual ankle roll at 0)."""
+    angles = np.zeros(12)
+    angles[plant.leg_columns] = plant.qpos_hold[plant.leg_qpos]
+    return angles
+
+
 def _base_position(plant: SimPlant, data: mujoco.MjData, sample: WalkingSample, angles: Array,
                    sites: tuple[int, int]) -> Array:
     """The base origin [m] (3,) of a sample's pose: the pelvis point on a box model; on a robot's own model, where
@@ -53,7 +60,7 @@ def _base_position(plant: SimPlant, data: mujoco.MjData, sample: WalkingSample, 
     data.qpos[:] = plant.qpos_hold
     data.qpos[0:3] = 0.0
     _upright(data.qpos, sample.yaw_pelvis_in_world)
-    data.qpos[plant.leg_qpos] = angles
+    data.qpos[plant.leg_qpos] = angles[plant.leg_columns]
     mujoco.mj_kinematics(plant.model, data)
     planned = (sample.position_left_ankle_in_world, sample.position_right_ankle_in_world)
     return np.asarray(sum(p - data.site_xpos[s] for p, s in zip(planned, sites, strict=True)) / 2, dtype=np.float64)
@@ -101,11 +108,11 @@ class ModelFeedforward:
     def torques(self, sample: WalkingSample) -> Array:
         """The leg joints' torques [N m], (12,), in the walker's column order, for this tick's ``sample``."""
         plant, model, data = self.plant, self.plant.model, self._data
-        angles = sample.joint_angles if sample.joint_angles is not None else plant.qpos_hold[plant.leg_qpos]
+        angles = sample.joint_angles if sample.joint_angles is not None else _held_angles(plant)
         qpos = self._qpos
         qpos[0:3] = _base_position(plant, self._scratch, sample, angles, self._sites)
         _upright(qpos, sample.yaw_pelvis_in_world)
-        qpos[plant.leg_qpos] = angles
+        qpos[plant.leg_qpos] = angles[plant.leg_columns]
         self._previous_qvel[:] = self._qvel
         if self._previous_qpos is None:
             self._previous_qpos = qpos.copy()
@@ -183,7 +190,7 @@ class MujocoPlant:
         self.robot, self.plant, self.rate = robot, plant, float(rate)
         self.steps_per_tick = round(steps)
         self._nominal = SimPlant(copy.deepcopy(model), plant.leg_actuators, plant.leg_qpos, plant.ctrl_hold,
-                                 plant.qpos_hold, plant.imported)
+                                 plant.qpos_hold, plant.imported, plant.leg_columns)
         self.disturbances = disturbances
         if disturbances is not None:
             disturbances.apply(model)
