@@ -11,7 +11,7 @@ from typing import Any
 
 _WHERE = {"ActuatorRow": "actuators", "actuator_markdown": "actuators", "actuator_table": "actuators",
           "write_actuator_csv": "actuators", "contact_mapping": "mjcf", "robot_mjcf": "mjcf",
-          "SimulationResult": "run", "simulate": "run"}
+          "SimulationResult": "result", "simulate": "run"}
 
 
 def __getattr__(name: str) -> Any:

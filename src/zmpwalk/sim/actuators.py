@@ -14,7 +14,7 @@ from numpy.lib.stride_tricks import sliding_window_view
 from zmpwalk.files import atomic_output
 
 if TYPE_CHECKING:
-    from zmpwalk.sim.run import SimulationResult
+    from zmpwalk.sim.result import SimulationResult
 
 IMPACT_WINDOW = 0.02  # [s] a torque or power held for less than this is an impact, shown apart
 

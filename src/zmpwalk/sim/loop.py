@@ -5,7 +5,7 @@
 ``controller.update(plant.measure())`` every control period, giving a list of step commands as an operator gives
 them: the first at the first tick (the walk starts :data:`~zmpwalk.online.START_DELAY` later, as a robot's does),
 each next one during the step before it, once that step has begun, ``command_phase`` of its step time into it. The
-result is the :class:`~zmpwalk.sim.run.SimulationResult` of :func:`zmpwalk.sim.run.simulate`, so
+result is the :class:`~zmpwalk.sim.result.SimulationResult` of :func:`zmpwalk.sim.run.simulate`, so
 :func:`zmpwalk.sim.verdict.walk_verdict` judges it.
 
 The feedforward runs per tick (:class:`~zmpwalk.sim.mujoco_plant.ModelFeedforward`): the inverse dynamics of the
@@ -34,14 +34,12 @@ from zmpwalk.footsteps import sole_corners
 from zmpwalk.kinematics import JOINT_COLUMNS
 from zmpwalk.online import START_DELAY, OnlineWalker
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.sim.disturbances import Disturbances
+from zmpwalk.sim.measure import AFTER_FALL
 from zmpwalk.sim.mujoco_plant import MujocoPlant
-from zmpwalk.sim.run import (
-    AFTER_FALL,
-    HOLD,
-    Disturbances,
-    SimulationResult,
-)
+from zmpwalk.sim.result import SimulationResult
 from zmpwalk.sim.soles import SoleMeasurements, foot_slip, rpy_from_quaternion, sole_measurements
+from zmpwalk.sim.verdict import HOLD
 from zmpwalk.zmp import batch_hull_margin, edge_margin
 
 Array = NDArray[np.float64]
@@ -157,7 +155,7 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
         progress: Called with the fraction done now and then (of the run's longest length).
 
     Returns:
-        The run: its :class:`~zmpwalk.sim.run.SimulationResult`, when each command was given, the refusals.
+        The run: its :class:`~zmpwalk.sim.result.SimulationResult`, when each command was given, the refusals.
 
     Raises:
         InvalidParameterError: No commands and no duration, an operator without a duration, a phase outside
@@ -223,8 +221,8 @@ def _plan_margin(robot: RobotModel, log: _Log, n: int) -> float:
 
 def _result(robot: RobotModel, plant: MujocoPlant, log: _Log, n: int, fall: int | None, planned_end: float,
             hold: float) -> SimulationResult:
-    """The run's :class:`~zmpwalk.sim.run.SimulationResult` from its first ``n`` ticks (row ``k``: the state at the end
-    of tick ``k``, labelled with the tick's time ``k / rate``, as :func:`~zmpwalk.sim.run.simulate` labels it)."""
+    """The run's :class:`~zmpwalk.sim.result.SimulationResult` from its first ``n`` ticks (row ``k``: the state at the
+    end of tick ``k``, labelled with the tick's time ``k / rate``, as :func:`~zmpwalk.sim.run.simulate` labels it)."""
     sensors, readings = plant.sensors, log.readings[:n]
     time = np.arange(n) / plant.rate
     pelvis, rpy = sensors.take(readings, "pelvis_pos"), rpy_from_quaternion(sensors.take(readings, "pelvis_quat"))

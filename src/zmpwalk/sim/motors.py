@@ -31,7 +31,7 @@ from zmpwalk.robots.model import JOINT_NAMES
 from zmpwalk.sim.actuators import IMPACT_WINDOW
 
 if TYPE_CHECKING:
-    from zmpwalk.sim.run import SimulationResult
+    from zmpwalk.sim.result import SimulationResult
 
 _FIELDS = ("rated_torque", "peak_torque", "no_load_speed", "gear_ratio", "efficiency")
 

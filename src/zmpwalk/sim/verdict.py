@@ -2,7 +2,7 @@
 
 A walk passes when all of these hold (the limits are module constants, stated in docs/simulation.md):
 
-1. **No fall** (the fall criterion of :mod:`zmpwalk.sim.run`): shown as the time walked of the run's length.
+1. **No fall** (the fall criterion of :mod:`zmpwalk.sim.measure`): shown as the time walked of the run's length.
 2. **It ends standing still**, over the final hold of at least :data:`MIN_HOLD` after the last step:
    both soles loaded (the less loaded one carries at least :data:`LOADED_SHARE` of the weight), the base's
    horizontal speed at most :data:`STILL_SPEED`, the torso's roll and pitch settled (their spread at most
@@ -43,14 +43,14 @@ from zmpwalk.sim.contact import CONTACT_FRACTION, LOADED_FRACTION
 from zmpwalk.sim.motors import Motor, MotorFit, motor_fits
 
 if TYPE_CHECKING:
-    from zmpwalk.sim.run import SimulationResult
+    from zmpwalk.sim.result import SimulationResult
 
 MIN_HOLD = 2.0  # [s]
 LOADED_SHARE = LOADED_FRACTION  # [-] of the weight on the less loaded sole
 STILL_SPEED = 0.05  # [m/s]
 SETTLED_ATTITUDE = 0.01  # [rad]
 SETTLE = 0.5  # [s] standing before a judged walk (simulate, report, demo, sweep, tune)
-HOLD = 2.0  # [s] standing after it: the verdict judges how the walk ends over this time
+HOLD = 2.0  # [s] standing after a judged walk: the verdict judges how the walk ends over this time
 FEET_DISTANCE = 0.02  # [m]
 FEET_YAW = math.radians(2.0)  # [rad]
 COP_MARGIN = -0.005  # [m]: 5 mm of the sensors' CoP beyond an edge is the foot's own inertia at its limit
