@@ -43,28 +43,17 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from zmpwalk.curves import smoothstep5
+from zmpwalk.capture_pattern import REACH_MARGIN, CaptureState, capture_pattern, quintic_from_rest, turned
 from zmpwalk.errors import InfeasiblePatternError, InvalidParameterError, UnreachableError
-from zmpwalk.footsteps import Pose2D
-from zmpwalk.kinematics import hip_positions_in_world, leg_reach_excess
-from zmpwalk.patterns.result import (
-    SUPPORT_DOUBLE,
-    SUPPORT_LEFT,
-    SUPPORT_RIGHT,
-    StepRecord,
-    SupportPhase,
-    WalkingPattern,
-    check_rate,
-)
+from zmpwalk.kinematics import leg_reach_excess
+from zmpwalk.patterns.result import WalkingPattern, check_rate
 from zmpwalk.robots.model import RobotModel
 
 Array = NDArray[np.float64]
 
 SWING_GRID = 0.01  # [s] the capture swing's duration is searched on this grid
-REACH_MARGIN = 0.01  # [m] the landing keeps this much of the leg's reach in hand
 REACH_SHRINK = 0.9  # [-] a landing out of reach is pulled towards the stance foot by this factor, then checked
 REACH_TRIES = 12  # pulls before the landing is given up as out of reach
-CROUCH_LEAST_TIME = 0.1  # [s] the CoM point is lowered for the legs' reach over at least this time
 SETTLE_TRIES = 3  # the settle is doubled up to this many times to keep the ZMP in the feet
 ZMP_TOLERANCE = 1e-9  # [m]
 LEAST_REPLANNED_SWING = 0.08  # [s] a capture step re-planned during its swing lands at least this much later
@@ -139,38 +128,6 @@ class CapturePlan:
     reached: bool
 
 
-def _rotate(vector: Array, yaw: float) -> Array:
-    """``vector`` (2,) turned by ``yaw`` [rad]."""
-    c, s = math.cos(yaw), math.sin(yaw)
-    return np.array([c * vector[0] - s * vector[1], s * vector[0] + c * vector[1]])
-
-
-def quintic_from_rest(start: Array, velocity: Array, end: Array, duration: float, s: Array) -> tuple[Array, Array]:
-    r"""Value and rate of the quintic from ``start`` with ``velocity`` and no acceleration to ``end`` at rest
-    (zero velocity and acceleration) after ``duration``, at times ``s`` in ``[0, duration]``.
-
-    .. math:: x(s) = x_0 + v_0 s + c_3 s^3 + c_4 s^4 + c_5 s^5
-
-    with ``c3, c4, c5`` from the three end conditions.
-
-    Args:
-        start, velocity, end: (k,) each [m], [m/s], [m].
-        duration: [s] (> 0).
-        s: (n,) [s].
-
-    Returns:
-        Positions (n, k) [m] and velocities (n, k) [m/s].
-    """
-    t = duration
-    gap = end - start - velocity * t
-    matrix = np.array([[t**3, t**4, t**5], [3 * t**2, 4 * t**3, 5 * t**4], [6 * t, 12 * t**2, 20 * t**3]])
-    coefficients = np.linalg.solve(matrix, np.vstack([gap, -velocity, np.zeros_like(gap)]))  # (3, k)
-    s = s[:, None]
-    value = start + velocity * s + s**3 * coefficients[0] + s**4 * coefficients[1] + s**5 * coefficients[2]
-    rate = velocity + 3 * s**2 * coefficients[0] + 4 * s**3 * coefficients[1] + 5 * s**4 * coefficients[2]
-    return value, rate
-
-
 def capture_step(
     robot: RobotModel,
     *,
@@ -222,6 +179,33 @@ def capture_step(
             within reach (:data:`REACH_MARGIN` in hand): the body is already too far from the stance foot.
     """
     settings = settings or CaptureSettings()
+    com, dcm, ankles, velocities = _checked_state(time, rate, end, stance, position_com_in_world, dcm_in_world,
+                                                  ankles_in_world, ankle_velocities_in_world)
+    omega = math.sqrt(robot.gravity / robot.pendulum_length)
+    st = 0 if stance == "left" else 1
+    stance_foot = _StanceFoot(robot, settings, st, float(foot_yaws[st]), ankles, dcm, omega)
+    swing_time, dcm_touchdown, landing = stance_foot.swing(time, touchdown)
+    n = max(math.ceil((max(end, time + swing_time + settings.settle + 1.0 / omega) - time) * rate - 1e-9), 1) + 1
+    plan = CaptureState(robot, time, rate, settings.lift, omega, st, com, dcm, stance_foot.p1, swing_time,
+                        stance_foot.st_yaw, float(yaw_pelvis_in_world), ankles, velocities, foot_yaws)
+    pattern, rest, settle, margin, landing, reached = _within_reach(plan, n, landing, stance_foot, settings.settle)
+    if margin < -ZMP_TOLERANCE:
+        pulled = ", pulled in for the legs' reach," if not reached else ""
+        raise InfeasiblePatternError(
+            f"capture step: the DCM at touchdown {np.round(dcm_touchdown, 3).tolist()} m lies outside the feet"
+            f"{pulled} (its ZMP leaves them by {-margin * 1e3:.1f} mm on the way to rest, settle {settle:g} s): "
+            "no single step catches it")
+    return pattern, CapturePlan(time=time, swing=("left", "right")[1 - st], swing_time=swing_time,
+                                zmp_stance=stance_foot.p1, dcm_start=dcm, dcm_touchdown=dcm_touchdown,
+                                landing=(float(landing[0]), float(landing[1]), stance_foot.st_yaw), rest=rest,
+                                reached=reached)
+
+
+def _checked_state(time: float, rate: float, end: float, stance: str, position_com_in_world: Array,
+                   dcm_in_world: Array, ankles_in_world: tuple[Array, Array],
+                   ankle_velocities_in_world: tuple[Array, Array]) -> tuple[Array, Array, list[Array], list[Array]]:
+    """The state :func:`capture_step` starts from, checked: the CoM point (3,) and the DCM (2,) [m], the ankles
+    [m] and their velocities [m/s], (3,) each (the raises of :func:`capture_step`)."""
     check_rate(rate)
     if stance not in ("left", "right"):
         raise InvalidParameterError("stance", stance, '"left" or "right"')
@@ -233,52 +217,78 @@ def capture_step(
         raise InvalidParameterError("position_com_in_world, dcm_in_world", (com.size, dcm.size), "3 and 2 values")
     ankles = [np.asarray(a, dtype=float).reshape(3) for a in ankles_in_world]
     velocities = [np.asarray(v, dtype=float).reshape(3) for v in ankle_velocities_in_world]
-    omega = math.sqrt(robot.gravity / robot.pendulum_length)
-    st = 0 if stance == "left" else 1
-    sw = 1 - st
-    st_side, sw_side = (1, -1) if st == 0 else (-1, 1)
-    st_yaw = float(foot_yaws[st])
-    half = np.array([robot.foot_length / 2, robot.foot_width / 2])
-    st_center_local = np.array([robot.sole_center_x, st_side * robot.sole_center_y])
-    sw_center_local = np.array([robot.sole_center_x, sw_side * robot.sole_center_y])
-    st_ankle = ankles[st][:2]
-    # 1. the stance ZMP: the stance sole's point nearest to the DCM, inside its edges
-    local = _rotate(dcm - st_ankle, -st_yaw) - st_center_local
-    inside = np.clip(local, -(half - settings.zmp_inset), half - settings.zmp_inset)
-    p1 = st_ankle + _rotate(st_center_local + inside, st_yaw)
-    # 2. the landing, for each swing time on the grid
-    gap_least = 2 * half[1] - 2 * robot.sole_center_y + settings.feet_clearance  # ankle gap across the stance
+    return com, dcm, ankles, velocities
 
-    def off_the_stance(landing: Array) -> Array:
+
+class _StanceFoot:
+    """The stance foot's geometry: the stance ZMP ``p1`` (step 1 of the module docstring) and the landings
+    of the swinging foot (step 2)."""
+
+    def __init__(self, robot: RobotModel, settings: CaptureSettings, st: int, st_yaw: float, ankles: list[Array],
+                 dcm: Array, omega: float) -> None:
+        """The stance foot ``st`` (0 left, 1 right) at yaw ``st_yaw`` [rad], with the ankles [m] and the
+        measured DCM [m]; ``omega`` [1/s] of the pendulum."""
+        self.settings, self.st_yaw, self.dcm, self.omega = settings, st_yaw, dcm, omega
+        self.swing_ankle = ankles[1 - st][:2]
+        st_side, self.sw_side = (1, -1) if st == 0 else (-1, 1)
+        half = np.array([robot.foot_length / 2, robot.foot_width / 2])
+        st_center_local = np.array([robot.sole_center_x, st_side * robot.sole_center_y])
+        self.sw_center_local = np.array([robot.sole_center_x, self.sw_side * robot.sole_center_y])
+        self.st_ankle = ankles[st][:2]
+        # 1. the stance ZMP: the stance sole's point nearest to the DCM, inside its edges
+        local = turned(dcm - self.st_ankle, -st_yaw) - st_center_local
+        inside = np.clip(local, -(half - settings.zmp_inset), half - settings.zmp_inset)
+        self.p1 = self.st_ankle + turned(st_center_local + inside, st_yaw)
+        # 2. the landing, for each swing time on the grid
+        self.gap_least = 2 * half[1] - 2 * robot.sole_center_y + settings.feet_clearance  # ankle gap across stance
+
+    def off_the_stance(self, landing: Array) -> Array:
         """``landing`` moved out across the stance foot until the soles' inner edges keep the clearance."""
-        across = _rotate(landing - st_ankle, -st_yaw)
-        if sw_side * across[1] >= gap_least:
+        across = turned(landing - self.st_ankle, -self.st_yaw)
+        if self.sw_side * across[1] >= self.gap_least:
             return landing
-        across[1] = sw_side * gap_least
-        return st_ankle + _rotate(across, st_yaw)
+        across[1] = self.sw_side * self.gap_least
+        return self.st_ankle + turned(across, self.st_yaw)
 
-    def landing_after(duration: float) -> tuple[float, Array, Array]:
+    def landing_after(self, duration: float) -> tuple[float, Array, Array]:
         """How far the foot misses the way at the foot speed [m] (<= 0: it makes it), xi(T) and the landing."""
-        dcm_touchdown = p1 + (dcm - p1) * math.exp(omega * duration)
+        p1 = self.p1
+        dcm_touchdown = p1 + (self.dcm - p1) * math.exp(self.omega * duration)
         ahead = dcm_touchdown - p1
         norm = float(np.linalg.norm(ahead))
-        sole_center = dcm_touchdown + (settings.landing_inset * ahead / norm if norm > 0 else 0.0)
-        landing = off_the_stance(sole_center - _rotate(sw_center_local, st_yaw))
-        return float(np.linalg.norm(landing - ankles[sw][:2])) - settings.foot_speed * duration, dcm_touchdown, landing
+        sole_center = dcm_touchdown + (self.settings.landing_inset * ahead / norm if norm > 0 else 0.0)
+        landing = self.off_the_stance(sole_center - turned(self.sw_center_local, self.st_yaw))
+        miss = float(np.linalg.norm(landing - self.swing_ankle)) - self.settings.foot_speed * duration
+        return miss, dcm_touchdown, landing
 
-    shortest = settings.shortest_swing if touchdown is None else max(touchdown - time, LEAST_REPLANNED_SWING)
-    first = round(shortest / SWING_GRID)
-    durations = np.arange(first, max(round(settings.longest_swing / SWING_GRID), first) + 1) * SWING_GRID
-    candidates = [(float(duration), *landing_after(float(duration))) for duration in durations]
-    fitting = [c for c in candidates if c[1] <= 0.0]
-    # the shortest swing that makes its way at the foot speed, else the one that misses it least
-    swing_time, _, dcm_touchdown, landing = fitting[0] if fitting else min(candidates, key=lambda c: c[1])
-    n = max(math.ceil((max(end, time + swing_time + settings.settle + 1.0 / omega) - time) * rate - 1e-9), 1) + 1
+    def swing(self, time: float, touchdown: float | None) -> tuple[float, Array, Array]:
+        """The swing time ``T`` [s], ``xi(T)`` [m] and the landing [m] (the module docstring's step 2), for a capture
+        at ``time`` [s] (``touchdown``: :func:`capture_step`'s)."""
+        settings = self.settings
+        shortest = settings.shortest_swing if touchdown is None else max(touchdown - time, LEAST_REPLANNED_SWING)
+        first = round(shortest / SWING_GRID)
+        durations = np.arange(first, max(round(settings.longest_swing / SWING_GRID), first) + 1) * SWING_GRID
+        candidates = [(float(duration), *self.landing_after(float(duration))) for duration in durations]
+        fitting = [c for c in candidates if c[1] <= 0.0]
+        # the shortest swing that makes its way at the foot speed, else the one that misses it least
+        swing_time, _, dcm_touchdown, landing = fitting[0] if fitting else min(candidates, key=lambda c: c[1])
+        return swing_time, dcm_touchdown, landing
+
+
+def _within_reach(plan: CaptureState, n: int, landing: Array, stance_foot: _StanceFoot,
+                  settle: float) -> tuple[WalkingPattern, Array, float, float, Array, bool]:
+    """:func:`_settled` (from ``settle`` [s]) for ``landing``, pulled towards the stance foot
+    (:data:`REACH_SHRINK`, up to :data:`REACH_TRIES` times) until both legs keep :data:`REACH_MARGIN` of their
+    reach: the pattern, the rest point, the settle [s], the least ZMP margin [m], the landing [m] and whether it was
+    not pulled in.
+
+    Raises:
+        UnreachableError: Still out of reach after the last pull.
+    """
+    robot = plan.robot
     reached = True
     for attempt in range(REACH_TRIES + 1):
-        pattern, rest, settle, margin = _settled(robot, time, rate, n, settings, omega, st, com, dcm, p1, swing_time,
-                                                 landing, st_yaw, float(yaw_pelvis_in_world), ankles, velocities,
-                                                 foot_yaws)
+        pattern, rest, settled, margin = _settled(plan, n, landing, settle)
         excess = leg_reach_excess(pattern.position_pelvis_in_world, pattern.yaw_pelvis_in_world,
                                   pattern.position_left_ankle_in_world, pattern.position_right_ankle_in_world, robot)
         worst = int(np.argmax([excess[0].max(), excess[1].max()]))
@@ -290,30 +300,17 @@ def capture_step(
                                    float(excess[worst].max()) + REACH_MARGIN,
                                    f"capture step, after {REACH_TRIES} landings pulled towards the stance foot")
         reached = False
-        landing = off_the_stance(st_ankle + REACH_SHRINK * (landing - st_ankle))
-    if margin < -ZMP_TOLERANCE:
-        pulled = ", pulled in for the legs' reach," if not reached else ""
-        raise InfeasiblePatternError(
-            f"capture step: the DCM at touchdown {np.round(dcm_touchdown, 3).tolist()} m lies outside the feet"
-            f"{pulled} (its ZMP leaves them by {-margin * 1e3:.1f} mm on the way to rest, settle {settle:g} s): "
-            "no single step catches it")
-    plan = CapturePlan(time=time, swing=("left", "right")[sw], swing_time=swing_time, zmp_stance=p1, dcm_start=dcm,
-                       dcm_touchdown=dcm_touchdown, landing=(float(landing[0]), float(landing[1]), st_yaw), rest=rest,
-                       reached=reached)
-    return pattern, plan
+        landing = stance_foot.off_the_stance(stance_foot.st_ankle + REACH_SHRINK * (landing - stance_foot.st_ankle))
+    return pattern, rest, settled, margin, landing, reached
 
 
-def _settled(robot: RobotModel, time: float, rate: float, n: int, settings: CaptureSettings, omega: float, st: int,
-             com: Array, dcm: Array, p1: Array, swing_time: float, landing: Array, st_yaw: float, pelvis_yaw: float,
-             ankles: list[Array], velocities: list[Array],
-             foot_yaws: tuple[float, float]) -> tuple[WalkingPattern, Array, float, float]:
-    """:func:`_build` with the settle doubled (up to :data:`SETTLE_TRIES` times) until the ZMP stays in the feet:
-    the pattern, the rest point, the settle [s] and the least ZMP margin [m] (< 0: it leaves them)."""
-    settle = settings.settle
+def _settled(plan: CaptureState, n: int, landing: Array, settle: float) -> tuple[WalkingPattern, Array, float, float]:
+    """:func:`~zmpwalk.capture_pattern.capture_pattern` with the ``settle`` [s] doubled (up to :data:`SETTLE_TRIES`
+    times) until the ZMP stays in the feet: the pattern, the rest point, the settle [s] and the least ZMP margin [m]
+    (< 0: it leaves them)."""
     for tries in range(SETTLE_TRIES + 1):
-        samples = max(n, math.ceil((swing_time + settle + 1.0 / omega) * rate) + 1)
-        pattern, rest = _build(robot, time, rate, np.arange(samples) / rate, settings, settle, omega, st, com, dcm,
-                               p1, swing_time, landing, st_yaw, pelvis_yaw, ankles, velocities, foot_yaws)
+        samples = max(n, math.ceil((plan.swing_time + settle + 1.0 / plan.omega) * plan.rate) + 1)
+        pattern, rest = capture_pattern(plan, np.arange(samples) / plan.rate, settle, landing)
         margin = float(pattern.zmp_margin().min())
         if margin >= -ZMP_TOLERANCE or tries == SETTLE_TRIES:
             break
@@ -321,115 +318,4 @@ def _settled(robot: RobotModel, time: float, rate: float, n: int, settings: Capt
     return pattern, rest, settle, margin
 
 
-def _crouch(robot: RobotModel, s: Array, pelvis: Array, pelvis_velocity: Array, pelvis_yaw: float,
-            feet: list[Array]) -> None:
-    """Lower the CoM point (in place) where a leg would otherwise be out of reach: a capture step can carry the
-    body further from the stance foot than the walk's height allows. The least lowering that keeps each hip
-    within the leg's reach less :data:`REACH_MARGIN` of its ankle, ``dz <= sqrt(r^2 - h^2)`` with ``h`` the
-    horizontal distance, is reached along a quintic by the first sample that needs it, and then held."""
-    reach = robot.max_leg_reach - REACH_MARGIN
-    hips = hip_positions_in_world(pelvis, np.full(len(s), pelvis_yaw), robot)
-    needed = np.zeros(len(s))
-    for hip, ankle in zip(hips, feet, strict=True):
-        horizontal = np.linalg.norm(hip[:, :2] - ankle[:, :2], axis=1)
-        allowed = np.sqrt(np.maximum(reach**2 - horizontal**2, 0.0))
-        needed = np.maximum(needed, (hip[:, 2] - ankle[:, 2]) - allowed)
-    if needed.max() <= 0.0:
-        return
-    drop = float(needed.max())
-    first = float(s[int(np.argmax(needed > 0.0))])
-    ramp = max(first, CROUCH_LEAST_TIME)
-    blend, slope, _ = smoothstep5(np.clip(s / ramp, 0.0, 1.0))
-    pelvis[:, 2] -= drop * blend
-    pelvis_velocity[:, 2] -= drop * slope / ramp
-
-
-def _build(robot: RobotModel, time: float, rate: float, s: Array, settings: CaptureSettings, settle: float,
-           omega: float, st: int, com: Array, dcm: Array, p1: Array, swing_time: float, landing: Array, st_yaw: float,
-           pelvis_yaw: float, ankles: list[Array], velocities: list[Array],
-           foot_yaws: tuple[float, float]) -> tuple[WalkingPattern, Array]:
-    """The capture pattern for one landing (the module docstring's three phases)."""
-    sw = 1 - st
-    n = len(s)
-    st_side, sw_side = (1, -1) if st == 0 else (-1, 1)
-    centers = [ankles[st][:2] + _rotate(np.array([robot.sole_center_x, st_side * robot.sole_center_y]), st_yaw),
-               landing + _rotate(np.array([robot.sole_center_x, sw_side * robot.sole_center_y]), st_yaw)]
-    rest = (centers[0] + centers[1]) / 2
-    dcm_touchdown = p1 + (dcm - p1) * math.exp(omega * swing_time)
-
-    def dcm_at(t: Array) -> tuple[Array, Array]:
-        """The planned DCM [m] and its rate [m/s] at times ``t`` (n,) after the capture."""
-        t = np.asarray(t, dtype=float)
-        single = t < swing_time - 1e-12
-        grow = np.exp(omega * np.minimum(t, swing_time))[:, None]
-        xi = np.where(single[:, None], p1 + (dcm - p1) * grow, 0.0)
-        rate_xi = np.where(single[:, None], omega * (dcm - p1) * grow, 0.0)
-        tau = np.clip((t - swing_time) / settle, 0.0, 1.0)
-        blend, slope, _ = smoothstep5(tau)
-        moving = rest + (dcm_touchdown - rest) * (1.0 - blend)[:, None]
-        moving_rate = -(dcm_touchdown - rest) * (slope / settle)[:, None]
-        xi = np.where(single[:, None], xi, moving)
-        rate_xi = np.where(single[:, None], rate_xi, moving_rate)
-        return xi, rate_xi
-
-    xi, xi_rate = dcm_at(s)
-    zmp = xi - xi_rate / omega  # p = xi - xi' / omega
-    # the CoM: c' = omega (xi - c), RK4 at the pattern's rate from the plan's CoM point
-    dt = 1.0 / rate
-    c = np.empty((n, 2))
-    c[0] = com[:2]
-    half_xi, _ = dcm_at(s[:-1] + dt / 2)
-    for k in range(n - 1):
-        a = omega * (xi[k] - c[k])
-        b = omega * (half_xi[k] - (c[k] + dt / 2 * a))
-        d = omega * (half_xi[k] - (c[k] + dt / 2 * b))
-        e = omega * (xi[k + 1] - (c[k] + dt * d))
-        c[k + 1] = c[k] + dt / 6 * (a + 2 * b + 2 * d + e)
-    pelvis = np.column_stack([c, np.full(n, com[2])])
-    pelvis_velocity = np.column_stack([omega * (xi - c), np.zeros(n)])
-    # the feet: the stance one stays, the swinging one moves along quintics to the landing
-    foot_position = [np.repeat(ankles[f][None], n, axis=0) for f in range(2)]
-    foot_velocity = [np.zeros((n, 3)) for _ in range(2)]
-    swing = s < swing_time
-    ground = float(ankles[st][2])
-    way, way_rate = quintic_from_rest(ankles[sw][:2], velocities[sw][:2], landing, swing_time, s[swing])
-    foot_position[sw][swing, :2], foot_velocity[sw][swing, :2] = way, way_rate
-    foot_position[sw][~swing, :2] = landing
-    top = max(float(ankles[sw][2]), ground + settings.lift)
-    first = s < swing_time / 2
-    up, up_rate = quintic_from_rest(ankles[sw][2:], velocities[sw][2:], np.array([top]), swing_time / 2, s[first])
-    down, down_rate = quintic_from_rest(np.array([top]), np.zeros(1), np.array([ground]), swing_time / 2,
-                                        s[swing & ~first] - swing_time / 2)
-    foot_position[sw][first, 2], foot_velocity[sw][first, 2] = up[:, 0], up_rate[:, 0]
-    foot_position[sw][swing & ~first, 2], foot_velocity[sw][swing & ~first, 2] = down[:, 0], down_rate[:, 0]
-    foot_position[sw][~swing, 2] = ground
-    yaw_blend, yaw_slope, _ = smoothstep5(np.clip(s / swing_time, 0.0, 1.0))
-    start_yaw = float(foot_yaws[sw])
-    yaws = [np.full(n, float(foot_yaws[f])) for f in range(2)]
-    yaw_rates = [np.zeros(n), np.zeros(n)]
-    yaws[sw] = start_yaw + (st_yaw - start_yaw) * yaw_blend
-    yaw_rates[sw] = (st_yaw - start_yaw) * yaw_slope / swing_time
-    _crouch(robot, s, pelvis, pelvis_velocity, pelvis_yaw, foot_position)
-    support = np.where(swing, SUPPORT_LEFT if st == 0 else SUPPORT_RIGHT, SUPPORT_DOUBLE).astype(np.int8)
-    st_pose = Pose2D(float(ankles[st][0]), float(ankles[st][1]), st_yaw)
-    sw_pose = Pose2D(float(landing[0]), float(landing[1]), st_yaw)
-    sides = (1, -1)
-    both = ((st_pose, sides[st]), (sw_pose, sides[sw])) if st == 0 else ((sw_pose, sides[sw]), (st_pose, sides[st]))
-    phases = [SupportPhase(time, time + swing_time, int(support[0]), ((st_pose, sides[st]),)),
-              SupportPhase(time + swing_time, math.inf, SUPPORT_DOUBLE, both)]
-    step = StepRecord(start=time, duration=swing_time, swing=("left", "right")[sw], kind="capture",
-                      landing=(float(landing[0]), float(landing[1]), st_yaw),
-                      parameters={"swing_time": swing_time, "settle": settle})
-    pattern = WalkingPattern(
-        robot=robot, rate=rate, generator="capture", time=time + s, support=support,
-        position_pelvis_in_world=pelvis, velocity_pelvis_in_world=pelvis_velocity,
-        yaw_pelvis_in_world=np.full(n, pelvis_yaw), yaw_rate_pelvis=np.zeros(n),
-        position_left_ankle_in_world=foot_position[0], velocity_left_ankle_in_world=foot_velocity[0],
-        yaw_left_foot_in_world=yaws[0], yaw_rate_left_foot=yaw_rates[0],
-        position_right_ankle_in_world=foot_position[1], velocity_right_ankle_in_world=foot_velocity[1],
-        yaw_right_foot_in_world=yaws[1], yaw_rate_right_foot=yaw_rates[1],
-        zmp_in_world=zmp, steps=[step], support_phases=phases)
-    return pattern, rest
-
-
-__all__ = ["CapturePlan", "CaptureSettings", "capture_step", "quintic_from_rest"]
+__all__ = ["REACH_MARGIN", "CapturePlan", "CaptureSettings", "capture_step", "quintic_from_rest"]

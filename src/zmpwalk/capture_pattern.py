@@ -1,0 +1,241 @@
+r"""The capture step's pattern for one landing: the DCM, the CoM and the feet of the three phases.
+
+:func:`capture_pattern` builds the pattern :func:`zmpwalk.capture.capture_step` chose a landing for (its module
+docstring's three phases): the DCM runs away from the stance ZMP until touchdown, moves to the midpoint of the soles
+along a quintic over the settle and rests there; the CoM follows it (``c' = omega (xi - c)``, RK4 at the pattern's
+rate); the swinging foot moves along quintics to the landing, lifted on the way, turning to the stance foot's yaw;
+the CoM point is lowered where a leg would otherwise be out of reach.
+
+Axes: world, x forward at the walk's start, y left, z up (docs/frames-and-units.md).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zmpwalk.curves import smoothstep5
+from zmpwalk.footsteps import Pose2D
+from zmpwalk.kinematics import hip_positions_in_world
+from zmpwalk.patterns.result import (
+    SUPPORT_DOUBLE,
+    SUPPORT_LEFT,
+    SUPPORT_RIGHT,
+    StepRecord,
+    SupportPhase,
+    WalkingPattern,
+)
+from zmpwalk.robots.model import RobotModel
+
+Array = NDArray[np.float64]
+
+REACH_MARGIN = 0.01  # [m] the landing keeps this much of the leg's reach in hand
+CROUCH_LEAST_TIME = 0.1  # [s] the CoM point is lowered for the legs' reach over at least this time
+
+
+def turned(vector: Array, yaw: float) -> Array:
+    """``vector`` (2,) turned by ``yaw`` [rad]."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.array([c * vector[0] - s * vector[1], s * vector[0] + c * vector[1]])
+
+
+def quintic_from_rest(start: Array, velocity: Array, end: Array, duration: float, s: Array) -> tuple[Array, Array]:
+    r"""Value and rate of the quintic from ``start`` with ``velocity`` and no acceleration to ``end`` at rest
+    (zero velocity and acceleration) after ``duration``, at times ``s`` in ``[0, duration]``.
+
+    .. math:: x(s) = x_0 + v_0 s + c_3 s^3 + c_4 s^4 + c_5 s^5
+
+    with ``c3, c4, c5`` from the three end conditions.
+
+    Args:
+        start, velocity, end: (k,) each [m], [m/s], [m].
+        duration: [s] (> 0).
+        s: (n,) [s].
+
+    Returns:
+        Positions (n, k) [m] and velocities (n, k) [m/s].
+    """
+    t = duration
+    gap = end - start - velocity * t
+    matrix = np.array([[t**3, t**4, t**5], [3 * t**2, 4 * t**3, 5 * t**4], [6 * t, 12 * t**2, 20 * t**3]])
+    coefficients = np.linalg.solve(matrix, np.vstack([gap, -velocity, np.zeros_like(gap)]))  # (3, k)
+    s = s[:, None]
+    value = start + velocity * s + s**3 * coefficients[0] + s**4 * coefficients[1] + s**5 * coefficients[2]
+    rate = velocity + 3 * s**2 * coefficients[0] + 4 * s**3 * coefficients[1] + 5 * s**4 * coefficients[2]
+    return value, rate
+
+
+@dataclass(frozen=True)
+class CaptureState:
+    """What a capture pattern is built from, but its landing and settle: the state at the capture and the
+    choices of steps 1 and 2 (:mod:`zmpwalk.capture`).
+
+    Attributes:
+        st: The stance foot (0 left, 1 right); ``ankles``, ``velocities`` and ``foot_yaws`` are left, right.
+    """
+
+    robot: RobotModel
+    time: float  # [s]
+    rate: float  # [Hz]
+    lift: float  # [m] least height of the swinging ankle above its landing height
+    omega: float  # [1/s]
+    st: int
+    com: Array  # [m]
+    dcm: Array  # [m]
+    p1: Array  # [m]
+    swing_time: float  # [s]
+    st_yaw: float  # [rad]
+    pelvis_yaw: float  # [rad]
+    ankles: list[Array]  # [m]
+    velocities: list[Array]  # [m/s]
+    foot_yaws: tuple[float, float]  # [rad]
+
+
+def capture_pattern(plan: CaptureState, s: Array, settle: float, landing: Array) -> tuple[WalkingPattern, Array]:
+    """The capture pattern for one landing (the module docstring's three phases) at times ``s`` [s] after the
+    capture, and the rest point [m]."""
+    robot, st, omega = plan.robot, plan.st, plan.omega
+    st_side, sw_side = (1, -1) if st == 0 else (-1, 1)
+    centers = [plan.ankles[st][:2] + turned(np.array([robot.sole_center_x, st_side * robot.sole_center_y]),
+                                             plan.st_yaw),
+               landing + turned(np.array([robot.sole_center_x, sw_side * robot.sole_center_y]), plan.st_yaw)]
+    rest = (centers[0] + centers[1]) / 2
+    xi, xi_rate = _dcm_at(plan, rest, settle, s)
+    zmp = xi - xi_rate / omega  # p = xi - xi' / omega
+    c = _com_path(plan, rest, settle, s, xi)
+    n = len(s)
+    pelvis = np.column_stack([c, np.full(n, plan.com[2])])
+    pelvis_velocity = np.column_stack([omega * (xi - c), np.zeros(n)])
+    foot_position, foot_velocity = _feet(plan, s, landing)
+    yaws, yaw_rates = _foot_yaws(plan, s)
+    _crouch(robot, s, pelvis, pelvis_velocity, plan.pelvis_yaw, foot_position)
+    support = np.where(s < plan.swing_time, SUPPORT_LEFT if st == 0 else SUPPORT_RIGHT,
+                       SUPPORT_DOUBLE).astype(np.int8)
+    steps, phases = _record(plan, landing, settle, int(support[0]))
+    pattern = WalkingPattern(
+        robot=robot, rate=plan.rate, generator="capture", time=plan.time + s, support=support,
+        position_pelvis_in_world=pelvis, velocity_pelvis_in_world=pelvis_velocity,
+        yaw_pelvis_in_world=np.full(n, plan.pelvis_yaw), yaw_rate_pelvis=np.zeros(n),
+        position_left_ankle_in_world=foot_position[0], velocity_left_ankle_in_world=foot_velocity[0],
+        yaw_left_foot_in_world=yaws[0], yaw_rate_left_foot=yaw_rates[0],
+        position_right_ankle_in_world=foot_position[1], velocity_right_ankle_in_world=foot_velocity[1],
+        yaw_right_foot_in_world=yaws[1], yaw_rate_right_foot=yaw_rates[1],
+        zmp_in_world=zmp, steps=steps, support_phases=phases)
+    return pattern, rest
+
+
+def _dcm_at(plan: CaptureState, rest: Array, settle: float, t: Array) -> tuple[Array, Array]:
+    """The planned DCM [m] and its rate [m/s] at times ``t`` (n,) after the capture: running away from ``p1``
+    until touchdown, then along the quintic to ``rest`` over ``settle`` [s], then at rest."""
+    p1, dcm, omega, swing_time = plan.p1, plan.dcm, plan.omega, plan.swing_time
+    dcm_touchdown = p1 + (dcm - p1) * math.exp(omega * swing_time)
+    t = np.asarray(t, dtype=float)
+    single = t < swing_time - 1e-12
+    grow = np.exp(omega * np.minimum(t, swing_time))[:, None]
+    xi = np.where(single[:, None], p1 + (dcm - p1) * grow, 0.0)
+    rate_xi = np.where(single[:, None], omega * (dcm - p1) * grow, 0.0)
+    tau = np.clip((t - swing_time) / settle, 0.0, 1.0)
+    blend, slope, _ = smoothstep5(tau)
+    moving = rest + (dcm_touchdown - rest) * (1.0 - blend)[:, None]
+    moving_rate = -(dcm_touchdown - rest) * (slope / settle)[:, None]
+    xi = np.where(single[:, None], xi, moving)
+    rate_xi = np.where(single[:, None], rate_xi, moving_rate)
+    return xi, rate_xi
+
+
+def _com_path(plan: CaptureState, rest: Array, settle: float, s: Array, xi: Array) -> Array:
+    """The CoM's horizontal path [m] (n, 2) at ``s``: ``c' = omega (xi - c)``, integrated with RK4 at the pattern's
+    rate from the plan's CoM point (``xi`` (n, 2): the DCM at ``s``)."""
+    omega, n = plan.omega, len(s)
+    dt = 1.0 / plan.rate
+    c = np.empty((n, 2))
+    c[0] = plan.com[:2]
+    half_xi, _ = _dcm_at(plan, rest, settle, s[:-1] + dt / 2)
+    for k in range(n - 1):
+        a = omega * (xi[k] - c[k])
+        b = omega * (half_xi[k] - (c[k] + dt / 2 * a))
+        d = omega * (half_xi[k] - (c[k] + dt / 2 * b))
+        e = omega * (xi[k + 1] - (c[k] + dt * d))
+        c[k + 1] = c[k] + dt / 6 * (a + 2 * b + 2 * d + e)
+    return c
+
+
+def _feet(plan: CaptureState, s: Array, landing: Array) -> tuple[list[Array], list[Array]]:
+    """The ankles' positions [m] and velocities [m/s] at ``s``, left and right, (n, 3) each: the stance one stays,
+    the swinging one moves along quintics to ``landing``, lifted :attr:`CaptureSettings.lift` on the way."""
+    st, swing_time, ankles, velocities = plan.st, plan.swing_time, plan.ankles, plan.velocities
+    sw, n = 1 - st, len(s)
+    foot_position = [np.repeat(ankles[f][None], n, axis=0) for f in range(2)]
+    foot_velocity = [np.zeros((n, 3)) for _ in range(2)]
+    swing = s < swing_time
+    ground = float(ankles[st][2])
+    way, way_rate = quintic_from_rest(ankles[sw][:2], velocities[sw][:2], landing, swing_time, s[swing])
+    foot_position[sw][swing, :2], foot_velocity[sw][swing, :2] = way, way_rate
+    foot_position[sw][~swing, :2] = landing
+    top = max(float(ankles[sw][2]), ground + plan.lift)
+    first = s < swing_time / 2
+    up, up_rate = quintic_from_rest(ankles[sw][2:], velocities[sw][2:], np.array([top]), swing_time / 2, s[first])
+    down, down_rate = quintic_from_rest(np.array([top]), np.zeros(1), np.array([ground]), swing_time / 2,
+                                        s[swing & ~first] - swing_time / 2)
+    foot_position[sw][first, 2], foot_velocity[sw][first, 2] = up[:, 0], up_rate[:, 0]
+    foot_position[sw][swing & ~first, 2], foot_velocity[sw][swing & ~first, 2] = down[:, 0], down_rate[:, 0]
+    foot_position[sw][~swing, 2] = ground
+    return foot_position, foot_velocity
+
+
+def _foot_yaws(plan: CaptureState, s: Array) -> tuple[list[Array], list[Array]]:
+    """The feet's yaws [rad] and yaw rates [rad/s] at ``s``, left and right: the swinging foot turns to the stance
+    foot's yaw during the swing."""
+    sw, n, swing_time = 1 - plan.st, len(s), plan.swing_time
+    yaw_blend, yaw_slope, _ = smoothstep5(np.clip(s / swing_time, 0.0, 1.0))
+    start_yaw = float(plan.foot_yaws[sw])
+    yaws = [np.full(n, float(plan.foot_yaws[f])) for f in range(2)]
+    yaw_rates = [np.zeros(n), np.zeros(n)]
+    yaws[sw] = start_yaw + (plan.st_yaw - start_yaw) * yaw_blend
+    yaw_rates[sw] = (plan.st_yaw - start_yaw) * yaw_slope / swing_time
+    return yaws, yaw_rates
+
+
+def _record(plan: CaptureState, landing: Array, settle: float,
+            single: int) -> tuple[list[StepRecord], list[SupportPhase]]:
+    """The capture pattern's step (one ``"capture"`` step) and its support phases (the single support ``single``
+    until touchdown, double after)."""
+    st, time, swing_time, st_yaw = plan.st, plan.time, plan.swing_time, plan.st_yaw
+    sw = 1 - st
+    st_pose = Pose2D(float(plan.ankles[st][0]), float(plan.ankles[st][1]), st_yaw)
+    sw_pose = Pose2D(float(landing[0]), float(landing[1]), st_yaw)
+    sides = (1, -1)
+    both = ((st_pose, sides[st]), (sw_pose, sides[sw])) if st == 0 else ((sw_pose, sides[sw]), (st_pose, sides[st]))
+    phases = [SupportPhase(time, time + swing_time, single, ((st_pose, sides[st]),)),
+              SupportPhase(time + swing_time, math.inf, SUPPORT_DOUBLE, both)]
+    step = StepRecord(start=time, duration=swing_time, swing=("left", "right")[sw], kind="capture",
+                      landing=(float(landing[0]), float(landing[1]), st_yaw),
+                      parameters={"swing_time": swing_time, "settle": settle})
+    return [step], phases
+
+
+
+def _crouch(robot: RobotModel, s: Array, pelvis: Array, pelvis_velocity: Array, pelvis_yaw: float,
+            feet: list[Array]) -> None:
+    """Lower the CoM point (in place) where a leg would otherwise be out of reach: a capture step can carry the
+    body further from the stance foot than the walk's height allows. The least lowering that keeps each hip
+    within the leg's reach less :data:`REACH_MARGIN` of its ankle, ``dz <= sqrt(r^2 - h^2)`` with ``h`` the
+    horizontal distance, is reached along a quintic by the first sample that needs it, and then held."""
+    reach = robot.max_leg_reach - REACH_MARGIN
+    hips = hip_positions_in_world(pelvis, np.full(len(s), pelvis_yaw), robot)
+    needed = np.zeros(len(s))
+    for hip, ankle in zip(hips, feet, strict=True):
+        horizontal = np.linalg.norm(hip[:, :2] - ankle[:, :2], axis=1)
+        allowed = np.sqrt(np.maximum(reach**2 - horizontal**2, 0.0))
+        needed = np.maximum(needed, (hip[:, 2] - ankle[:, 2]) - allowed)
+    if needed.max() <= 0.0:
+        return
+    drop = float(needed.max())
+    first = float(s[int(np.argmax(needed > 0.0))])
+    ramp = max(first, CROUCH_LEAST_TIME)
+    blend, slope, _ = smoothstep5(np.clip(s / ramp, 0.0, 1.0))
+    pelvis[:, 2] -= drop * blend
+    pelvis_velocity[:, 2] -= drop * slope / ramp
