@@ -122,17 +122,56 @@ def robot_mjcf(robot: RobotModel, mass_scale: float = 1.0) -> str:
     scaled = RobotModel(**{**vars(robot), "links": {
         name: type(link)(link.mass * mass_scale, link.size, link.com) for name, link in robot.links.items()}})
     mapping = contact_mapping(scaled)
-    links = scaled.links
     servos = robot.servos
     servos = type(servos)(servos.kp * mass_scale, servos.kv * mass_scale, servos.armature * mass_scale)
+    torso = scaled.links["torso"]
+    legs = "".join(_leg(scaled, side, label, mapping) for side, label in ((1, "left"), (-1, "right")))
+    touch_size = _box((1.05 * torso.size[0], 1.05 * torso.size[1], 1.05 * torso.size[2]))
+    solref = _fmt(*mapping.solref)
+    return f"""<mujoco model="{robot.name}">
+  <compiler angle="radian" autolimits="true"/>
+  <option timestep="{TIMESTEP}" integrator="implicitfast" cone="elliptic" gravity="0 0 {-robot.gravity:.9g}"/>
+  <default>
+    <joint armature="{servos.armature:.9g}" damping="0"/>
+    <geom solref="{solref}" solimp="0.95 0.99 0.0001" condim="3"/>
+  </default>
+  <visual><global offwidth="640" offheight="480"/></visual>
+  <asset>
+    <texture name="grid" type="2d" builtin="checker" rgb1=".85 .85 .85" rgb2=".7 .7 .7" width="512" height="512"/>
+    <material name="grid" texture="grid" texrepeat="8 8" reflectance="0.1"/>
+  </asset>
+  <worldbody>
+    <light pos="0 0 3" dir="0 0 -1" directional="true"/>
+    <geom name="floor" type="plane" size="0 0 0.05" material="grid" friction="{mapping.friction:.9g} 0.005 0.0001"/>
+    <body name="torso" pos="0 0 {robot.pelvis_height:.9g}">
+      <freejoint name="root"/>
+      {_inertial(torso.mass, torso.com, torso.size)}
+      <geom name="torso" type="box" size="{_box(torso.size)}" pos="{_fmt(*torso.com)}" rgba="0.8 0.45 0.2 1"/>
+      <site name="pelvis" pos="0 0 0" size="0.01"/>
+      <site name="torso_touch" type="box" size="{touch_size}" pos="{_fmt(*torso.com)}"
+            rgba="0 0 0 0"/>{legs}
+    </body>
+  </worldbody>
+  <actuator>
+{_servos(servos.kp, servos.kv)}
+  </actuator>
+  <sensor>
+{_sensors()}
+  </sensor>
+</mujoco>
+"""
+
+
+def _leg(robot: RobotModel, side: int, label: str, mapping: ContactMapping) -> str:
+    """The bodies of one leg (``side`` 1 left, -1 right; ``label`` its name) with the masses of ``robot``'s
+    ``[bodies]``, its joints, and its sole, the only geom of the leg that collides (``mapping``'s friction). The
+    joint-only links carry :data:`SMALL_FRACTION` of the thigh's mass, taken from the thigh and the foot."""
+    links = robot.links
     small = links["thigh"].mass * SMALL_FRACTION
     tiny_size = (0.01, 0.01, 0.01)
-    torso = links["torso"]
-    legs = []
-    for side, label in ((1, "left"), (-1, "right")):
-        thigh, shank, foot = links["thigh"], links["shank"], links["foot"]
-        foot_com = (foot.com[0], side * foot.com[1], foot.com[2])
-        legs.append(f"""
+    thigh, shank, foot = links["thigh"], links["shank"], links["foot"]
+    foot_com = (foot.com[0], side * foot.com[1], foot.com[2])
+    return f"""
       <body name="{label}_hip_yaw_link" pos="{_fmt(0.0, side * robot.hip_spacing / 2, -robot.hip_drop)}">
         <joint name="{label}_hip_yaw" axis="0 0 1"/>
         {_inertial(small, (0, 0, 0), tiny_size)}
@@ -163,7 +202,20 @@ def robot_mjcf(robot: RobotModel, mass_scale: float = 1.0) -> str:
             </body>
           </body>
         </body>
-      </body>""")
+      </body>"""
+
+
+def _servos(kp: float, kv: float) -> str:
+    """A position servo with gains ``kp`` [N m/rad] and ``kv`` [N m s/rad] on every leg joint."""
+    return "\n".join(
+        f'    <position name="{label}_{joint}" joint="{label}_{joint}" kp="{kp:.9g}" '
+        f'kv="{kv:.9g}"/>'
+        for label in ("left", "right") for joint in JOINT_NAMES)
+
+
+def _sensors() -> str:
+    """The sensors zmpwalk measures with: the pelvis pose and gyro, the torso's touch of the ground, a
+    force-torque sensor and the pose of each ankle, and each joint's angle, rate and actuator torque."""
     sensors = [
         '    <framepos name="pelvis_pos" objtype="site" objname="pelvis"/>',
         '    <framequat name="pelvis_quat" objtype="site" objname="pelvis"/>',
@@ -182,41 +234,4 @@ def robot_mjcf(robot: RobotModel, mass_scale: float = 1.0) -> str:
             sensors += [f'    <jointpos name="{label}_{joint}_q" joint="{label}_{joint}"/>',
                         f'    <jointvel name="{label}_{joint}_qd" joint="{label}_{joint}"/>',
                         f'    <actuatorfrc name="{label}_{joint}_tau" actuator="{label}_{joint}"/>']
-    touch_size = _box((1.05 * torso.size[0], 1.05 * torso.size[1], 1.05 * torso.size[2]))
-    actuators = "\n".join(
-        f'    <position name="{label}_{joint}" joint="{label}_{joint}" kp="{servos.kp:.9g}" '
-        f'kv="{servos.kv:.9g}"/>'
-        for label in ("left", "right") for joint in JOINT_NAMES)
-    solref = _fmt(*mapping.solref)
-    return f"""<mujoco model="{robot.name}">
-  <compiler angle="radian" autolimits="true"/>
-  <option timestep="{TIMESTEP}" integrator="implicitfast" cone="elliptic" gravity="0 0 {-robot.gravity:.9g}"/>
-  <default>
-    <joint armature="{servos.armature:.9g}" damping="0"/>
-    <geom solref="{solref}" solimp="0.95 0.99 0.0001" condim="3"/>
-  </default>
-  <visual><global offwidth="640" offheight="480"/></visual>
-  <asset>
-    <texture name="grid" type="2d" builtin="checker" rgb1=".85 .85 .85" rgb2=".7 .7 .7" width="512" height="512"/>
-    <material name="grid" texture="grid" texrepeat="8 8" reflectance="0.1"/>
-  </asset>
-  <worldbody>
-    <light pos="0 0 3" dir="0 0 -1" directional="true"/>
-    <geom name="floor" type="plane" size="0 0 0.05" material="grid" friction="{mapping.friction:.9g} 0.005 0.0001"/>
-    <body name="torso" pos="0 0 {robot.pelvis_height:.9g}">
-      <freejoint name="root"/>
-      {_inertial(torso.mass, torso.com, torso.size)}
-      <geom name="torso" type="box" size="{_box(torso.size)}" pos="{_fmt(*torso.com)}" rgba="0.8 0.45 0.2 1"/>
-      <site name="pelvis" pos="0 0 0" size="0.01"/>
-      <site name="torso_touch" type="box" size="{touch_size}" pos="{_fmt(*torso.com)}"
-            rgba="0 0 0 0"/>{"".join(legs)}
-    </body>
-  </worldbody>
-  <actuator>
-{actuators}
-  </actuator>
-  <sensor>
-{chr(10).join(sensors)}
-  </sensor>
-</mujoco>
-"""
+    return "\n".join(sensors)

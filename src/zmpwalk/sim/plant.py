@@ -95,10 +95,25 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
     if not any(g.type == mujoco.mjtGeom.mjGEOM_PLANE for g in spec.worldbody.geoms):
         spec.worldbody.add_geom(name="zmpwalk_floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 0.05])
     add_pd_layer(spec, plant)
-    # Zero pose of the legs, base at the origin: where the ankle points sit in the foot bodies.
+    qpos = np.array(plant.qpos_reference)
+    _add_sites(spec, model, robot, plant, qpos)
+    virtual = _virtual_columns(robot)
+    _add_sensors(spec, plant, virtual)
+    model = spec.compile()
+    actuators = _leg_actuators(model, plant, virtual)
+    columns = np.array([i for i in range(12) if i not in virtual], dtype=np.intp)
+    leg_qpos = np.array([model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, plant.joints[i].name)]
+                         for i in columns])
+    return Plant(model, np.array(actuators), leg_qpos, _held_controls(model, plant), qpos, True, columns)
+
+
+def _add_sites(spec: mujoco.MjSpec, model: mujoco.MjModel, robot: RobotModel, plant: ModelPlant,
+               qpos: Array) -> None:
+    """Add the ``pelvis`` site at the base body's origin and an ``{left,right}_ankle`` site at each ankle point
+    (axes of the sole frame), placed in the foot bodies from the zero pose of the legs with the base at the origin
+    (``qpos``: the reference pose, the other joints' angles)."""
     data = mujoco.MjData(model)
     joint_ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint.name) for joint in plant.joints]
-    qpos = np.array(plant.qpos_reference)
     zero = qpos.copy()
     for j in joint_ids:
         zero[model.jnt_qposadr[j]] = 0.0
@@ -117,6 +132,11 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
         quaternion = np.empty(4)
         mujoco.mju_mat2Quat(quaternion, (rotation.T @ chain.sole_rotation).flatten())  # site axes: the sole frame
         spec.body(foot).add_site(name=f"{label}_ankle", pos=position, quat=quaternion, size=[0.005, 0.005, 0.005])
+
+
+def _add_sensors(spec: mujoco.MjSpec, plant: ModelPlant, virtual: set[int]) -> None:
+    """Add zmpwalk's sensors: the base's pose and gyro, each ankle's force-torque and pose, each leg joint's angle,
+    rate and actuator torque (a ``virtual`` column's read from its actuator that does nothing)."""
     sensors = [("pelvis_pos", mujoco.mjtSensor.mjSENS_FRAMEPOS, "pelvis"),
                ("pelvis_quat", mujoco.mjtSensor.mjSENS_FRAMEQUAT, "pelvis"),
                ("pelvis_gyro", mujoco.mjtSensor.mjSENS_GYRO, "pelvis")]
@@ -128,7 +148,6 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
     for name, kind, site in sensors:
         sensor = spec.add_sensor(name=name, type=kind, objname=site)
         sensor.objtype = mujoco.mjtObj.mjOBJ_SITE
-    virtual = _virtual_columns(robot)
     for index, (column, joint) in enumerate(zip(JOINT_COLUMNS, plant.joints, strict=True)):
         if index in virtual:
             _add_virtual_actuator(spec, joint.name, plant.joints[6 * (index // 6) + 4].name, column)
@@ -137,7 +156,14 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
                              ("tau", mujoco.mjtSensor.mjSENS_JOINTACTFRC)):
             sensor = spec.add_sensor(name=f"{column}_{suffix}", type=kind, objname=joint.name)
             sensor.objtype = mujoco.mjtObj.mjOBJ_JOINT
-    model = spec.compile()
+
+
+def _leg_actuators(model: mujoco.MjModel, plant: ModelPlant, virtual: set[int]) -> list[int]:
+    """The actuator index of each joint column (a ``virtual`` column's: its actuator that does nothing).
+
+    Raises:
+        InvalidParameterError: A leg joint driven by neither a position servo nor the PD layer.
+    """
     actuators = []
     for index, (column, joint) in enumerate(zip(JOINT_COLUMNS, plant.joints, strict=True)):
         if index in virtual:
@@ -149,10 +175,7 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
                                         "torque motor (<motor>, driven by the PD layer): zmpwalk drives the leg "
                                         "joints with joint angles")
         actuators.append(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, joint.actuator.name))
-    columns = np.array([i for i in range(12) if i not in virtual], dtype=np.intp)
-    leg_qpos = np.array([model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, plant.joints[i].name)]
-                         for i in columns])
-    return Plant(model, np.array(actuators), leg_qpos, _held_controls(model, plant), qpos, True, columns)
+    return actuators
 
 
 def _virtual_columns(robot: RobotModel) -> set[int]:
