@@ -192,7 +192,7 @@ def test_a_backward_push_is_survived_with_a_capture_step_and_not_without(hubo, w
     capture planned them (within 20 mm, the verdict's bound)."""
     from zmpwalk import Stabilizer
     from zmpwalk.sim import simulate
-    from zmpwalk.sim.run import Disturbances
+    from zmpwalk.sim.disturbances import Disturbances
 
     pattern, index = walk
     joints = pattern_joint_trajectory(pattern, check_limits=False)

@@ -143,7 +143,7 @@ def test_simulate_command_errors(capsys, argv, message):
 
 
 def test_disturbances_tilt_gravity_scale_masses_and_push_in_their_window():
-    from zmpwalk.sim.run import Disturbances
+    from zmpwalk.sim.disturbances import Disturbances
 
     model = mujoco.MjModel.from_xml_string(robot_mjcf(load_robot("mju-biped")))
     mass = float(model.body_mass.sum())
@@ -184,7 +184,7 @@ def test_loaded_soles_on_a_tilted_floor_do_not_creep():
     sole creep under it (the noslip solver runs on a tilted floor, Disturbances.apply). HUBO standing 2 s on
     the slope: each ankle stays within 0.03 mm (0.06-0.08 mm without noslip; TALOS 1.9-3.0 mm without, 0.2
     with). A level floor keeps the cheaper contacts."""
-    from zmpwalk.sim.run import NOSLIP_ITERATIONS, Disturbances
+    from zmpwalk.sim.disturbances import NOSLIP_ITERATIONS, Disturbances
 
     robot = load_robot("hubo")
     level = mujoco.MjModel.from_xml_string(robot_mjcf(robot))
@@ -201,7 +201,7 @@ def test_loaded_soles_on_a_tilted_floor_do_not_creep():
 
 def test_noisy_delayed_sensors_reach_the_stabilizer_and_bad_noise_is_rejected():
     from zmpwalk.balance import Stabilizer
-    from zmpwalk.sim.run import SensorNoise
+    from zmpwalk.sim.disturbances import SensorNoise
 
     with pytest.raises(InvalidParameterError, match=r"noise\.force"):
         SensorNoise(force=-1.0)
@@ -291,3 +291,24 @@ def test_a_sweep_walks_a_tuned_schedule_and_the_quintic_pelvis():
     assert result.passed  # open loop on the box model: the paper's tables fail this walk's verdict
     (quintic,) = sweep("hubo", ["turn45"], workers=1, pelvis="quintic")
     assert quintic.simulated > 5.0 and not quintic.fell
+
+
+def test_the_simulation_names_are_found_where_the_cli_the_report_and_the_plant_import_them():
+    import zmpwalk.sim as sim
+    from zmpwalk.sim import closed_loop, disturbances, measure, references, result, run
+
+    assert sim.simulate is run.simulate and sim.SimulationResult is run.SimulationResult is result.SimulationResult
+    assert run.Disturbances is disturbances.Disturbances and run.SensorNoise is disturbances.SensorNoise
+    assert run.write_result_csv is result.write_result_csv
+    assert (run.FALL_TILT, run.FALL_HEIGHT_FRACTION, run.AFTER_FALL) == (
+        measure.FALL_TILT, measure.FALL_HEIGHT_FRACTION, measure.AFTER_FALL)
+    assert run.CONTROL_RATE == references.CONTROL_RATE and run.CAPTURE_INTERVAL == closed_loop.CAPTURE_INTERVAL
+    assert run._MeasurementReader is disturbances._MeasurementReader  # the controller's plant reads its sensors so
+
+
+def test_a_robots_own_model_settles_and_holds_longer_than_a_judged_walk_when_simulate_is_given_neither():
+    from zmpwalk.sim import run, verdict
+
+    assert (run.OWN_MODEL_SETTLE, run.OWN_MODEL_HOLD) == (1.0, 2.0)  # [s]
+    assert (verdict.SETTLE, verdict.HOLD) == (0.5, 2.0)  # [s] what the CLI, the report and the sweeps simulate
+    assert run._settle_and_hold(load_robot("hubo"), None, None) == (0.0, 0.0)  # a box model starts at rest
