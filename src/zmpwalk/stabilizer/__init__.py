@@ -8,7 +8,9 @@
 - :mod:`~zmpwalk.stabilizer.loops`: DCM feedback, CoM admittance, ankle damping, foot force difference, torso
   attitude;
 - :mod:`~zmpwalk.stabilizer.landing`: landing and stepping;
-- :mod:`~zmpwalk.stabilizer.joints`: the corrections onto the joints and the servo stiffness loop.
+- :mod:`~zmpwalk.stabilizer.joints`: the corrections onto the joints and the servo stiffness loop;
+- :mod:`~zmpwalk.stabilizer.freshness`: whether numba's disk cache of them is current.
 
-The laws are those of :mod:`zmpwalk.balance`, whose docstring numbers them.
+The laws are those of :mod:`zmpwalk.balance`, whose docstring numbers them. A new gain is a field of
+:class:`~zmpwalk.stabilizer_gains.StabilizerGains` and its use, ``params[P.<field>]``, in its loop.
 """
