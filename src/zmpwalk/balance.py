@@ -52,7 +52,7 @@ separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega 
    compression ``(f / k)^(1/e)`` under its measured force ``f`` where the robot file gives the soles' contact
    law (a stance sole pressed into the floor lowers the whole robot, and a swinging foot whose plan comes down
    gently reaches the floor that much early). The corrections are released once the plan puts the foot down,
-   unless its sole has carried no load for over :data:`zmpwalk.balance_kernel.AIRBORNE_AIM` (a late
+   unless its sole has carried no load for over :data:`zmpwalk.stabilizer.landing.AIRBORNE_AIM` (a late
    touchdown), which keeps its aim until it carries load; a stance sole that unloads for a shorter moment
    (sensor noise, a rocking body) is not taken for one.
 7. **Floor slope**: in double support both soles lie on the floor, so their attitude (IMU and measured leg
@@ -82,14 +82,15 @@ centre line, the one motion five joints cannot make at any posture (the sole's r
 position, heading and pitch). No ankle-roll torque is asked for: the ankle damping's roll and the torso roll
 reach the sole only as that dropped twist, and the lateral balance is the hip roll's, moving the CoM sideways
 (the CoM admittance) and placing the swinging foot (landing control); ``tests/test_five_joint_legs.py`` checks
-the split on a five-joint chain. It runs compiled
-(:mod:`zmpwalk.balance_kernel`, numba, cached on disk after the first compile) on arrays allocated once per
+the split on a five-joint chain. It runs compiled (:mod:`zmpwalk.balance_kernel`, one compiled function per loop
+in :mod:`zmpwalk.stabilizer`, numba, cached on disk after the first compile) on arrays allocated once per
 stabilizer: a tick costs about 5 µs from Python and allocates nothing.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -97,7 +98,9 @@ from numpy.typing import NDArray
 
 from zmpwalk.errors import InvalidParameterError
 from zmpwalk.kinematics import leg_chains, rest_mass
+from zmpwalk.leg_chain import LegChain
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.stabilizer.layout import LOG_SIZE, STATE_SIZE, L, S, initial_state, pack_parameters
 from zmpwalk.stabilizer_gains import StabilizerGains
 
 Array = NDArray[np.float64]
@@ -208,61 +211,29 @@ class Stabilizer:
         wanted = self.gains.servo_stiffness * self._mass * robot.gravity * robot.pendulum_length
         self.servo_gain = (np.zeros(12) if stiffness is None
                            else np.maximum(wanted / np.maximum(stiffness, 1e-9) - 1.0, 0.0))
-        params = np.zeros(kernel.PARAMETERS)
-        params[:len(kernel.GAIN_NAMES)] = [getattr(self.gains, name) for name in kernel.GAIN_NAMES]
-        params[kernel.P_DT] = self.dt
-        params[kernel.P_OMEGA] = self.omega
-        params[kernel.P_MASS] = self._mass
-        params[kernel.P_REST_MOMENT:kernel.P_REST_MOMENT + 3] = rest * np.asarray(rest_com)
-        params[kernel.P_HALF_LENGTH] = robot.foot_length / 2
-        params[kernel.P_HALF_WIDTH] = robot.foot_width / 2
-        params[kernel.P_ANKLE_HEIGHT] = robot.ankle_height
-        params[kernel.P_PENDULUM_LENGTH] = robot.pendulum_length
-        params[kernel.P_SOLE_CENTER_X] = robot.sole_center_x
-        params[kernel.P_SOLE_CENTER_Y] = robot.sole_center_y
-        params[kernel.P_LOAD_THRESHOLD] = LOAD_FRACTION * self._mass * robot.gravity
-        params[kernel.P_ANKLE_OFFSET:kernel.P_ANKLE_OFFSET + 6] = np.concatenate([c.ankle for c in self.chains])
-        params[kernel.P_SOLE_NORMAL:kernel.P_SOLE_NORMAL + 6] = np.concatenate([c.sole_rotation[:, 2]
-                                                                               for c in self.chains])
-        params[kernel.P_SERVO_GAIN:kernel.P_SERVO_GAIN + 12] = self.servo_gain
-        params[kernel.P_STIFFEN] = float(self.servo_gain.any())
-        params[kernel.P_FEET_CLEARANCE] = self.gains.feet_clearance
-        params[kernel.P_TOUCHDOWN_SPEED] = self.gains.touchdown_speed
-        params[kernel.P_LANDING_HEIGHT_LIMIT] = self.gains.landing_height_limit
-        params[kernel.P_WHOLE_BODY_REST] = self.gains.whole_body_rest if com_reference == "pelvis" else 0.0
-        if robot.contact is not None:  # the soles' compliance, where the robot file gives it
-            params[kernel.P_SOLE_STIFFNESS] = robot.contact.stiffness
-            params[kernel.P_SOLE_EXPONENT] = robot.contact.exponent
-        self._params = params
-        chain = np.empty((2, 6, 11))
-        for leg, leg_chain in enumerate(self.chains):
-            chain[leg, :, 0:3] = leg_chain.axes
-            chain[leg, :, 3:6] = leg_chain.points
-            chain[leg, :, 6:9] = leg_chain.link_coms
-            chain[leg, :, 9] = leg_chain.link_masses
-            chain[leg, :, 10] = np.argsort(np.asarray(leg_chain.role_order))  # chain joint -> role column
-        self._chain = chain
-        self._state = np.zeros(kernel.STATE_SIZE)
-        self._log = np.zeros(kernel.LOG_SIZE)
+        sole_law = robot.contact  # the soles' compliance, where the robot file gives it
+        self._params = pack_parameters(
+            self.gains, whole_body_rest=self.gains.whole_body_rest if com_reference == "pelvis" else 0.0,
+            dt=self.dt, omega=self.omega, mass=self._mass, rest_moment=rest * np.asarray(rest_com),
+            half_length=robot.foot_length / 2, half_width=robot.foot_width / 2, ankle_height=robot.ankle_height,
+            pendulum_length=robot.pendulum_length, sole_center_x=robot.sole_center_x,
+            sole_center_y=robot.sole_center_y, load_threshold=LOAD_FRACTION * self._mass * robot.gravity,
+            ankle_offset=np.concatenate([c.ankle for c in self.chains]), servo_gain=self.servo_gain,
+            stiffen=float(self.servo_gain.any()), sole_stiffness=0.0 if sole_law is None else sole_law.stiffness,
+            sole_exponent=0.0 if sole_law is None else sole_law.exponent,
+            sole_normal=np.concatenate([c.sole_rotation[:, 2] for c in self.chains]))
+        self._chain = chain = chain_table(self.chains)
+        self._state = np.zeros(STATE_SIZE)
+        self._log = log = np.zeros(LOG_SIZE)
         self._work = np.zeros((6, 7, 12))
         self._targets = np.zeros(12)
-        log = self._log
-        self.state = BalanceState(  # views into the kernel's log: every update overwrites them in place
-            zmp_desired=log[kernel.L_ZMP_DESIRED:kernel.L_ZMP_DESIRED + 2],
-            zmp_measured=log[kernel.L_ZMP_MEASURED:kernel.L_ZMP_MEASURED + 2],
-            dcm_error=log[kernel.L_DCM_ERROR:kernel.L_DCM_ERROR + 2],
-            com_offset=log[kernel.L_COM_OFFSET:kernel.L_COM_OFFSET + 2],
-            ankle_offsets=log[kernel.L_ANKLE_OFFSETS:kernel.L_ANKLE_OFFSETS + 4].reshape(2, 2),
-            height_difference=0.0,
-            pelvis_turn=log[kernel.L_PELVIS_TURN:kernel.L_PELVIS_TURN + 2],
-            slope_offset=log[kernel.L_SLOPE_OFFSET:kernel.L_SLOPE_OFFSET + 2],
-            whole_body_offset=log[kernel.L_WHOLE_BODY_OFFSET:kernel.L_WHOLE_BODY_OFFSET + 2])
+        self.state = balance_state(log)
         # One tick on the legs' reference posture here, so that the first tick of the loop is no slower than the
         # others (numba's first call into a function is: about 0.5 ms).
         posture = np.concatenate([np.asarray(c.reference, dtype=float)[list(c.role_order)] for c in self.chains])
         vector = np.zeros(12)
         self.reset()
-        kernel.tick(params, chain, self._state, log, self._work, self._targets, 0, vector[:3], 0.0, vector[:2],
+        kernel.tick(self._params, chain, self._state, log, self._work, self._targets, 0, vector[:3], 0.0, vector[:2],
                     vector[:3], vector[:3], 0.0, 0.0, posture, vector[:6], vector[:6], vector[:2], vector[:3], posture,
                     math.nan)
         self.reset()
@@ -270,22 +241,22 @@ class Stabilizer:
     @property
     def _anchor(self) -> int:
         """The odometry's reference sole: 0 left, 1 right."""
-        return int(self._state[self._kernel.S_ANCHOR])
+        return int(self._state[S.anchor])
 
     @property
     def _feet(self) -> Array:
         """The odometry's ankles in world [m], (2, 2), a writable view of the state."""
-        return self._state[self._kernel.S_FEET:self._kernel.S_FEET + 4].reshape(2, 2)
+        return self._state[S.feet:S.feet + 4].reshape(2, 2)
 
     @property
     def _landing(self) -> Array:
         """The swinging feet's landing corrections in world [m], (2, 2), a view of the state."""
-        return self._state[self._kernel.S_LANDING:self._kernel.S_LANDING + 4].reshape(2, 2)
+        return self._state[S.landing:S.landing + 4].reshape(2, 2)
 
     @property
     def _landing_yaw(self) -> Array:
         """Their yaw corrections [rad], (2,), a view of the state."""
-        return self._state[self._kernel.S_LANDING_YAW:self._kernel.S_LANDING_YAW + 2]
+        return self._state[S.landing_yaw:S.landing_yaw + 2]
 
     def landing_correction(self, foot: str) -> Array:
         """The landing correction of ``foot`` (``"left"`` or ``"right"``) in world [m], (2,), a copy: where the
@@ -312,7 +283,7 @@ class Stabilizer:
 
     def reset(self) -> None:
         """Forget the filters and offsets (the next update starts from the reference)."""
-        self._kernel.initial_state(self._state, self._log)
+        initial_state(self._state, self._log)
         self.state.height_difference = 0.0
 
     def update(self, *, support: int, position_com_in_world: Array, yaw_pelvis_in_world: float, zmp_in_world: Array,
@@ -365,7 +336,7 @@ class Stabilizer:
                                 _number("measurement.yaw", measured_yaw))
         if status:
             self._raise(status, position_com_in_world, zmp_in_world, ankles_in_world, joint_angles, m, support)
-        self.state.height_difference = float(self._log[self._kernel.L_HEIGHT_DIFFERENCE])
+        self.state.height_difference = float(self._log[L.height_difference])
         return self._targets
 
     def _raise(self, status: int, com: Array, zmp: Array, ankles: tuple[Array, Array], angles: Array,
@@ -383,6 +354,35 @@ class Stabilizer:
                  m.joint_angles)[status - 1]
         raise InvalidParameterError(INPUT_NAMES[status - 1], f"{np.size(given)} values",
                                     f"{kernel.INPUT_SIZES[status - 1]} values")
+
+
+def chain_table(chains: Sequence[LegChain]) -> Array:
+    """The compiled leg's table (2, 6, 11) of both leg chains (:mod:`zmpwalk.stabilizer.leg`): per leg and chain
+    joint its axis and a point on it in the base frame at zero angles [m], its link's CoM [m] and mass [kg], and
+    its role-ordered column."""
+    chain = np.empty((2, 6, 11))
+    for leg, leg_chain in enumerate(chains):
+        chain[leg, :, 0:3] = leg_chain.axes
+        chain[leg, :, 3:6] = leg_chain.points
+        chain[leg, :, 6:9] = leg_chain.link_coms
+        chain[leg, :, 9] = leg_chain.link_masses
+        chain[leg, :, 10] = np.argsort(np.asarray(leg_chain.role_order))  # chain joint -> role column
+    return chain
+
+
+def balance_state(log: Array) -> BalanceState:
+    """The :class:`BalanceState` whose arrays are views into the compiled tick's ``log``: every update overwrites
+    them in place."""
+    return BalanceState(
+        zmp_desired=log[L.zmp_desired:L.zmp_desired + 2],
+        zmp_measured=log[L.zmp_measured:L.zmp_measured + 2],
+        dcm_error=log[L.dcm_error:L.dcm_error + 2],
+        com_offset=log[L.com_offset:L.com_offset + 2],
+        ankle_offsets=log[L.ankle_offsets:L.ankle_offsets + 4].reshape(2, 2),
+        height_difference=0.0,
+        pelvis_turn=log[L.pelvis_turn:L.pelvis_turn + 2],
+        slope_offset=log[L.slope_offset:L.slope_offset + 2],
+        whole_body_offset=log[L.whole_body_offset:L.whole_body_offset + 2])
 
 
 INPUT_NAMES = ("position_com_in_world", "zmp_in_world", "ankles_in_world[0]", "ankles_in_world[1]", "joint_angles",

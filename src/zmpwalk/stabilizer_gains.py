@@ -37,7 +37,8 @@ class StabilizerGains:
         velocity_filter: Time constant of the CoM velocity estimate's low-pass filter [s].
         landing_time_constant: How fast a swinging foot's aim moves to its planned place in world [s].
         landing_release: How fast that correction is released once the plan puts the foot down, unless its
-            sole has been bare for over ``balance_kernel.AIRBORNE_AIM`` (a late touchdown, still aiming) [s].
+            sole has been bare for over ``zmpwalk.stabilizer.landing.AIRBORNE_AIM`` (a late touchdown, still
+            aiming) [s].
         landing_limit: Largest landing correction [m].
         slope_time_constant: Low-pass filter of the floor normal measured under both soles in double support
             [s]; 0 turns the slope compensation off.
