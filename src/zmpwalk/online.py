@@ -94,7 +94,6 @@ from zmpwalk.patterns.polynomial import (
     check_pelvis,
     closing_command,
     first_sample_at,
-    hyperbolic_stages,
     infeasible_command,
     largest_command,
     plan_next_in_parts,
@@ -580,16 +579,11 @@ class OnlineWalker:
 
         The legs' reach is checked at every sample: by their inverse kinematics with ``joints``, else by the
         hip-to-ankle distance."""
-        hyperbolic = self._pelvis == "hyperbolic"
         stages, next_stance, next_boundary = yield from plan_next_in_parts(
-            self.robot, self._schedule, stance, boundary, command, reach=False,
-            pelvis="cubic" if hyperbolic else self._pelvis)
+            self.robot, self._schedule, stance, boundary, command, reach=False, pelvis=self._pelvis)
         if not stages:
             return None
         yield
-        if hyperbolic:  # the pendulum's pelvis
-            stages = yield from hyperbolic_stages(stages, boundary, self.robot)
-            next_boundary = stages[-1].end
         # the samples of these stages, split from the neighbours' exactly as the batch path splits them
         first_index = first_sample_at(stages[0].start, rate)
         stop_index = first_sample_at(next_boundary.time, rate)

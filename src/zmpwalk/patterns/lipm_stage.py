@@ -19,7 +19,7 @@ is the steady step of Fig. 3 laid on the stage:
 
 * along ``u``: coast ``d/2``; interval I (ZMP ``u_1``) ``t_1``; interval II (coast) ``t_2``;
   interval III (ZMP ``u_2``) ``t_3``; coast ``d/2``. The times are those of the steady step of
-  this stage's stride, step time and double support (:func:`~zmpwalk.patterns.hyperbolic.solve_step`,
+  this stage's stride, step time and double support (:func:`~zmpwalk.patterns.pendulum.solve_step`,
   Eq. 11).
 * across ``w``: coast ``d/2``; ZMP ``w_1`` over the first half of the single support, ``w_2`` over
   the second; coast ``d/2``. In steady walking ``w_1 = w_2 = y_ZMP`` (Eq. 10: one lateral ZMP).
@@ -50,7 +50,7 @@ swing's steady state has (Eq. 15 solves the paper's version of this with two ZMP
 state). The closing swing holds one ZMP per axis over its single support that ends with ``xi`` on
 the middle of the ankles: the state from which the pendulum can come to rest there; the *settle*
 stage (both feet down) holds two ZMPs, one per half, that bring it to rest exactly (the full state,
-solved as a 2x2 system: :func:`~zmpwalk.patterns.hyperbolic.solve_zmps`).
+solved as a 2x2 system: :func:`~zmpwalk.patterns.pendulum.solve_zmps`).
 
 **Feasibility.** The ZMP is the pattern's own input here, so it is checked, not assumed: at every
 piece boundary (the ZMP is constant or moves with the body on a straight line between them, so the
@@ -70,7 +70,7 @@ from numpy.typing import NDArray
 
 from zmpwalk.errors import InfeasiblePatternError, InvalidParameterError
 from zmpwalk.footsteps import Pose2D, StagePlan, foot_corners
-from zmpwalk.patterns.hyperbolic import COAST, Piece, propagate, run_pieces, solve_step, solve_zmps
+from zmpwalk.patterns.pendulum import COAST, Piece, propagate, run_pieces, solve_step, solve_zmps
 from zmpwalk.patterns.result import PHASE_TIME_TOL
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.slices import ALONE, Parts, whole
