@@ -15,7 +15,7 @@
 Behaviour:
 
 * The walker starts standing in the ready posture. The first command starts a
-  walk (with the start stage of :func:`zmpwalk.patterns.polynomial.plan_next`).
+  walk (with the start stage of :func:`zmpwalk.patterns.planning.plan_next`).
 * :meth:`OnlineWalker.command` gives the command that runs after the step now under way, replacing one
   given before it started. It only stores the command (microseconds). Its whole check, the step and the
   stop it would end with, every sample at the control rate (the pattern, the legs' angles and rates, the
@@ -326,7 +326,7 @@ class OnlineWalker:
 
         It names first the parameter that cannot be met at any setting of the others, reach before step time:
         where the legs are the cause, or the check refused the step time (or another parameter) but the stride
-        fits at no step time (:func:`~zmpwalk.patterns.polynomial.step_time_rejection`), the stride, with the
+        fits at no step time (:func:`~zmpwalk.patterns.stride_search.step_time_rejection`), the stride, with the
         largest that fits, searched by bisection the first time this is read (tens of milliseconds): read it
         outside the hard real-time part of the loop, e.g. when :attr:`checking` has become None without the
         command being :attr:`queued`.

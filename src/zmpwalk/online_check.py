@@ -137,7 +137,7 @@ READY_SECONDS = 4.5  # [s] a plan's rows: from standstill the start stage, up to
 class RowBuffers:
     """Row buffers reused from plan to plan. A plan's rows freed in a tick (at every step change) made the C
     allocator give the top of its heap back to the system: 0.1-0.3 ms, measured; given back here instead, a
-    buffer is kept for a later check (each at most once: :meth:`OnlineWalker._release`)."""
+    buffer is kept for a later check (each at most once: :meth:`zmpwalk.online.OnlineWalker._release`)."""
 
     def __init__(self, width: int, ready: int = 0, rows: int = 0) -> None:
         """``ready`` buffers of ``rows`` rows are made now and written once: the system maps a page at its first

@@ -1,6 +1,6 @@
 """The hyperbolic (linear inverted pendulum) pelvis of one stage: Lim et al.'s pattern, online, in 2-D.
 
-The online walker plans one *stage* (one swing, see :mod:`zmpwalk.patterns.polynomial`) at a time
+The online walker plans one *stage* (one swing, see :mod:`zmpwalk.patterns.stages`) at a time
 from the pelvis state it inherits. With the pelvis (the centre of mass) at constant height ``z_b``
 the ZMP equation of Lim et al. (Eq. 4) holds for each horizontal axis on its own:
 
@@ -63,6 +63,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -307,6 +308,59 @@ def axis_at_in_parts(a: float, axis_starts: Array, position: Array, velocity: Ar
     v = np.where(coasting, v0, hyper_v)
     acceleration = np.where(coasting, 0.0, a * a * (hyper_x - c))  # Eq. 4
     return x, v, acceleration
+
+
+@dataclass(frozen=True)
+class LipmColumns:
+    """The hyperbolic pelvises of a table's stages as column arrays, so that many samples evaluate in one pass.
+
+    Attributes:
+        yaw: Each stage's frame heading in world [rad], 0 where a stage has none.
+        axes: For the ``along`` then the ``across`` axis, the pieces' starts [s], positions [m], velocities [m/s]
+            and ZMPs [m] (NaN: coasting), each shape (stages, :data:`PIECES`), NaN where a stage has none.
+    """
+
+    yaw: Array  # [rad]
+    axes: list[list[Array]]
+
+    @classmethod
+    def of(cls, pelvises: Sequence[LipmPelvis | None]) -> LipmColumns:
+        """The columns of ``pelvises`` (None: a stage without one)."""
+        unused = np.full(PIECES, np.nan)
+        yaw = np.array([p.yaw if p else 0.0 for p in pelvises])
+        axes = [
+            [np.array([getattr(getattr(p, axis), name) if p else unused for p in pelvises], dtype=float)
+             for name in ("starts", "position", "velocity", "zmp")]
+            for axis in ("along", "across")]
+        return cls(yaw, axes)
+
+    def pelvis_at_in_parts(self, hyperbolic: NDArray[np.bool_], k: NDArray[np.intp], elapsed: Array,
+                           robot: RobotModel, curves_xy: tuple[Array, ...]) -> Parts[tuple[Array, ...]]:
+        """Pelvis x, y, their rates and accelerations in world: the hyperbolic pelvis where ``hyperbolic`` (per
+        sample), else ``curves_xy``. In parts (each axis, then the turn to world).
+
+        Args:
+            hyperbolic: Whether each sample's stage has a hyperbolic pelvis, shape (n,).
+            k: Each sample's stage, shape (n,).
+            elapsed: Each sample's time from its stage start [s], shape (n,).
+            robot: The robot (``pendulum_length`` is ``z_b``).
+            curves_xy: The pelvis of the curves: x, y [m], their rates [m/s] and accelerations [m/s^2].
+        """
+        a = math.sqrt(robot.gravity / robot.pendulum_length)
+        axes = []
+        for starts, position, velocity, zmp in self.axes:
+            sample_starts, sample_positions = starts[k], position[k]  # each sample's stage's pieces, (n, PIECES)
+            yield
+            sample_velocities, sample_zmps = velocity[k], zmp[k]
+            yield
+            axes.append((yield from axis_at_in_parts(a, sample_starts, sample_positions, sample_velocities,
+                                                     sample_zmps, elapsed)))
+            yield
+        (u, du, ddu), (w, dw, ddw) = axes
+        c, s = np.cos(self.yaw[k]), np.sin(self.yaw[k])  # the supporting foot's frame to world
+        world = (u * c - w * s, u * s + w * c, du * c - dw * s, du * s + dw * c, ddu * c - ddw * s,
+                 ddu * s + ddw * c)
+        return tuple(np.where(hyperbolic, value, other) for value, other in zip(world, curves_xy, strict=True))
 
 
 def _zmp_margin(plan: StagePlan, along: LipmAxis, across: LipmAxis, robot: RobotModel) -> Parts[float]:

@@ -15,9 +15,10 @@ The models:
 * ``"hyperbolic"``: the linear inverted pendulum under a piecewise-constant ZMP, per stage
   (:class:`~zmpwalk.patterns.lipm_pelvis.HyperbolicPelvis`).
 
-The preview-control pattern (:mod:`zmpwalk.patterns.preview`) is not one: it tracks a ZMP reference over the whole
-walk with a look-ahead of :data:`~zmpwalk.patterns.preview.PREVIEW_TIME`, so its pelvis over a stage depends on the
-stages after it, not on the boundary state alone; it runs on the finished footsteps of a whole walk.
+The preview-control pattern (:mod:`zmpwalk.patterns.preview`) is not one: its pelvis is a discrete-time servo
+tracking a ZMP reference with a look-ahead of :data:`~zmpwalk.patterns.preview.PREVIEW_TIME` (longer than a step),
+so the pelvis over a stage depends on the stages after it, not on the state the stage starts from, and has no
+closed form to evaluate at any time; it runs on the sampled pattern of a whole walk.
 """
 
 from __future__ import annotations
