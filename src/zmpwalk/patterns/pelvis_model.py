@@ -24,7 +24,7 @@ closed form to evaluate at any time; it runs on the sampled pattern of a whole w
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Protocol
+from typing import Protocol, runtime_checkable
 
 from zmpwalk.errors import InvalidParameterError
 from zmpwalk.footsteps import StagePlan
@@ -34,12 +34,15 @@ from zmpwalk.robots.model import RobotModel
 from zmpwalk.slices import Parts
 
 
+@runtime_checkable
 class PelvisModel(Protocol):
-    """A pelvis model of the stage engine."""
+    """A pelvis model of the stage engine: the named ones (:func:`pelvis_model`), or any object with these
+    members, given as ``pelvis`` to :func:`~zmpwalk.patterns.planning.plan_walk` or
+    :func:`~zmpwalk.patterns.polynomial.generate`."""
 
     @property
     def name(self) -> str:
-        """The pelvis option that names it (one of :data:`PELVIS_CURVES`)."""
+        """Its name (for the named ones, the pelvis option: one of :data:`PELVIS_CURVES`)."""
         ...
 
     @property
@@ -63,7 +66,7 @@ PELVIS_CURVES = ("cubic", "quintic", "hyperbolic")
 _MODELS: dict[str, PelvisModel] = {"cubic": CUBIC, "quintic": QUINTIC, "hyperbolic": HYPERBOLIC}
 
 
-def check_pelvis(pelvis: str) -> str:
+def check_pelvis(pelvis: object) -> str:
     """``pelvis`` if it is one of :data:`PELVIS_CURVES`.
 
     Raises:
@@ -74,10 +77,12 @@ def check_pelvis(pelvis: str) -> str:
     return pelvis
 
 
-def pelvis_model(pelvis: str) -> PelvisModel:
-    """The pelvis model named ``pelvis`` (one of :data:`PELVIS_CURVES`).
+def pelvis_model(pelvis: str | PelvisModel) -> PelvisModel:
+    """The pelvis model named ``pelvis`` (one of :data:`PELVIS_CURVES`), or ``pelvis`` itself where it is a model.
 
     Raises:
-        InvalidParameterError: Any other name (the message lists them).
+        InvalidParameterError: Any other value (the message lists the names).
     """
+    if not isinstance(pelvis, str) and isinstance(pelvis, PelvisModel):
+        return pelvis
     return _MODELS[check_pelvis(pelvis)]

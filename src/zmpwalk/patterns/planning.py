@@ -20,7 +20,7 @@ from zmpwalk.errors import UnreachableError, ZmpwalkError
 from zmpwalk.footsteps import LEFT, StagePlan, Stance, grounded_stage, plan_command
 from zmpwalk.kinematics import check_leg_reach
 from zmpwalk.patterns.evaluation import StageTable, evaluate
-from zmpwalk.patterns.pelvis_model import pelvis_model
+from zmpwalk.patterns.pelvis_model import PelvisModel, pelvis_model
 from zmpwalk.patterns.stages import Boundary, Stage, standing_stage
 from zmpwalk.patterns.stride_search import STRIDE_CAUSES, infeasible_command, step_time_rejection
 from zmpwalk.robots.model import RobotModel
@@ -55,7 +55,7 @@ def check_reach(stages: Sequence[Stage], robot: RobotModel) -> None:
 
 def plan_next_in_parts(
     robot: RobotModel, schedule: Schedule, stance: Stance, boundary: Boundary, command: StepCommand,
-    reach: bool = True, pelvis: str = "cubic",
+    reach: bool = True, pelvis: str | PelvisModel = "cubic",
 ) -> Parts[tuple[list[Stage], Stance, Boundary]]:
     """Stages of one command from a stance and boundary state; nothing is changed on error.
     In parts (the footsteps, then each stage; :mod:`zmpwalk.slices`); :func:`plan_next` runs it whole.
@@ -70,7 +70,8 @@ def plan_next_in_parts(
         reach: Check the legs' reach here (a caller that checks many commands at
             once with :func:`check_reach` passes False).
         pelvis: ``"cubic"`` (the paper's curves), ``"quintic"`` (jerk-continuous) or ``"hyperbolic"``
-            (the pendulum's own motion under a piecewise-constant ZMP: :mod:`zmpwalk.patterns.lipm_stage`).
+            (the pendulum's own motion under a piecewise-constant ZMP: :mod:`zmpwalk.patterns.lipm_stage`), or a
+            :class:`~zmpwalk.patterns.pelvis_model.PelvisModel` of one's own.
 
     Raises:
         ZmpwalkError: The command is infeasible for this robot (reach, overlap, timing, and for the
@@ -110,7 +111,7 @@ def plan_walk(
     commands: Sequence[StepCommand],
     schedule: Schedule | None = None,
     labels: Sequence[str] | None = None,
-    pelvis: str = "cubic",
+    pelvis: str | PelvisModel = "cubic",
 ) -> tuple[list[Stage], Stance]:
     """Stages of a whole walk from the ready posture, closed by a stop and a standing stage.
 
@@ -124,7 +125,8 @@ def plan_walk(
         schedule: Parameter tables.
         labels: How an error names each command (default ``step N``, 1-based).
         pelvis: ``"cubic"`` (the paper's curves) or ``"quintic"`` (jerk-continuous, zero acceleration at
-            every curve's ends: the cart-table ZMP is continuous; the parameters keep their meaning).
+            every curve's ends: the cart-table ZMP is continuous; the parameters keep their meaning), or another
+            pelvis model (:func:`plan_next`).
 
     Raises:
         ZmpwalkError: With the command's label in front, for the first command that fails.
@@ -161,7 +163,7 @@ class _Walk:
 
     robot: RobotModel
     schedule: Schedule
-    pelvis: str
+    pelvis: str | PelvisModel
     sequence: list[StepCommand]  # the commands and the closing stop
     labels: Sequence[str] | None
     given: int  # commands given (the closing stop follows them)

@@ -25,8 +25,8 @@ from zmpwalk.patterns.evaluation import evaluate as evaluate
 from zmpwalk.patterns.evaluation import side_shift_profile as side_shift_profile  # docs/equations.md
 from zmpwalk.patterns.lipm_pelvis import hyperbolic_stages as hyperbolic_stages
 from zmpwalk.patterns.pelvis_model import PELVIS_CURVES as PELVIS_CURVES
+from zmpwalk.patterns.pelvis_model import PelvisModel, pelvis_model
 from zmpwalk.patterns.pelvis_model import check_pelvis as check_pelvis
-from zmpwalk.patterns.pelvis_model import pelvis_model
 from zmpwalk.patterns.planning import CHUNK_STAGES as CHUNK_STAGES
 from zmpwalk.patterns.planning import REACH_CHECK_POINTS as REACH_CHECK_POINTS
 from zmpwalk.patterns.planning import check_reach as check_reach
@@ -66,7 +66,7 @@ def generate(
     rate: float = 100.0,
     schedule: Schedule | None = None,
     labels: Sequence[str] | None = None,
-    pelvis: str = "cubic",
+    pelvis: str | PelvisModel = "cubic",
 ) -> WalkingPattern:
     """The HUBO walking pattern of a command sequence, sampled at ``rate`` [Hz].
 
@@ -76,7 +76,7 @@ def generate(
         rate: Samples per second (HUBO's reference rate is 100 Hz).
         schedule: Parameter tables; Tables 2-3 of the paper by default.
         labels: How an error names each command (default ``step N``).
-        pelvis: ``"cubic"`` or ``"quintic"`` (:func:`plan_walk`).
+        pelvis: ``"cubic"`` or ``"quintic"``, or another pelvis model (:func:`plan_walk`).
 
     Returns:
         The pattern from the ready posture at t = 0 to standing after the last step.
@@ -93,7 +93,7 @@ def generate_chunks(
     schedule: Schedule | None = None,
     labels: Sequence[str] | None = None,
     chunk_stages: int = CHUNK_STAGES,
-    pelvis: str = "cubic",
+    pelvis: str | PelvisModel = "cubic",
 ) -> Iterator[WalkingPattern]:
     """The pattern of :func:`generate` in consecutive pieces, for walks too long to hold at once.
 
@@ -112,8 +112,9 @@ def generate_chunks(
     return _chunks(stages, robot, rate, chunk_stages, generator_name(pelvis))
 
 
-def generator_name(pelvis: str) -> str:
-    """The name a pattern of these pelvis curves carries: ``"hyperbolic"`` for the pendulum's, else ``"polynomial"``."""
+def generator_name(pelvis: str | PelvisModel) -> str:
+    """The name a pattern of this pelvis model carries: ``"hyperbolic"`` for the pendulum's, ``"polynomial"`` for
+    the curves'."""
     return pelvis_model(pelvis).generator
 
 
