@@ -173,7 +173,7 @@ def test_a_whole_walk_names_an_earlier_step_beyond_reach_before_a_later_steps_st
 def test_the_closing_stop_is_named_after_the_step_it_follows(hubo):
     """The stop a walk gets after its last command is not a numbered step of the user's: it is named after the
     last one (labels as a steps file gives them, or the default)."""
-    from zmpwalk.patterns.polynomial import _Walk
+    from zmpwalk.patterns.planning import _Walk
     from zmpwalk.schedule import Schedule
 
     commands = [StepCommand(0.8, 0.1)] * 3

@@ -165,7 +165,7 @@ def grounded_stage(stance: Stance, support: int, step_time: float, parameters: S
     ``"start"`` begins a walk from standstill; ``"settle"`` ends one (the robot
     comes to rest in the middle of the feet). It lasts
     ``(GROUNDED_STRETCH + (1 - d1) / 2) * step_time``: one slow sway cubic to or
-    from rest and one regular cubic (see :func:`zmpwalk.patterns.polynomial.sway_times`).
+    from rest and one regular cubic (see :func:`zmpwalk.patterns.stages.sway_times`).
     """
     still = stance.pose(-support)
     duration = (GROUNDED_STRETCH + (1.0 - parameters.d1) / 2.0) * step_time

@@ -15,7 +15,7 @@
 Behaviour:
 
 * The walker starts standing in the ready posture. The first command starts a
-  walk (with the start stage of :func:`zmpwalk.patterns.polynomial.plan_next`).
+  walk (with the start stage of :func:`zmpwalk.patterns.planning.plan_next`).
 * :meth:`OnlineWalker.command` gives the command that runs after the step now under way, replacing one
   given before it started. It only stores the command (microseconds). Its whole check, the step and the
   stop it would end with, every sample at the control rate (the pattern, the legs' angles and rates, the
@@ -65,87 +65,50 @@ from __future__ import annotations
 import math
 import numbers
 import time
-from array import array
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk.commands import StepCommand
-from zmpwalk.errors import (
-    InfeasibleCommandError,
-    InvalidParameterError,
-    ZmpwalkError,
-)
+from zmpwalk.errors import InvalidParameterError, ZmpwalkError
 from zmpwalk.footsteps import Stance
-from zmpwalk.kinematics import (
-    Leg,
-    check_joint_limits,
-    check_leg_reach,
-    joint_trajectory,
-    joint_trajectory_in_parts,
-    leg_ik_scalar,
+from zmpwalk.online_check import (
+    READY_BUFFERS,
+    READY_SECONDS,
+    ROW_JOINT_RATES,
+    ROW_JOINTS,
+    ROW_LEFT,
+    ROW_PELVIS,
+    ROW_RIGHT,
+    ROW_WIDTH,
+    ROW_WIDTH_WITH_JOINTS,
+    ROW_ZMP,
+    SLICE_ROWS,
+    CheckedPlan,
+    CheckJob,
+    CommandCheck,
+    Rejection,
+    RowBuffers,
+    bare_error,
+    online_pelvis,
+    row_scalars,
 )
-from zmpwalk.patterns.evaluation import Samples, StageTable, evaluate_in_parts
-from zmpwalk.patterns.polynomial import (
-    STRIDE_CAUSES,
-    Boundary,
-    Stage,
-    check_pelvis,
-    closing_command,
-    first_sample_at,
-    hyperbolic_stages,
-    infeasible_command,
-    largest_command,
-    plan_next_in_parts,
-    step_time_rejection,
-)
+from zmpwalk.patterns.polynomial import first_sample_at
 from zmpwalk.patterns.result import SUPPORT_NAMES, check_rate
+from zmpwalk.patterns.stages import Boundary
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
-from zmpwalk.slices import ALONE, UNFINISHED, Parts, run_for, run_to_end
+from zmpwalk.slices import UNFINISHED, run_for, run_to_end
 
 Array = NDArray[np.float64]
 
-# Columns of a sampled row.
-_PELVIS, _PELVIS_YAW = slice(0, 3), 3
-_LEFT, _LEFT_YAW = slice(4, 7), 7
-_RIGHT, _RIGHT_YAW = slice(8, 11), 11
-_ZMP, _SUPPORT = slice(12, 14), 14
-_JOINTS, _JOINT_RATES = slice(15, 27), slice(27, 39)
-_WIDTH = 15
-_WIDTH_WITH_JOINTS = 39
-SLICE_ROWS = 400  # samples per block of a command's check (each block's pattern and legs in parts of tens of us)
 START_DELAY = 0.6  # [s] a walk commanded from standstill starts this much later (its check is done by then)
 
 
 def start_delay_ticks(rate: float) -> int:
     """:data:`START_DELAY` in whole ticks at ``rate`` [Hz] (rounded up)."""
     return math.ceil(START_DELAY * rate - 1e-9)
-HINT_RATE = 100.0  # [Hz] sampling of the search for the largest stride that fits, in a rejection
-HINT_CONFIRMATIONS = 5  # tries at the control rate, each HINT_SHRINK smaller
-HINT_SHRINK = 0.98
-
-
-ONLINE_GENERATORS = ("polynomial", "hyperbolic")
-
-
-def online_pelvis(pelvis: str, generator: str) -> str:
-    """The pelvis curves of :func:`~zmpwalk.patterns.polynomial.plan_next` for a generator and pelvis option.
-
-    Raises:
-        InvalidParameterError: An unknown name, or a pelvis curve with the hyperbolic generator.
-    """
-    if generator not in ONLINE_GENERATORS:
-        raise InvalidParameterError("generator", generator, f"one of {', '.join(ONLINE_GENERATORS)}")
-    if generator == "hyperbolic":
-        if pelvis != "cubic":
-            raise InvalidParameterError("pelvis", pelvis, "the default: the hyperbolic generator's pelvis is the "
-                                        "pendulum's own motion")
-        return "hyperbolic"
-    if check_pelvis(pelvis) == "hyperbolic":
-        raise InvalidParameterError("pelvis", pelvis, "cubic or quintic (generator=\"hyperbolic\" for the other)")
-    return pelvis
 
 
 @dataclass(slots=True)  # not frozen: a frozen dataclass's __init__ costs 1 us more, a third of a tick
@@ -180,83 +143,7 @@ class WalkingSample:
     joint_velocities: Array | None = None
 
 
-@dataclass
-class _Plan:
-    command: StepCommand
-    stages: list[Stage]
-    stance: Stance
-    boundary: Boundary
-    rows: Array
-    first_index: int
-    closing: _Plan | None = None  # the automatic stop after this plan, planned and checked with it
-    standing: Array | None = None  # the row of standing still after it, where it ends at rest
-    scalars: Scalars = field(default_factory=lambda: _scalars(np.empty((0, _WIDTH))))  # per row (:func:`_scalars`)
-
-
 _SUPPORT_OF_CODE = {float(code): name for code, name in enumerate(SUPPORT_NAMES)}
-Scalars = tuple["array[float]", "array[float]", "array[float]", "array[float]"]
-_SCALAR_COLUMNS = (_SUPPORT, _PELVIS_YAW, _LEFT_YAW, _RIGHT_YAW)
-
-
-def _scalars(rows: Array) -> Scalars:
-    """The rows' support codes and pelvis, left and right yaws, each column an ``array("d")``: a tick reads Python
-    floats from it without numpy's scalar conversion (:data:`_SUPPORT_OF_CODE` names the support), and a plan
-    dropped in a tick frees four buffers (lists of Python floats, one per value, took 0.3 ms to free)."""
-    support, pelvis, left, right = (array("d", np.ascontiguousarray(rows[:, column]).tobytes())
-                                    for column in _SCALAR_COLUMNS)
-    return support, pelvis, left, right
-
-
-@dataclass
-class _Job:
-    """A command under check: where it starts and its planning, in parts run a few per tick."""
-
-    command: StepCommand
-    stance: Stance
-    boundary: Boundary
-    start: int  # index of the tick at which its step begins
-    planning: Parts[_Plan | None]
-    origin: tuple[Stance, Boundary]  # the walker's end of plan when given: the job is stale once it changes
-    expected: int  # parts its check is expected to take
-    given: int  # index of the tick at which it was commanded
-    buffers: list[Array]  # the rows its planning took (:class:`_RowBuffers`), given back if it does not end a plan
-    parts: int = 0  # parts run so far
-
-
-POOL_BUFFERS = 8  # row buffers kept for the next checks (a walker holds at most six plans' at a time)
-READY_BUFFERS = 6  # of them made (and their pages touched) with the walker, each for READY_SECONDS of rows
-READY_SECONDS = 4.5  # [s] a plan's rows: from standstill the start stage, up to three stages and the stop and
-# settle after them fit in 4.5 step times; 4.5 s covers every step of up to 1 s (longer ones take new buffers)
-
-
-class _RowBuffers:
-    """Row buffers reused from plan to plan. A plan's rows freed in a tick (at every step change) made the C
-    allocator give the top of its heap back to the system: 0.1-0.3 ms, measured; given back here instead, a
-    buffer is kept for a later check (each at most once: :meth:`OnlineWalker._release`)."""
-
-    def __init__(self, width: int, ready: int = 0, rows: int = 0) -> None:
-        """``ready`` buffers of ``rows`` rows are made now and written once: the system maps a page at its first
-        write (a page fault, 1-10 us each on a virtual machine: a block's first fill cost up to 0.4 ms)."""
-        self.width = width
-        self.free: list[Array] = [np.full((rows, width), np.nan) for _ in range(ready)]
-
-    def take(self, count: int) -> Array:
-        """``count`` rows: a view of the smallest kept buffer that holds them, else of a new one (a quarter
-        larger, for a longer step later)."""
-        best = -1
-        for number, buffer in enumerate(self.free):
-            if len(buffer) >= count and (best < 0 or len(buffer) < len(self.free[best])):
-                best = number
-        buffer = self.free.pop(best) if best >= 0 else np.empty((count + count // 4 + 1, self.width))
-        return buffer[:count]
-
-    def give(self, rows: Array) -> None:
-        """Keep the buffer of ``rows`` (a view :meth:`take` gave, or an array of its own) for a later check."""
-        buffer: Array = rows if rows.base is None else rows.base
-        if len(self.free) < POOL_BUFFERS and buffer.ndim == 2 and buffer.shape[1] == self.width:
-            self.free.append(buffer)
-
-
 _clock = time.perf_counter  # [s] the clock of the budget (a test replaces it with one that counts parts)
 WORK_BUDGET = 50e-6  # [s] a tick runs parts of a check while the next one is expected to end within this
 WORK_FRACTION = 0.01  # [-] ... or within this fraction of the control period, where that is longer (below 200 Hz)
@@ -270,18 +157,6 @@ def work_budget(rate: float) -> float:
     return max(WORK_BUDGET, WORK_FRACTION / rate)
 
 
-def _bare(error: ZmpwalkError) -> ZmpwalkError:
-    """``error`` without its traceback and the errors it was raised in handling, to be kept as the rejection: a
-    traceback holds the frames of the failed check's generators, their arrays with them, until it is freed
-    (in the next command(), inside the loop)."""
-    cause: BaseException | None = error
-    while cause is not None:
-        following = cause.__cause__ or cause.__context__
-        cause.__traceback__ = cause.__cause__ = cause.__context__ = None
-        cause = following
-    return error
-
-
 def _checked_budget(budget: object, rate: float) -> float:
     """``budget`` [s] as a float: a positive number below the control period at ``rate`` [Hz].
 
@@ -291,17 +166,6 @@ def _checked_budget(budget: object, rate: float) -> float:
     if isinstance(budget, bool) or not isinstance(budget, numbers.Real) or not 0.0 < float(budget) < 1.0 / rate:
         raise InvalidParameterError("budget", budget, f"a time in (0, {1.0 / rate:g}) s, the control period")
     return float(budget)
-
-
-@dataclass
-class _Rejection:
-    """A command refused by its check, where it was to start, and whether the error is the one to give."""
-
-    command: StepCommand
-    error: ZmpwalkError
-    stance: Stance
-    boundary: Boundary
-    named: bool = False  # the parameter to fix is named (:meth:`OnlineWalker._rejected` has run)
 
 
 class OnlineWalker:
@@ -339,18 +203,19 @@ class OnlineWalker:
         self.robot = robot
         self.rate = float(rate)
         self.joints = bool(joints)
-        self._width = _WIDTH_WITH_JOINTS if self.joints else _WIDTH
+        self._width = ROW_WIDTH_WITH_JOINTS if self.joints else ROW_WIDTH
         self._schedule = schedule or Schedule.hubo()
         self._index = 0
         self._stance = Stance.ready(robot)
         self._boundary = Boundary(0.0)
-        self._current: _Plan | None = None
-        self._pending: _Plan | None = None
-        self._job: _Job | None = None
-        self._rejection: _Rejection | None = None
+        self._current: CheckedPlan | None = None
+        self._pending: CheckedPlan | None = None
+        self._job: CheckJob | None = None
+        self._rejection: Rejection | None = None
         self._check_parts = 0  # parts the last completed check took
-        self._buffers = _RowBuffers(self._width, READY_BUFFERS, math.ceil(READY_SECONDS * self.rate))
-        self._set_standing(self._standing_row(self._stance))
+        self._buffers = RowBuffers(self._width, READY_BUFFERS, math.ceil(READY_SECONDS * self.rate))
+        self._check = CommandCheck(robot, self._schedule, self._pelvis, self.joints, self._buffers)
+        self._set_standing(self._check.standing_row(self._stance))
 
     @property
     def time(self) -> float:
@@ -424,9 +289,9 @@ class OnlineWalker:
             boundary = self._rest_start(boundary, given + delay)
         if wait:
             try:
-                plan = run_to_end(self._checked(command, stance, boundary, self.rate))
+                plan = run_to_end(self._check.checked(command, stance, boundary, self.rate))
             except ZmpwalkError as error:
-                raise self._rejected(command, stance, boundary, error) from None
+                raise self._check.rejected(command, stance, boundary, error, self.rate) from None
             self._drop_job()  # a command given now supersedes one still being checked
             self._rejection = None
             dropped, self._pending = self._pending, plan  # None: a stop while standing
@@ -436,8 +301,8 @@ class OnlineWalker:
         start = first_sample_at(boundary.time, self.rate)
         self._drop_job()
         buffers: list[Array] = []
-        self._job = _Job(command, stance, boundary, start,
-                         self._checked(command, stance, boundary, self.rate, buffers), origin, expected, given,
+        self._job = CheckJob(command, stance, boundary, start,
+                         self._check.checked(command, stance, boundary, self.rate, buffers), origin, expected, given,
                          buffers)
 
     def _rest_start(self, rest: Boundary, earliest: int) -> Boundary:
@@ -461,7 +326,7 @@ class OnlineWalker:
 
         It names first the parameter that cannot be met at any setting of the others, reach before step time:
         where the legs are the cause, or the check refused the step time (or another parameter) but the stride
-        fits at no step time (:func:`~zmpwalk.patterns.polynomial.step_time_rejection`), the stride, with the
+        fits at no step time (:func:`~zmpwalk.patterns.stride_search.step_time_rejection`), the stride, with the
         largest that fits, searched by bisection the first time this is read (tens of milliseconds): read it
         outside the hard real-time part of the loop, e.g. when :attr:`checking` has become None without the
         command being :attr:`queued`.
@@ -470,8 +335,8 @@ class OnlineWalker:
             return None
         rejection = self._rejection
         if not rejection.named:
-            rejection.error = _bare(self._rejected(rejection.command, rejection.stance, rejection.boundary,
-                                                   rejection.error))
+            rejection.error = bare_error(self._check.rejected(rejection.command, rejection.stance,
+                                                              rejection.boundary, rejection.error, self.rate))
             rejection.named = True
         return rejection.error
 
@@ -500,14 +365,14 @@ class OnlineWalker:
             job.parts += parts
         except ZmpwalkError as error:
             self._drop_job()
-            self._rejection = _Rejection(job.command, _bare(error), job.stance, job.boundary)
+            self._rejection = Rejection(job.command, bare_error(error), job.stance, job.boundary)
             return
         if plan is UNFINISHED:
             return
         self._check_parts = job.parts
         self._job = None  # its buffers are the plan's rows now
         self._rejection = None
-        dropped, self._pending = self._pending, plan if isinstance(plan, _Plan) else None
+        dropped, self._pending = self._pending, plan if isinstance(plan, CheckedPlan) else None
         self._release(dropped)
 
     def _drop_job(self) -> None:
@@ -517,7 +382,7 @@ class OnlineWalker:
                 self._buffers.give(rows)
             self._job = None
 
-    def _release(self, *plans: _Plan | None) -> None:
+    def _release(self, *plans: CheckedPlan | None) -> None:
         """Keep the rows of ``plans`` and their stops for later checks, where the walker holds them no more (as
         the step under way, the queued command, or their stops); each once, and a released plan keeps no rows."""
         held = [plan for plan in (self._current, self._pending) if plan is not None]
@@ -527,107 +392,6 @@ class OnlineWalker:
                 if part is not None and len(part.rows) and not any(part is other for other in held):
                     self._buffers.give(part.rows)
                     part.rows = part.rows[:0]
-
-    def _checked(self, command: StepCommand, stance: Stance, boundary: Boundary, rate: float,
-                 buffers: list[Array] | None = None) -> Parts[_Plan | None]:
-        """Plan a command and the stop it leads to when no other follows, sampled (and the legs solved) at
-        ``rate``, yielding between slices: planned and checked together, so that no accepted command can make
-        a later tick fail, and no tick plans. Returns None for a stop while standing.
-
-        Args:
-            buffers: For :meth:`command`'s check, in slices: the rows are taken from the walker's buffers
-                (:class:`_RowBuffers`) and listed here. None: in one pass, in rows of their own."""
-        plan = yield from self._plan(command, stance, boundary, rate, buffers)
-        if plan is not None and not command.stop:
-            yield
-            try:
-                plan.closing = yield from self._plan(closing_command(command), plan.stance, plan.boundary, rate,
-                                                     buffers)
-            except ZmpwalkError as error:
-                raise error.in_context("the closing step this command would end with (when no other follows)") \
-                    from None
-        return plan
-
-    def _rejected(self, command: StepCommand, stance: Stance, boundary: Boundary,
-                  cause: ZmpwalkError) -> ZmpwalkError:
-        """The rejection of a command its check refused with ``cause``, naming first the parameter that cannot
-        be met at any setting of the others (reach before step time): the largest stride that fits where the
-        stride is the cause, or fits at no step time (searched at :data:`HINT_RATE` at most, then confirmed, or
-        reduced, at the control rate); else ``cause``."""
-        coarse = min(self.rate, HINT_RATE)
-
-        def feasible(candidate: StepCommand) -> object:
-            return run_to_end(self._checked(candidate, stance, boundary, coarse))
-
-        if isinstance(cause, STRIDE_CAUSES):
-            error: ZmpwalkError = infeasible_command(command, cause, feasible)
-        else:
-            error = step_time_rejection(command, cause, feasible)
-        for _ in range(HINT_CONFIRMATIONS):
-            if not isinstance(error, InfeasibleCommandError) or not error.largest or coarse == self.rate:
-                break
-            try:
-                run_to_end(self._checked(largest_command(command, error), stance, boundary, self.rate))
-                break
-            except ZmpwalkError:
-                error = error.with_largest({k: v * HINT_SHRINK for k, v in error.largest.items()})
-        return error
-
-    def _plan(self, command: StepCommand, stance: Stance, boundary: Boundary, rate: float,
-              buffers: list[Array] | None) -> Parts[_Plan | None]:
-        """Plan, sample (and solve the legs of) one command from a stance at ``rate`` [Hz], yielding after the
-        plan and between the parts of every :data:`SLICE_ROWS` samples; None for a stop while standing.
-
-        The legs' reach is checked at every sample: by their inverse kinematics with ``joints``, else by the
-        hip-to-ankle distance."""
-        hyperbolic = self._pelvis == "hyperbolic"
-        stages, next_stance, next_boundary = yield from plan_next_in_parts(
-            self.robot, self._schedule, stance, boundary, command, reach=False,
-            pelvis="cubic" if hyperbolic else self._pelvis)
-        if not stages:
-            return None
-        yield
-        if hyperbolic:  # the pendulum's pelvis
-            stages = yield from hyperbolic_stages(stages, boundary, self.robot)
-            next_boundary = stages[-1].end
-        # the samples of these stages, split from the neighbours' exactly as the batch path splits them
-        first_index = first_sample_at(stages[0].start, rate)
-        stop_index = first_sample_at(next_boundary.time, rate)
-        count = max(stop_index - first_index, 0)
-        if buffers is None:
-            rows = np.empty((count, self._width))
-        else:
-            rows = self._buffers.take(count)
-            buffers.append(rows)
-        yield ALONE  # the stage table's numbers: a long part (a Python loop over the stages' fields)
-        table = yield from StageTable.in_parts(stages)
-        yield
-        # in slices for command(); an imported robot's legs in one pass (its base velocities are differences
-        # along the step)
-        size = SLICE_ROWS if buffers is not None and self.robot.legs is None else max(len(rows), 1)
-        scalars = _scalars(rows[:0])
-        for begin in range(0, len(rows), size):
-            block = rows[begin:min(begin + size, len(rows))]
-            times = np.arange(first_index + begin, first_index + begin + len(block)) / rate
-            samples = yield from evaluate_in_parts(table, times, self.robot)
-            yield
-            yield from self._fill_pattern(block, samples)
-            yield
-            for column, values in zip(scalars, _scalars(block), strict=True):
-                column.extend(values)
-            yield
-            if self.joints:
-                yield from self._fill_joints(block, samples)
-            else:
-                check_leg_reach(samples.time, block[:, _PELVIS], samples.pelvis_yaw, samples.left_position,
-                                samples.right_position, self.robot)
-            yield
-        standing = None
-        if next_boundary.at_rest:  # the row of standing still (one IK) in a slice of its own
-            standing = self._standing_row(next_stance)
-            yield
-        return _Plan(command, stages, next_stance, next_boundary, rows, first_index, standing=standing,
-                     scalars=scalars)
 
     def stop(self) -> None:
         """Queue a closing step into the ready posture (nothing happens when standing).
@@ -666,27 +430,27 @@ class OnlineWalker:
         return WalkingSample(
             time=index / self.rate,
             support=_SUPPORT_OF_CODE[code],
-            position_pelvis_in_world=row[_PELVIS],
+            position_pelvis_in_world=row[ROW_PELVIS],
             yaw_pelvis_in_world=pelvis_yaw,
-            position_left_ankle_in_world=row[_LEFT],
+            position_left_ankle_in_world=row[ROW_LEFT],
             yaw_left_foot_in_world=left_yaw,
-            position_right_ankle_in_world=row[_RIGHT],
+            position_right_ankle_in_world=row[ROW_RIGHT],
             yaw_right_foot_in_world=right_yaw,
-            zmp_in_world=row[_ZMP],
-            joint_angles=row[_JOINTS] if self.joints else None,
-            joint_velocities=row[_JOINT_RATES] if self.joints else None,
+            zmp_in_world=row[ROW_ZMP],
+            joint_angles=row[ROW_JOINTS] if self.joints else None,
+            joint_velocities=row[ROW_JOINT_RATES] if self.joints else None,
         )
 
-    def _advance(self, index: int) -> _Plan | None:
+    def _advance(self, index: int) -> CheckedPlan | None:
         """Make the queued command (or the automatic stop) current; None when standing. A command still under
         check waits (module docstring): no tick runs the rest of a check at once."""
-        dropped: list[_Plan | None] = []
+        dropped: list[CheckedPlan | None] = []
         try:
             return self._next_plan(index, dropped)
         finally:
             self._release(*dropped)
 
-    def _next_plan(self, index: int, dropped: list[_Plan | None]) -> _Plan | None:
+    def _next_plan(self, index: int, dropped: list[CheckedPlan | None]) -> CheckedPlan | None:
         """:meth:`_advance`, listing the plans it drops in ``dropped``."""
         while True:
             if self._pending is None and not self._boundary.at_rest and self._current is not None:
@@ -704,66 +468,11 @@ class OnlineWalker:
             self._current = plan
             self._stance, self._boundary = plan.stance, plan.boundary
             if plan.boundary.at_rest:
-                self._set_standing(plan.standing if plan.standing is not None else self._standing_row(plan.stance))
+                standing = plan.standing if plan.standing is not None else self._check.standing_row(plan.stance)
+                self._set_standing(standing)
             if index < plan.first_index + len(plan.rows):
                 return plan
 
-    def _fill_pattern(self, rows: Array, samples: Samples) -> Parts[None]:
-        """Fill ``rows`` with the pattern's samples (the legs: :meth:`_fill_joints`), in two parts."""
-        rows[:, 0:2] = samples.pelvis_xy
-        rows[:, 2] = self.robot.pelvis_height
-        rows[:, _PELVIS_YAW] = samples.pelvis_yaw
-        yield
-        rows[:, _LEFT] = samples.left_position
-        rows[:, _LEFT_YAW] = samples.left_yaw
-        rows[:, _RIGHT] = samples.right_position
-        rows[:, _RIGHT_YAW] = samples.right_yaw
-        rows[:, _ZMP] = samples.zmp_xy
-        rows[:, _SUPPORT] = samples.support
-
-    def _fill_joints(self, rows: Array, samples: Samples) -> Parts[None]:
-        n = len(samples.time)
-        pelvis = np.column_stack([samples.pelvis_xy, np.full(n, self.robot.pelvis_height)])
-        trajectory = yield from joint_trajectory_in_parts(
-            samples.time, pelvis, samples.pelvis_yaw, np.column_stack([samples.pelvis_velocity_xy, np.zeros(n)]),
-            samples.pelvis_yaw_rate,
-            ((samples.left_position, samples.left_yaw, samples.left_velocity, samples.left_yaw_rate),
-             (samples.right_position, samples.right_yaw, samples.right_velocity, samples.right_yaw_rate)),
-            self.robot)
-        rows[:, _JOINTS] = trajectory.angles
-        rows[:, _JOINT_RATES] = trajectory.velocities
-
     def _set_standing(self, row: Array) -> None:
         self._standing = row
-        self._standing_scalars = tuple(column[0] for column in _scalars(row[None, :]))  # Python floats
-
-    def _standing_row(self, stance: Stance) -> Array:
-        middle = np.array([(stance.left.x + stance.right.x) / 2, (stance.left.y + stance.right.y) / 2])
-        row = np.zeros(self._width)
-        row[0:2] = middle
-        row[2] = self.robot.pelvis_height
-        row[_PELVIS_YAW] = (stance.left.yaw + stance.right.yaw) / 2
-        row[_LEFT] = (stance.left.x, stance.left.y, self.robot.ankle_height)
-        row[_LEFT_YAW] = stance.left.yaw
-        row[_RIGHT] = (stance.right.x, stance.right.y, self.robot.ankle_height)
-        row[_RIGHT_YAW] = stance.right.yaw
-        row[_ZMP] = middle
-        row[_SUPPORT] = 0
-        if self.joints and self.robot.legs is None:  # closed-form legs: the scalar IK (microseconds)
-            c, s = math.cos(row[_PELVIS_YAW]), math.sin(row[_PELVIS_YAW])
-            for index, (side, ankle, yaw) in enumerate(((1, row[_LEFT], row[_LEFT_YAW]),
-                                                        (-1, row[_RIGHT], row[_RIGHT_YAW]))):
-                dx, dy, dz = (float(v) for v in ankle - row[_PELVIS])
-                row[15 + 6 * index:21 + 6 * index] = leg_ik_scalar(
-                    Leg.of(self.robot, side), (c * dx + s * dy, c * dy - s * dx, dz), float(yaw - row[_PELVIS_YAW]))
-            check_joint_limits(np.zeros(1), row[None, _JOINTS], self.robot)
-            row[_JOINT_RATES] = 0.0
-        elif self.joints:
-            z, one = np.zeros((1, 3)), np.zeros(1)
-            trajectory = joint_trajectory(
-                np.zeros(1), row[None, _PELVIS], row[None, _PELVIS_YAW], z, one,
-                ((row[None, _LEFT], row[None, _LEFT_YAW], z, one), (row[None, _RIGHT], row[None, _RIGHT_YAW], z, one)),
-                self.robot)
-            row[_JOINTS] = trajectory.angles[0]
-            row[_JOINT_RATES] = 0.0
-        return row
+        self._standing_scalars = tuple(column[0] for column in row_scalars(row[None, :]))  # Python floats

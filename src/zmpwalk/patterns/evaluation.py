@@ -1,10 +1,12 @@
-"""Evaluating a walk's stages at any times, vectorised: the closed forms of :mod:`zmpwalk.patterns.polynomial`.
+"""Evaluating a walk's stages at any times, vectorised: the closed forms of :mod:`zmpwalk.patterns.stages`.
 
 A :class:`StageTable` holds the stages as column arrays; :func:`evaluate` gives the pelvis, both ankles, their
 rates, yaws and the cart-table ZMP at many times in one vectorised pass. :func:`evaluate_in_parts` is the same
 computation cut into parts of a few numpy calls each (:mod:`zmpwalk.slices`): the swinging ankle, the pelvis
 base and side shift, the sway, the feet, the ZMP, so that :class:`zmpwalk.online.OnlineWalker` runs a few
 per control tick; :func:`evaluate` runs it whole (the batch paths: the same code, the same numbers).
+Where a stage carries the pendulum's pieces (the hyperbolic pelvis model), its pelvis replaces the curves'
+(:class:`~zmpwalk.patterns.lipm_stage.LipmColumns`).
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ from numpy.typing import NDArray
 
 from zmpwalk import curves
 from zmpwalk.footsteps import LEFT, StagePlan
-from zmpwalk.patterns.lipm_stage import PIECES, LipmPelvis, axis_at_in_parts
+from zmpwalk.patterns.lipm_stage import LipmColumns, LipmPelvis
 from zmpwalk.patterns.result import SUPPORT_DOUBLE, SUPPORT_LEFT, SUPPORT_RIGHT
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.slices import Parts, run_to_end, whole
@@ -78,7 +80,7 @@ def side_shift_profile(tau: Array, profile: NDArray[np.integer], quintic: bool =
 
 
 class StageLike(Protocol):
-    """What a :class:`StageTable` reads of a stage: :class:`zmpwalk.patterns.polynomial.Stage` (not imported
+    """What a :class:`StageTable` reads of a stage: :class:`zmpwalk.patterns.stages.Stage` (not imported
     here: that module builds on this one). Positions [m], times [s], slopes per unit normalised time [m]."""
 
     @property
@@ -165,15 +167,10 @@ class StageTable:
         along = dx * hx + dy * hy
         self.along_x, self.along_y = along * hx, along * hy  # [m] cycloid part (Eq. 11)
         self.across_x, self.across_y = dx - self.along_x, dy - self.along_y  # [m] half-cosine part (Eqs. 14-17)
-        if self.hyperbolic.any():  # the pieces of each axis of the hyperbolic pelvis, (stages, PIECES)
+        self.lipm: LipmColumns | None = None  # the hyperbolic pelvises, where a stage has one
+        if self.hyperbolic.any():
             yield
-            unused = np.full(PIECES, np.nan)
-            pelvises = [s.lipm for s in stages]
-            self.lipm_yaw = np.array([p.yaw if p else 0.0 for p in pelvises])
-            self.lipm_axes = [
-                [np.array([getattr(getattr(p, axis), name) if p else unused for p in pelvises], dtype=float)
-                 for name in ("starts", "position", "velocity", "zmp")]
-                for axis in ("along", "across")]
+            self.lipm = LipmColumns.of([s.lipm for s in stages])
 
     def index_at(self, time: Array) -> NDArray[np.intp]:
         """Index of the stage each time belongs to (a boundary time opens the next stage)."""
@@ -235,9 +232,9 @@ def evaluate_in_parts(table: StageTable, time: Array, robot: RobotModel,
                                                                    right_rate) = yield from _feet_in_parts(
         table, k, len(t), swing, robot)
     yield
-    if table.hyperbolic.any():
-        pelvis_x, pelvis_y, pelvis_vx, pelvis_vy, pelvis_ax, pelvis_ay = yield from _hyperbolic_pelvis(
-            table, k, elapsed, robot, (pelvis_x, pelvis_y, pelvis_vx, pelvis_vy, pelvis_ax, pelvis_ay))
+    if table.lipm is not None:  # the pendulum's pelvis in place of the curves, where a stage has one
+        pelvis_x, pelvis_y, pelvis_vx, pelvis_vy, pelvis_ax, pelvis_ay = yield from table.lipm.pelvis_at_in_parts(
+            table.hyperbolic[k], k, elapsed, robot, (pelvis_x, pelvis_y, pelvis_vx, pelvis_vy, pelvis_ax, pelvis_ay))
         yield
     l_over_g = robot.pendulum_length / robot.gravity
     zmp = np.column_stack([pelvis_x - l_over_g * pelvis_ax, pelvis_y - l_over_g * pelvis_ay])  # Eqs. 1-2
@@ -378,27 +375,6 @@ def _feet_in_parts(table: StageTable, k: NDArray[np.intp], n: int, swing: tuple[
     support = np.where(in_swing, np.where(left_swings, SUPPORT_RIGHT, SUPPORT_LEFT), SUPPORT_DOUBLE)
     return support, (left_position, left_velocity, left_yaw, left_rate), (right_position, right_velocity,
                                                                           right_yaw, right_rate)
-
-
-def _hyperbolic_pelvis(table: StageTable, k: NDArray[np.intp], elapsed: Array, robot: RobotModel,
-                       curves_xy: tuple[Array, ...]) -> Parts[tuple[Array, ...]]:
-    """Pelvis x, y, their rates and accelerations: the hyperbolic pelvis where a stage has one, else ``curves_xy``.
-    In parts (each axis, then the turn to world)."""
-    a = math.sqrt(robot.gravity / robot.pendulum_length)
-    axes = []
-    for starts, position, velocity, zmp in table.lipm_axes:
-        sample_starts, sample_positions = starts[k], position[k]  # each sample's stage's pieces, (n, PIECES)
-        yield
-        sample_velocities, sample_zmps = velocity[k], zmp[k]
-        yield
-        axes.append((yield from axis_at_in_parts(a, sample_starts, sample_positions, sample_velocities, sample_zmps,
-                                                 elapsed)))
-        yield
-    (u, du, ddu), (w, dw, ddw) = axes
-    c, s = np.cos(table.lipm_yaw[k]), np.sin(table.lipm_yaw[k])  # the supporting foot's frame to world
-    hyperbolic = table.hyperbolic[k]
-    world = (u * c - w * s, u * s + w * c, du * c - dw * s, du * s + dw * c, ddu * c - ddw * s, ddu * s + ddw * c)
-    return tuple(np.where(hyperbolic, value, other) for value, other in zip(world, curves_xy, strict=True))
 
 
 def _cubic_basis(tau: Array) -> tuple[Array, ...]:

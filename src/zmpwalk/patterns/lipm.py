@@ -1,4 +1,4 @@
-"""The online LIPM generator: the stage engine of :mod:`zmpwalk.patterns.polynomial` with the hyperbolic pelvis of
+"""The online LIPM generator: the stage engine of :mod:`zmpwalk.patterns.planning` with the hyperbolic pelvis of
 Lim et al. (Eqs. 4-11, per stage: :mod:`zmpwalk.patterns.lipm_stage`) for any step commands.
 
 The paper's own straight walk, with its start and stop transients (Eqs. 12-15), is kept apart as a reproduction

@@ -1,6 +1,6 @@
 """The hyperbolic (linear inverted pendulum) pelvis of one stage: Lim et al.'s pattern, online, in 2-D.
 
-The online walker plans one *stage* (one swing, see :mod:`zmpwalk.patterns.polynomial`) at a time
+The online walker plans one *stage* (one swing, see :mod:`zmpwalk.patterns.stages`) at a time
 from the pelvis state it inherits. With the pelvis (the centre of mass) at constant height ``z_b``
 the ZMP equation of Lim et al. (Eq. 4) holds for each horizontal axis on its own:
 
@@ -19,7 +19,7 @@ is the steady step of Fig. 3 laid on the stage:
 
 * along ``u``: coast ``d/2``; interval I (ZMP ``u_1``) ``t_1``; interval II (coast) ``t_2``;
   interval III (ZMP ``u_2``) ``t_3``; coast ``d/2``. The times are those of the steady step of
-  this stage's stride, step time and double support (:func:`~zmpwalk.patterns.hyperbolic.solve_step`,
+  this stage's stride, step time and double support (:func:`~zmpwalk.patterns.pendulum.solve_step`,
   Eq. 11).
 * across ``w``: coast ``d/2``; ZMP ``w_1`` over the first half of the single support, ``w_2`` over
   the second; coast ``d/2``. In steady walking ``w_1 = w_2 = y_ZMP`` (Eq. 10: one lateral ZMP).
@@ -50,7 +50,7 @@ swing's steady state has (Eq. 15 solves the paper's version of this with two ZMP
 state). The closing swing holds one ZMP per axis over its single support that ends with ``xi`` on
 the middle of the ankles: the state from which the pendulum can come to rest there; the *settle*
 stage (both feet down) holds two ZMPs, one per half, that bring it to rest exactly (the full state,
-solved as a 2x2 system: :func:`~zmpwalk.patterns.hyperbolic.solve_zmps`).
+solved as a 2x2 system: :func:`~zmpwalk.patterns.pendulum.solve_zmps`).
 
 **Feasibility.** The ZMP is the pattern's own input here, so it is checked, not assumed: at every
 piece boundary (the ZMP is constant or moves with the body on a straight line between them, so the
@@ -63,6 +63,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -70,7 +71,7 @@ from numpy.typing import NDArray
 
 from zmpwalk.errors import InfeasiblePatternError, InvalidParameterError
 from zmpwalk.footsteps import Pose2D, StagePlan, foot_corners
-from zmpwalk.patterns.hyperbolic import COAST, Piece, propagate, run_pieces, solve_step, solve_zmps
+from zmpwalk.patterns.pendulum import COAST, Piece, propagate, run_pieces, solve_step, solve_zmps
 from zmpwalk.patterns.result import PHASE_TIME_TOL
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.slices import ALONE, Parts, whole
@@ -307,6 +308,59 @@ def axis_at_in_parts(a: float, axis_starts: Array, position: Array, velocity: Ar
     v = np.where(coasting, v0, hyper_v)
     acceleration = np.where(coasting, 0.0, a * a * (hyper_x - c))  # Eq. 4
     return x, v, acceleration
+
+
+@dataclass(frozen=True)
+class LipmColumns:
+    """The hyperbolic pelvises of a table's stages as column arrays, so that many samples evaluate in one pass.
+
+    Attributes:
+        yaw: Each stage's frame heading in world [rad], 0 where a stage has none.
+        axes: For the ``along`` then the ``across`` axis, the pieces' starts [s], positions [m], velocities [m/s]
+            and ZMPs [m] (NaN: coasting), each shape (stages, :data:`PIECES`), NaN where a stage has none.
+    """
+
+    yaw: Array  # [rad]
+    axes: list[list[Array]]
+
+    @classmethod
+    def of(cls, pelvises: Sequence[LipmPelvis | None]) -> LipmColumns:
+        """The columns of ``pelvises`` (None: a stage without one)."""
+        unused = np.full(PIECES, np.nan)
+        yaw = np.array([p.yaw if p else 0.0 for p in pelvises])
+        axes = [
+            [np.array([getattr(getattr(p, axis), name) if p else unused for p in pelvises], dtype=float)
+             for name in ("starts", "position", "velocity", "zmp")]
+            for axis in ("along", "across")]
+        return cls(yaw, axes)
+
+    def pelvis_at_in_parts(self, hyperbolic: NDArray[np.bool_], k: NDArray[np.intp], elapsed: Array,
+                           robot: RobotModel, curves_xy: tuple[Array, ...]) -> Parts[tuple[Array, ...]]:
+        """Pelvis x, y, their rates and accelerations in world: the hyperbolic pelvis where ``hyperbolic`` (per
+        sample), else ``curves_xy``. In parts (each axis, then the turn to world).
+
+        Args:
+            hyperbolic: Whether each sample's stage has a hyperbolic pelvis, shape (n,).
+            k: Each sample's stage, shape (n,).
+            elapsed: Each sample's time from its stage start [s], shape (n,).
+            robot: The robot (``pendulum_length`` is ``z_b``).
+            curves_xy: The pelvis of the curves: x, y [m], their rates [m/s] and accelerations [m/s^2].
+        """
+        a = math.sqrt(robot.gravity / robot.pendulum_length)
+        axes = []
+        for starts, position, velocity, zmp in self.axes:
+            sample_starts, sample_positions = starts[k], position[k]  # each sample's stage's pieces, (n, PIECES)
+            yield
+            sample_velocities, sample_zmps = velocity[k], zmp[k]
+            yield
+            axes.append((yield from axis_at_in_parts(a, sample_starts, sample_positions, sample_velocities,
+                                                     sample_zmps, elapsed)))
+            yield
+        (u, du, ddu), (w, dw, ddw) = axes
+        c, s = np.cos(self.yaw[k]), np.sin(self.yaw[k])  # the supporting foot's frame to world
+        world = (u * c - w * s, u * s + w * c, du * c - dw * s, du * s + dw * c, ddu * c - ddw * s,
+                 ddu * s + ddw * c)
+        return tuple(np.where(hyperbolic, value, other) for value, other in zip(world, curves_xy, strict=True))
 
 
 def _zmp_margin(plan: StagePlan, along: LipmAxis, across: LipmAxis, robot: RobotModel) -> Parts[float]:
