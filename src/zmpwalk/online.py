@@ -79,12 +79,11 @@ from zmpwalk.errors import (
 )
 from zmpwalk.footsteps import Stance
 from zmpwalk.kinematics import (
-    Leg,
     check_joint_limits,
     check_leg_reach,
     joint_trajectory,
     joint_trajectory_in_parts,
-    leg_ik_scalar,
+    leg_chains,
 )
 from zmpwalk.patterns.evaluation import Samples, StageTable, evaluate_in_parts
 from zmpwalk.patterns.polynomial import (
@@ -751,11 +750,11 @@ class OnlineWalker:
         row[_SUPPORT] = 0
         if self.joints and self.robot.legs is None:  # closed-form legs: the scalar IK (microseconds)
             c, s = math.cos(row[_PELVIS_YAW]), math.sin(row[_PELVIS_YAW])
-            for index, (side, ankle, yaw) in enumerate(((1, row[_LEFT], row[_LEFT_YAW]),
-                                                        (-1, row[_RIGHT], row[_RIGHT_YAW]))):
+            for index, (chain, ankle, yaw) in enumerate(zip(leg_chains(self.robot), (row[_LEFT], row[_RIGHT]),
+                                                             (row[_LEFT_YAW], row[_RIGHT_YAW]), strict=True)):
                 dx, dy, dz = (float(v) for v in ankle - row[_PELVIS])
-                row[15 + 6 * index:21 + 6 * index] = leg_ik_scalar(
-                    Leg.of(self.robot, side), (c * dx + s * dy, c * dy - s * dx, dz), float(yaw - row[_PELVIS_YAW]))
+                row[15 + 6 * index:21 + 6 * index] = chain.solve_flat_one(
+                    (c * dx + s * dy, c * dy - s * dx, dz), float(yaw - row[_PELVIS_YAW]))
             check_joint_limits(np.zeros(1), row[None, _JOINTS], self.robot)
             row[_JOINT_RATES] = 0.0
         elif self.joints:
