@@ -55,6 +55,7 @@ class SampledMotion(Protocol):
     yaw_rate_right_foot: Array
     robot: RobotModel
 
+
 def hip_positions_in_world(
     position_pelvis_in_world: Array, yaw_pelvis_in_world: Array, robot: RobotModel
 ) -> tuple[Array, Array]:
@@ -332,7 +333,8 @@ def leg_chains(robot: RobotModel) -> tuple[LegChain, LegChain]:
 
 
 def _straight_chain(robot: RobotModel, side: int) -> LegChain:
-    """The robot file's left (``side = +1``) or right (-1) leg, its hip at the pelvis origin's hip point."""
+    """The robot file's left (``side = +1``) or right (-1) leg in the pelvis frame (a robot file has no
+    :attr:`~zmpwalk.robots.model.RobotModel.com_offset`: its pattern's pelvis point is the pelvis origin)."""
     label = "left" if side > 0 else "right"
     limits = [robot.limits_of(f"{label}_{joint}") for joint in LEG_JOINTS]
     chain = LegChain.from_lengths(

@@ -348,7 +348,7 @@ class LegChain:
             UnreachableError: The ankle is out of the leg's reach (``time`` is nan).
         """
         if self.straight is not None:
-            return straight_form.solve_flat_one(self.straight, ankle, yaw, knee_forward, self.label)
+            return straight_form.solve_flat_one(self.straight, ankle, yaw, knee_forward, self.side)
         angles, excess, _ = self.solve_flat(np.array([ankle]), np.array([yaw]), knee_forward=knee_forward)
         if excess[0] > 0.0:
             raise UnreachableError(self.label, float("nan"), float(excess[0]))

@@ -218,12 +218,12 @@ def solve_flat_in_parts(leg: StraightLeg, px: Array, py: Array, pz: Array, yaw: 
 
 
 def solve_flat_one(leg: StraightLeg, ankle: tuple[float, float, float], foot_yaw: float, knee_forward: bool,
-                   label: str) -> tuple[float, ...]:
+                   side: int) -> tuple[float, ...]:
     """The same closed form for one pose with a flat foot of yaw ``foot_yaw`` [rad] (pelvis frame), the ankle
     [m]; the six angles [rad]. Plain ``math`` for a controller that solves one leg per tick.
 
     Raises:
-        UnreachableError: The ankle is out of the leg's reach (``leg`` is ``label``, ``time`` is nan).
+        UnreachableError: The ankle is out of the leg's reach (``side`` +1 left, -1 right; ``time`` is nan).
     """
     c, s = math.cos(foot_yaw), math.sin(foot_yaw)
     dx, dy, dz = leg.hip[0] - ankle[0], leg.hip[1] - ankle[1], leg.hip[2] - ankle[2]
@@ -232,7 +232,7 @@ def solve_flat_one(leg: StraightLeg, ankle: tuple[float, float, float], foot_yaw
     distance = math.sqrt(rx * rx + ry * ry + rz * rz)
     if distance > a + b or distance < abs(a - b):
         excess = max(distance - a - b, abs(a - b) - distance)
-        raise UnreachableError(label, math.nan, excess)
+        raise UnreachableError("left" if side > 0 else "right", math.nan, excess)
     q4 = math.acos(max(-1.0, min(1.0, (distance * distance - a * a - b * b) / (2 * a * b))))
     if not knee_forward:
         q4 = -q4
