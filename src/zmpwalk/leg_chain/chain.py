@@ -324,7 +324,7 @@ class LegChain:
         straight leg (:func:`zmpwalk.leg_chain.straight.solve_flat_in_parts`), in one for any other chain."""
         if self.straight is not None:
             excess: Array = yield from straight_form.solve_flat_in_parts(self.straight, *position, yaw, velocity,
-                                                                    knee_forward, angles, rates)
+                                                                         knee_forward, angles, rates)
             return excess
         yield
         p = np.column_stack(position)
