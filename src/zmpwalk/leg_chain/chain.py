@@ -106,6 +106,9 @@ class LegChain:
             posture, relative to level [rad] (:class:`zmpwalk.robots.collision.Sole`; for reading).
         link_lengths: Thigh and shank [m] of a straight leg built from them (:meth:`from_lengths`), which its
             own closed form uses as given, or None (any other chain).
+        straight: Hip centre, thigh and shank of a straight leg built from its link lengths, whose own closed
+            form (:mod:`zmpwalk.leg_chain.straight`) :meth:`solve` takes; None for any other chain (an imported
+            model's, whatever its axes: :func:`zmpwalk.leg_chain.straight.recognise`). Set from the others.
     """
 
     side: int
@@ -123,6 +126,7 @@ class LegChain:
     virtual: int | None = None
     sole_tilt_reference: tuple[float, float] = (0.0, 0.0)  # [rad]
     link_lengths: tuple[float, float] | None = None  # [m]
+    straight: StraightLeg | None = field(init=False, repr=False, default=None)
 
     @classmethod
     def from_lengths(cls, side: int, joint_names: tuple[str, ...], hip: tuple[float, float, float], thigh: float,
@@ -197,19 +201,12 @@ class LegChain:
         """Point nearest both ankle axes (the ankle centre) [m], (3,)."""
         return _closest_point_to_lines(self.points[4:], self.axes[4:])[0]
 
-    @property
-    def straight(self) -> StraightLeg | None:
-        """Hip centre, thigh and shank of a straight leg built from its link lengths (:meth:`from_lengths`),
-        whose own closed form (:mod:`zmpwalk.leg_chain.straight`) :meth:`solve` takes; None for any other chain
-        (an imported model's, whatever its axes: see :func:`zmpwalk.leg_chain.straight.recognise`)."""
-        return self._straight  # type: ignore[attr-defined, no-any-return]
-
     # --- forward kinematics -------------------------------------------------------------------------------
     def __post_init__(self) -> None:
         skews = np.array([[[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]] for w in self.axes])
         object.__setattr__(self, "_skews", skews)
         object.__setattr__(self, "_skews2", skews @ skews)
-        object.__setattr__(self, "_straight", straight_form.recognise(self))
+        object.__setattr__(self, "straight", straight_form.recognise(self))
 
     def transforms(self, q: Array) -> tuple[Array, Array]:
         """Cumulative rotations (n, 7, 3, 3) and translations (n, 7, 3): ``prod_{j<i} exp(xi_j q_j)``, i = 0..6."""
