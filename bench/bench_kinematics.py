@@ -12,27 +12,28 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from zmpwalk import StepCommand, load_robot
-from zmpwalk.kinematics import Leg, leg_fk, leg_ik, leg_ik_scalar, leg_ik_yaw
+from zmpwalk.kinematics import leg_chains
+from zmpwalk.leg_chain import LegChain
 from zmpwalk.online import OnlineWalker
 
 
-def poses(leg: Leg, n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def poses(chain: LegChain, n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     rng = np.random.default_rng(seed)
     q = np.column_stack([rng.uniform(-0.5, 0.5, n), rng.uniform(-0.3, 0.3, n), rng.uniform(-1.0, 0.4, n),
                          rng.uniform(0.2, 1.6, n), np.zeros(n), np.zeros(n)])
     q[:, 5] = -q[:, 1]
     q[:, 4] = -(q[:, 2] + q[:, 3])  # flat feet, as in walking
-    position, rotation = leg_fk(leg, q)
+    position, rotation = chain.fk(q)
     return position, rotation, np.arctan2(rotation[:, 1, 0], rotation[:, 0, 0])
 
 
 def main() -> None:
     robot = load_robot("hubo")
-    leg = Leg.of(robot, 1)
-    position, rotation, yaw = poses(leg, 200_000)
+    chain = leg_chains(robot)[0]
+    position, rotation, yaw = poses(chain, 200_000)
     best = {}
-    for name, solve in (("flat-foot (yaw)", lambda: leg_ik_yaw(leg, position, yaw)),
-                        ("general rotation", lambda: leg_ik(leg, position, rotation))):
+    for name, solve in (("flat-foot (yaw)", lambda: chain.solve_flat(position, yaw)),
+                        ("general rotation", lambda: chain.solve(position, rotation))):
         solve()
         runs = []
         for _ in range(5):
@@ -44,13 +45,13 @@ def main() -> None:
     count = 20_000
     start = time.perf_counter()
     for i in range(count):
-        leg_ik_scalar(leg, (float(position[i, 0]), float(position[i, 1]), float(position[i, 2])), float(yaw[i]))
+        chain.solve_flat_one((float(position[i, 0]), float(position[i, 1]), float(position[i, 2])), float(yaw[i]))
     scalar = (time.perf_counter() - start) / count
     print(f"closed-form IK, scalar (math): {scalar * 1e6:.2f} us per leg solution")
     numeric = []
     for i in range(200):
         def residual(x: np.ndarray, i: int = i) -> np.ndarray:
-            p, r = leg_fk(leg, x[None, :])
+            p, r = chain.fk(x[None, :])
             return np.concatenate([p[0] - position[i], (r[0] - rotation[i]).ravel()])
 
         start = time.perf_counter()

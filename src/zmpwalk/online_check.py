@@ -24,12 +24,11 @@ from zmpwalk.commands import StepCommand
 from zmpwalk.errors import InfeasibleCommandError, InvalidParameterError, ZmpwalkError
 from zmpwalk.footsteps import Stance
 from zmpwalk.kinematics import (
-    Leg,
     check_joint_limits,
     check_leg_reach,
     joint_trajectory,
     joint_trajectory_in_parts,
-    leg_ik_scalar,
+    leg_chains,
 )
 from zmpwalk.patterns.evaluation import Samples, StageTable, evaluate_in_parts
 from zmpwalk.patterns.pelvis_model import check_pelvis
@@ -343,11 +342,11 @@ class CommandCheck:
         row[ROW_SUPPORT] = 0
         if self.joints and self.robot.legs is None:  # closed-form legs: the scalar IK (microseconds)
             c, s = math.cos(row[ROW_PELVIS_YAW]), math.sin(row[ROW_PELVIS_YAW])
-            for index, (side, ankle, yaw) in enumerate(((1, row[ROW_LEFT], row[ROW_LEFT_YAW]),
-                                                        (-1, row[ROW_RIGHT], row[ROW_RIGHT_YAW]))):
+            for index, (chain, ankle, yaw) in enumerate(zip(leg_chains(self.robot), (row[ROW_LEFT], row[ROW_RIGHT]),
+                                                             (row[ROW_LEFT_YAW], row[ROW_RIGHT_YAW]), strict=True)):
                 dx, dy, dz = (float(v) for v in ankle - row[ROW_PELVIS])
-                row[15 + 6 * index:21 + 6 * index] = leg_ik_scalar(
-                    Leg.of(self.robot, side), (c * dx + s * dy, c * dy - s * dx, dz), float(yaw - row[ROW_PELVIS_YAW]))
+                row[15 + 6 * index:21 + 6 * index] = chain.solve_flat_one(
+                    (c * dx + s * dy, c * dy - s * dx, dz), float(yaw - row[ROW_PELVIS_YAW]))
             check_joint_limits(np.zeros(1), row[None, ROW_JOINTS], self.robot)
             row[ROW_JOINT_RATES] = 0.0
         elif self.joints:

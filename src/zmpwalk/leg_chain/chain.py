@@ -1,9 +1,9 @@
-r"""Kinematics of any 6-DoF leg: forward, Jacobian, closed-form inverse where the axes allow, numeric otherwise.
+r"""One leg as a chain of six revolute joints: geometry, forward kinematics, Jacobian, and its inverse kinematics.
 
-A leg imported from a robot's model is a chain of six revolute joints from the
-pelvis (the floating base) to the foot, in any order and with any axes. It is
-written as a product of exponentials in the **pelvis frame** (the base body's
-frame; x forward, y left, z up) at the model's zero configuration:
+A leg is a chain of six revolute joints from the pelvis (the floating base) to
+the foot, in any order and with any axes. It is written as a product of
+exponentials in the **pelvis frame** (the base body's frame; x forward, y left,
+z up) at the zero configuration:
 
 .. math::
     T_{foot}(q) = e^{\hat\xi_1 q_1} e^{\hat\xi_2 q_2} \cdots e^{\hat\xi_6 q_6} M,
@@ -18,7 +18,8 @@ on the floor. A model whose sole is tilted at zero angles (a foot box pitched
 10 degrees, level in the keyframe) has ``R_s = R_y(10 deg)``
 (:func:`zmpwalk.robots.collision.foot_sole`): the inverse kinematics is asked
 for the sole's pose, so a walking pattern's flat foot is a flat sole. Angles
-are the model's own (its signs and zeros).
+are the model's own (its signs and zeros). A robot file's leg (HUBO's) is the
+chain of its link lengths (:meth:`LegChain.from_lengths`).
 
 **Five-joint legs** (hip yaw, roll and pitch, knee, ankle pitch: Unitree H1)
 are a six-joint chain whose ankle roll is **virtual** (:attr:`LegChain.virtual`):
@@ -36,109 +37,36 @@ sole's heading and pitch exactly, and the virtual angle is the sole's
 **residual roll** about that line: what the foot rolls on the floor when the
 real joints are sent alone (``tests/test_five_joint_legs.py``).
 
-**Closed form** (:meth:`LegChain.solve`), wherever the three hip axes meet in
-one point ``H`` and the two ankle axes meet in one point ``A_0`` (any axis order:
-yaw-roll-pitch as HUBO and TALOS, pitch-roll-yaw, ...). With the target
-``g = T_d M^{-1}``, three subproblems of Paden and Kahan (Murray, Li and
-Sastry, *A Mathematical Introduction to Robotic Manipulation*, 1994, Sec. 3.3):
+**Inverse kinematics** (:meth:`LegChain.solve`), chosen from the geometry:
 
-1. the knee (subproblem 3): the hip joints turn about ``H`` and the ankle joints
-   fix ``A_0``, so ``|e^{\hat\xi_4 q_4} A_0 - H| = |g A_0 - H|``;
-2. the ankle (subproblem 2, two intersecting axes):
-   ``e^{\hat\xi_5 q_5} e^{\hat\xi_6 q_6} (g^{-1} H) = e^{-\hat\xi_4 q_4} H``;
-3. the hip (subproblem 2 on the third hip axis, then subproblem 1):
-   ``e^{\hat\xi_1 q_1} e^{\hat\xi_2 q_2} e^{\hat\xi_3 q_3} = g\,(e^{\hat\xi_4 q_4} e^{\hat\xi_5 q_5}
-   e^{\hat\xi_6 q_6})^{-1}``.
-
-Each subproblem has up to two solutions; zmpwalk takes, at each, the one
-nearest the leg's reference angles (the ready posture), so the knee keeps the
-branch it stands in.
-
-**Numeric** (damped least squares, warm-started from the reference angles and
-iterated on every sample at once) where the axes do not meet, such as Booster
-T1's hip (pitch, roll and yaw axes 2 cm and 8.2 cm apart):
-
-.. math:: \Delta q = J^T (J J^T + \lambda^2 I)^{-1} e
-
-with ``e`` the foot's position error and the rotation vector of its
-orientation error. It stops when every sample is within :data:`IK_TOLERANCE`;
-a sample that does not converge is reported with its remaining error as the
-``excess`` of :meth:`LegChain.solve`, and a joint trajectory then raises
-:class:`~zmpwalk.errors.UnreachableError` naming the leg and the time.
+* a leg whose hip axes meet and whose ankle axes meet: a closed form. The
+  straight leg built from its link lengths (:mod:`zmpwalk.leg_chain.straight`:
+  yaw-roll-pitch hip, knee and pitch-roll ankle on one vertical line, HUBO) has
+  its own, with joint rates as its time derivative for whole trajectories
+  (:meth:`LegChain.solve_flat_in_parts`) and a ``math`` path for one control
+  tick (:meth:`LegChain.solve_flat_one`); any other, an imported model's, the
+  subproblems of Paden and Kahan (:mod:`zmpwalk.leg_chain.paden_kahan`), each
+  branch nearest its reference angles;
+* otherwise damped least squares (:mod:`zmpwalk.leg_chain.numeric`).
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
-Array = NDArray[np.float64]
+from zmpwalk.errors import UnreachableError
+from zmpwalk.leg_chain import straight as straight_form
+from zmpwalk.leg_chain.numeric import solve_numeric
+from zmpwalk.leg_chain.paden_kahan import solve_closed
+from zmpwalk.leg_chain.rotations import Array, cross3, rot_z
+from zmpwalk.leg_chain.straight import StraightLeg
+from zmpwalk.slices import Parts, run_to_end
 
-IK_TOLERANCE = 1e-10  # [m] and [rad]: convergence of the numeric IK
-IK_MAX_ITERATIONS = 100
-IK_DAMPING = 1e-6  # lambda of the damped least squares [-]
-IK_MAX_STEP = 0.3  # [rad] largest joint change of one iteration (keeps far targets from overshooting)
 AXES_MEET_TOLERANCE = 1e-6  # [m] axes closer than this meet (closed form applies)
-
-
-def _rodrigues(axis: Array, angle: Array) -> Array:  # the IK's few rotations; transforms() has its own
-    """Rotation matrices about a fixed unit ``axis`` (3,) by ``angle`` (n,), shape (n, 3, 3)."""
-    x, y, z = axis
-    k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
-    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
-    return np.asarray(np.eye(3) + s * k + (1.0 - c) * (k @ k), dtype=np.float64)
-
-
-def cross3(a: Array, b: Array) -> Array:
-    """Cross products along the last axis of 3-vectors (``np.cross`` without its axis handling, which
-    dominates on the small arrays of one control tick)."""
-    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1], a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
-
-
 _EYE = np.eye(3)
-
-
-def _wrap(angle: Array) -> Array:
-    return np.asarray((angle + np.pi) % (2 * np.pi) - np.pi, dtype=np.float64)
-
-
-def _nearest(candidates: list[Array], reference: float) -> Array:
-    """Per sample, the candidate angle (each (n,)) nearest ``reference`` (wrap-aware)."""
-    stacked = np.stack(candidates)
-    distance = np.abs(_wrap(stacked - reference))
-    return np.asarray(stacked[np.argmin(distance, axis=0), np.arange(stacked.shape[1])], dtype=np.float64)
-
-
-def _subproblem1(axis: Array, u: Array, v: Array) -> Array:
-    """Angle about ``axis`` (3,) taking vectors ``u`` to ``v`` (n, 3) (Paden-Kahan 1; projections)."""
-    up = u - np.outer(u @ axis, axis)
-    vp = v - np.outer(v @ axis, axis)
-    return np.asarray(np.arctan2(np.einsum("ni,ni->n", np.cross(up, vp), np.broadcast_to(axis, up.shape)),
-                                 np.einsum("ni,ni->n", up, vp)), dtype=np.float64)
-
-
-def _subproblem2(axis1: Array, axis2: Array, u: Array, v: Array) -> tuple[list[tuple[Array, Array]], Array]:
-    """``exp(axis1 t1) exp(axis2 t2) u = v`` for vectors (n, 3) about axes through one point (Paden-Kahan 2).
-
-    Returns:
-        The two solutions ``(t1, t2)`` and ``gamma^2`` (< 0 where none exists; the nearest is taken there).
-    """
-    w12 = float(axis1 @ axis2)
-    cross = np.cross(axis1, axis2)
-    denominator = w12 * w12 - 1.0
-    a = (w12 * (u @ axis2) - v @ axis1) / denominator
-    b = (w12 * (v @ axis1) - u @ axis2) / denominator
-    gamma2 = (np.einsum("ni,ni->n", u, u) - a * a - b * b - 2 * a * b * w12) / float(cross @ cross)
-    gamma = np.sqrt(np.maximum(gamma2, 0.0))
-    solutions = []
-    for sign in (1.0, -1.0):
-        z = np.outer(a, axis1) + np.outer(b, axis2) + np.outer(sign * gamma, cross)
-        solutions.append((_subproblem1(axis1, z, v), _subproblem1(axis2, u, z)))
-    return solutions, np.asarray(gamma2, dtype=np.float64)
 
 
 def _closest_point_to_lines(points: Array, axes: Array) -> tuple[Array, float]:
@@ -176,6 +104,11 @@ class LegChain:
             see the module docstring), or None.
         sole_tilt_reference: The (roll, pitch) of the sole's lowest points' plane in the model's reference
             posture, relative to level [rad] (:class:`zmpwalk.robots.collision.Sole`; for reading).
+        link_lengths: Thigh and shank [m] of a straight leg built from them (:meth:`from_lengths`), which its
+            own closed form uses as given, or None (any other chain).
+        straight: Hip centre, thigh and shank of a straight leg built from its link lengths, whose own closed
+            form (:mod:`zmpwalk.leg_chain.straight`) :meth:`solve` takes; None for any other chain (an imported
+            model's, whatever its axes: :func:`zmpwalk.leg_chain.straight.recognise`). Set from the others.
     """
 
     side: int
@@ -192,6 +125,26 @@ class LegChain:
     sole_rotation: Array = field(default_factory=lambda: np.eye(3))
     virtual: int | None = None
     sole_tilt_reference: tuple[float, float] = (0.0, 0.0)  # [rad]
+    link_lengths: tuple[float, float] | None = None  # [m]
+    straight: StraightLeg | None = field(init=False, repr=False, default=None)
+
+    @classmethod
+    def from_lengths(cls, side: int, joint_names: tuple[str, ...], hip: tuple[float, float, float], thigh: float,
+                     shank: float, **fields: Any) -> LegChain:
+        """The straight leg (:mod:`zmpwalk.leg_chain.straight`) of a robot file: hip yaw, roll and pitch about z, x
+        and y meeting at ``hip`` [m] (pelvis frame), the knee (y) ``thigh`` [m] below it, the ankle pitch and roll
+        (y, x) ``shank`` [m] below the knee, the foot frame at the ankle with a level sole.
+
+        Args:
+            fields: The other attributes (``reference``, ``lower``, ``upper``, ``link_masses``, ``link_coms``).
+        """
+        ex, ey, ez = np.eye(3)
+        hip_point = np.array(hip)
+        knee = hip_point + [0.0, 0.0, -thigh]
+        ankle = knee + [0.0, 0.0, -shank]
+        return cls(side, joint_names, np.array([ez, ex, ey, ey, ey, ex]),
+                   np.array([hip_point, hip_point, hip_point, knee, ankle, ankle]), ankle,
+                   link_lengths=(thigh, shank), **fields)
 
     @property
     def virtual_column(self) -> int | None:
@@ -253,6 +206,7 @@ class LegChain:
         skews = np.array([[[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]] for w in self.axes])
         object.__setattr__(self, "_skews", skews)
         object.__setattr__(self, "_skews2", skews @ skews)
+        object.__setattr__(self, "straight", straight_form.recognise(self))
 
     def transforms(self, q: Array) -> tuple[Array, Array]:
         """Cumulative rotations (n, 7, 3, 3) and translations (n, 7, 3): ``prod_{j<i} exp(xi_j q_j)``, i = 0..6."""
@@ -274,10 +228,10 @@ class LegChain:
 
     def fk(self, q: Array, transforms: tuple[Array, Array] | None = None) -> tuple[Array, Array]:
         """Ankle position [m] (n, 3) and sole rotation (n, 3, 3) in the pelvis frame for angles (n, 6) [rad]."""
-        position, rotation = self._fk_chain(q, transforms)
+        position, rotation = self.fk_chain(q, transforms)
         return position, np.asarray(rotation @ self.sole_rotation, dtype=np.float64)
 
-    def _fk_chain(self, q: Array, transforms: tuple[Array, Array] | None = None) -> tuple[Array, Array]:
+    def fk_chain(self, q: Array, transforms: tuple[Array, Array] | None = None) -> tuple[Array, Array]:
         """Ankle position and the chain's rotation ``prod exp(xi_i q_i)`` (the sole's, without ``R_s``)."""
         rotations, translations = self.transforms(q) if transforms is None else transforms
         rotation, translation = rotations[:, 6], translations[:, 6]
@@ -294,6 +248,12 @@ class LegChain:
         jacobian[:, 3:, :] = np.swapaxes(axes, 1, 2)
         return jacobian
 
+
+    def joint_rates(self, q: Array, twist: Array) -> Array:
+        """Joint rates [rad/s] (n, 6) that give the ankle ``twist`` (n, 6) (velocity [m/s], angular velocity
+        [rad/s], pelvis frame) at angles ``q`` (n, 6) [rad]: ``J(q)^-1 twist``."""
+        return np.asarray(np.linalg.solve(self.jacobian(q), twist[..., None])[..., 0], dtype=np.float64)
+
     # --- inverse kinematics -------------------------------------------------------------------------------
     def solve(self, position_ankle_in_pelvis: Array, rotation_foot_in_pelvis: Array,
               numeric: bool | None = None, start: Array | None = None) -> tuple[Array, Array]:
@@ -301,8 +261,9 @@ class LegChain:
         :attr:`sole_rotation`; a flat sole of yaw ``psi`` is ``R_z(psi)``).
 
         Args:
-            numeric: Force the numeric IK (True) or the closed form (False); None picks the closed form
-                where :attr:`closed_form` holds.
+            numeric: Force the numeric IK (True) or the closed form (False): the straight leg's own
+                (:attr:`straight`; the knee bent as the reference's), else Paden and Kahan's; None picks the
+                closed form where :attr:`closed_form` holds.
             start: Warm start of the numeric IK (n, 6) [rad] (default: :attr:`reference`).
 
         Returns:
@@ -315,100 +276,80 @@ class LegChain:
         if numeric is None:
             numeric = not self.closed_form
         if numeric:
-            return self._solve_numeric(p, rotation, start)
-        return self._solve_closed(p, rotation)
+            return solve_numeric(self, p, rotation, start)
+        if self.straight is not None:
+            return straight_form.solve(self.straight, p, rotation, knee_forward=bool(self.reference[3] >= 0.0))
+        return solve_closed(self, p, rotation)
 
-    def _solve_closed(self, p: Array, rotation: Array) -> tuple[Array, Array]:
-        n = len(p)
-        w, r = self.axes, self.points
-        hip = self.hip
-        ankle0 = self.ankle_point
-        reference = self.reference
+    def solve_flat(self, position_ankle_in_pelvis: Array, yaw_foot_in_pelvis: Array,
+                   velocity_ankle_in_pelvis: Array | None = None, yaw_rate_foot_in_pelvis: Array | None = None,
+                   knee_forward: bool = True) -> tuple[Array, Array, Array | None]:
+        """:meth:`solve` for flat soles (``R_z(yaw)``) and, given the ankle's velocity and the foot's yaw rate, the
+        joint rates: angles (n, 6) [rad], reach excess (n,) [m] (> 0 unreachable) and rates (n, 6) [rad/s] or None.
 
-        def g_point(x: Array) -> Array:  # g = T_d M^-1 applied to points (3,) or (n, 3)
-            return np.asarray(np.einsum("nij,nj->ni", rotation, np.broadcast_to(x - self.ankle, (n, 3))) + p)
+        Args:
+            position_ankle_in_pelvis: [m], (n, 3).
+            yaw_foot_in_pelvis: The sole's yaw relative to the pelvis [rad], (n,).
+            velocity_ankle_in_pelvis: [m/s], (n, 3) (relative to the pelvis, in its frame), or None.
+            yaw_rate_foot_in_pelvis: [rad/s], (n,), or None.
+            knee_forward: The straight leg's knee branch (``q4 >= 0`` or ``<= 0``); any other chain keeps the
+                branch of its reference angles.
+        """
+        p = np.atleast_2d(position_ankle_in_pelvis)
+        yaw = np.asarray(yaw_foot_in_pelvis, dtype=np.float64)
+        velocity = None
+        if velocity_ankle_in_pelvis is not None and yaw_rate_foot_in_pelvis is not None:
+            v = np.atleast_2d(velocity_ankle_in_pelvis)
+            velocity = (v[:, 0], v[:, 1], v[:, 2], np.asarray(yaw_rate_foot_in_pelvis))
+        if self.straight is None:
+            angles, excess = self.solve(p, rot_z(yaw))
+            if velocity is None:
+                return angles, excess, None
+            zero = np.zeros(len(p))
+            return angles, excess, self.joint_rates(angles, np.column_stack([*velocity[:3], zero, zero, velocity[3]]))
+        rows, rates = np.empty((6, len(p))), (None if velocity is None else np.empty((6, len(p))))
+        excess = run_to_end(straight_form.solve_flat_in_parts(self.straight, p[:, 0], p[:, 1], p[:, 2], yaw,
+                                                               velocity, knee_forward, rows, rates))
+        return rows.T, excess, (None if rates is None else rates.T)
 
-        # 1. knee: |exp(xi4 q4) A0 - H| = delta (subproblem 3)
-        delta = np.linalg.norm(g_point(ankle0) - hip, axis=1)
-        u = ankle0 - r[3]
-        v = hip - r[3]
-        up, vp = u - w[3] * (w[3] @ u), v - w[3] * (w[3] @ v)
-        along = float(w[3] @ (ankle0 - hip))
-        delta_p2 = delta * delta - along * along
-        delta_p = np.sqrt(np.maximum(delta_p2, 0.0))
-        lu, lv = float(np.linalg.norm(up)), float(np.linalg.norm(vp))
-        excess = np.maximum(delta_p - (lu + lv), abs(lu - lv) - delta_p)
-        theta0 = math.atan2(float(w[3] @ np.cross(up, vp)), float(up @ vp))
-        phi = np.arccos(np.clip((lu * lu + lv * lv - delta_p2) / (2 * lu * lv), -1.0, 1.0))
-        q4 = _nearest([_wrap(theta0 + phi), _wrap(theta0 - phi)], reference[3])
-        # 2. ankle: exp(xi5 q5) exp(xi6 q6) (g^-1 H) = exp(-xi4 q4) H (subproblem 2 about A0)
-        h_seen = np.einsum("nji,nj->ni", rotation, hip - p) + self.ankle  # g^-1 H
-        knee_back = np.einsum("nij,j->ni", _rodrigues(w[3], -q4), hip - r[3]) + r[3]
-        solutions, _ = _subproblem2(w[4], w[5], h_seen - ankle0, knee_back - ankle0)
-        choice = _pick(solutions, reference[4], reference[5])
-        q5, q6 = choice
-        # 3. hip: R1 R2 R3 = R_d (R4 R5 R6)^T (subproblem 2 on axis 3, then subproblem 1)
-        lower = _rodrigues(w[3], q4) @ _rodrigues(w[4], q5) @ _rodrigues(w[5], q6)
-        hip_rotation = rotation @ np.swapaxes(lower, 1, 2)
-        target = hip_rotation @ w[2]
-        solutions, _ = _subproblem2(w[0], w[1], np.broadcast_to(w[2], (n, 3)), target)
-        q1, q2 = _pick(solutions, reference[0], reference[1])
-        perpendicular = np.cross(w[2], np.eye(3)[int(np.argmin(np.abs(w[2])))])
-        perpendicular /= np.linalg.norm(perpendicular)
-        upper = _rodrigues(w[0], q1) @ _rodrigues(w[1], q2)
-        seen = np.einsum("nji,njk,k->ni", upper, hip_rotation, perpendicular)  # (R1 R2)^T R_hip x
-        q3 = _subproblem1(w[2], np.broadcast_to(perpendicular, (n, 3)), seen)
-        angles = np.column_stack([q1, q2, q3, q4, q5, q6])
-        # Where the ankle cannot turn the foot as asked (no exact solution), report the residual.
-        position, _ = self._fk_chain(angles)
-        residual = np.linalg.norm(position - p, axis=1)
-        excess = np.where(excess > 0, excess, np.where(residual > 1e-6, residual, excess))
-        return angles, excess
+    def solve_flat_in_parts(self, position: tuple[Array, Array, Array], yaw: Array,
+                            velocity: tuple[Array, Array, Array, Array] | None, knee_forward: bool,
+                            angles: Array, rates: Array | None) -> Parts[Array]:
+        """:meth:`solve_flat` for a whole trajectory, on component arrays (n,) (ankle x, y, z [m]; ``velocity``:
+        its x, y, z [m/s] and the foot's yaw rate [rad/s], or None), writing the rows of ``angles`` [rad] and
+        ``rates`` [rad/s] (6, n); returns the reach excess [m] (n,). In parts of tens of microseconds for the
+        straight leg (:func:`zmpwalk.leg_chain.straight.solve_flat_in_parts`), in one for any other chain."""
+        if self.straight is not None:
+            excess: Array = yield from straight_form.solve_flat_in_parts(self.straight, *position, yaw, velocity,
+                                                                         knee_forward, angles, rates)
+            return excess
+        yield
+        p = np.column_stack(position)
+        if velocity is None or rates is None:
+            solved, excess, _ = self.solve_flat(p, yaw, knee_forward=knee_forward)
+        else:
+            solved, excess, solved_rates = self.solve_flat(p, yaw, np.column_stack(velocity[:3]), velocity[3],
+                                                           knee_forward)
+            if solved_rates is not None:
+                rates[:] = solved_rates.T
+        angles[:] = solved.T
+        return excess
 
-    def _solve_numeric(self, p: Array, rotation: Array, start: Array | None = None) -> tuple[Array, Array]:
-        n = len(p)
-        q = np.broadcast_to(self.reference, (n, 6)).copy() if start is None else start.copy()
-        eye = np.eye(6)
-        error = np.zeros((n, 6))
-        for _ in range(IK_MAX_ITERATIONS):
-            position, current = self._fk_chain(q)
-            error[:, :3] = p - position
-            error[:, 3:] = _rotation_vector(rotation @ np.swapaxes(current, 1, 2))
-            norm = np.max(np.abs(error), axis=1)
-            active = norm > IK_TOLERANCE
-            if not active.any():
-                break
-            jacobian = self.jacobian(q[active])
-            jjt = jacobian @ np.swapaxes(jacobian, 1, 2) + IK_DAMPING**2 * eye
-            step = np.einsum("nji,nj->ni", jacobian, np.linalg.solve(jjt, error[active][..., None])[..., 0])
-            largest = np.max(np.abs(step), axis=1, keepdims=True)
-            q[active] += step * np.minimum(1.0, IK_MAX_STEP / np.maximum(largest, 1e-300))
-        position, current = self._fk_chain(q)
-        residual = np.linalg.norm(p - position, axis=1)
-        residual = np.maximum(residual, np.linalg.norm(_rotation_vector(rotation @ np.swapaxes(current, 1, 2)),
-                                                       axis=1))
-        excess = np.where(residual > 1e3 * IK_TOLERANCE, residual, -1.0)
-        return _wrap(q), excess
+    def solve_flat_one(self, ankle: tuple[float, float, float], yaw: float,
+                       knee_forward: bool = True) -> tuple[float, ...]:
+        """The six angles [rad] for one ankle position [m] with a flat sole of yaw ``yaw`` [rad] (pelvis frame):
+        plain ``math`` for the straight leg (a controller that solves one leg per tick), :meth:`solve_flat`
+        on one sample for any other chain.
 
-
-def _pick(solutions: list[tuple[Array, Array]], reference1: float, reference2: float) -> tuple[Array, Array]:
-    """The solution pair nearest the reference angles, per sample."""
-    cost = np.stack([np.abs(_wrap(a - reference1)) + np.abs(_wrap(b - reference2)) for a, b in solutions])
-    best = np.argmin(cost, axis=0)
-    first = np.where(best == 0, solutions[0][0], solutions[1][0])
-    second = np.where(best == 0, solutions[0][1], solutions[1][1])
-    return first, second
+        Raises:
+            UnreachableError: The ankle is out of the leg's reach (``time`` is nan).
+        """
+        if self.straight is not None:
+            return straight_form.solve_flat_one(self.straight, ankle, yaw, knee_forward, self.side)
+        angles, excess, _ = self.solve_flat(np.array([ankle]), np.array([yaw]), knee_forward=knee_forward)
+        if excess[0] > 0.0:
+            raise UnreachableError(self.label, float("nan"), float(excess[0]))
+        return tuple(float(angle) for angle in angles[0])
 
 
-def _rotation_vector(rotation: Array) -> Array:
-    """Axis times angle of rotations (n, 3, 3), (n, 3) (accurate near the identity and up to pi)."""
-    cos = np.clip((np.trace(rotation, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
-    angle = np.arccos(cos)
-    vee = 0.5 * np.stack([rotation[:, 2, 1] - rotation[:, 1, 2], rotation[:, 0, 2] - rotation[:, 2, 0],
-                          rotation[:, 1, 0] - rotation[:, 0, 1]], axis=-1)
-    sin = np.sin(angle)
-    scale = np.where(sin > 1e-9, angle / np.where(sin > 1e-9, sin, 1.0), 1.0 + angle * angle / 6.0)
-    return np.asarray(vee * scale[:, None], dtype=np.float64)
-
-
-__all__ = ["LegChain", "cross3"]
+__all__ = ["AXES_MEET_TOLERANCE", "LegChain"]
