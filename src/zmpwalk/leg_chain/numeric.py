@@ -16,14 +16,10 @@ a sample that does not converge is reported with its remaining error as the
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
+from zmpwalk.leg_chain.geometry import ChainGeometry
 from zmpwalk.leg_chain.rotations import Array, wrap
-
-if TYPE_CHECKING:
-    from zmpwalk.leg_chain.chain import LegChain
 
 IK_TOLERANCE = 1e-10  # [m] and [rad]: convergence of the numeric IK
 IK_MAX_ITERATIONS = 100
@@ -31,7 +27,7 @@ IK_DAMPING = 1e-6  # lambda of the damped least squares [-]
 IK_MAX_STEP = 0.3  # [rad] largest joint change of one iteration (keeps far targets from overshooting)
 
 
-def solve_numeric(chain: LegChain, p: Array, rotation: Array, start: Array | None = None) -> tuple[Array, Array]:
+def solve_numeric(chain: ChainGeometry, p: Array, rotation: Array, start: Array | None = None) -> tuple[Array, Array]:
     """Angles (n, 6) [rad] in chain order for ankle positions ``p`` (n, 3) [m] and the chain's own rotations
     (n, 3, 3), from ``start`` (n, 6) [rad] (default: the chain's reference angles), and per sample the remaining
     error where it did not converge [m] (> 0), else -1."""

@@ -24,17 +24,14 @@ branch it stands in.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 
+from zmpwalk.leg_chain.geometry import ChainGeometry
 from zmpwalk.leg_chain.rotations import Array, rodrigues, wrap
 
-if TYPE_CHECKING:
-    from zmpwalk.leg_chain.chain import LegChain
 
-
-def solve_closed(chain: LegChain, p: Array, rotation: Array) -> tuple[Array, Array]:
+def solve_closed(chain: ChainGeometry, p: Array, rotation: Array) -> tuple[Array, Array]:
     """Angles (n, 6) [rad] in chain order for ankle positions ``p`` (n, 3) [m] and the chain's own rotations
     ``g`` (n, 3, 3) (the sole's target turned back by :attr:`LegChain.sole_rotation`), and per sample how far
     the target is out of reach [m] (> 0 unreachable)."""

@@ -40,16 +40,14 @@ lengths (a robot file's leg) takes this closed form (:func:`recognise`).
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, NamedTuple
+from typing import NamedTuple
 
 import numpy as np
 
 from zmpwalk.errors import InvalidParameterError, UnreachableError
+from zmpwalk.leg_chain.geometry import ChainGeometry
 from zmpwalk.leg_chain.rotations import Array, rot_x, rot_y
 from zmpwalk.slices import Parts
-
-if TYPE_CHECKING:
-    from zmpwalk.leg_chain.chain import LegChain
 
 _EX, _EY, _EZ = np.eye(3)
 STRAIGHT_AXES = np.array([_EZ, _EX, _EY, _EY, _EY, _EX])  # hip yaw, roll, pitch, knee, ankle pitch, roll
@@ -71,7 +69,7 @@ class StraightLeg(NamedTuple):
     shank: float  # [m]
 
 
-def recognise(chain: LegChain) -> StraightLeg | None:
+def recognise(chain: ChainGeometry) -> StraightLeg | None:
     """The straight leg's parameters of a chain built from its link lengths (its
     :attr:`~zmpwalk.leg_chain.LegChain.link_lengths` set, :meth:`~zmpwalk.leg_chain.LegChain.from_lengths`),
     else None.
