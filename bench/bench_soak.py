@@ -29,7 +29,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from zmpwalk import OnlineWalker, StepCommand, load_robot
-from zmpwalk.footsteps import LEFT, Pose2D, Stance, plan_command
+from zmpwalk.footsteps import Pose2D, Stance, plan_command
+from zmpwalk.sides import Side
 from zmpwalk.schedule import Schedule
 
 PAGE = os.sysconf("SC_PAGE_SIZE")  # [B]
@@ -74,7 +75,7 @@ class Footsteps:
 
 def error_of(sample: object, foot: int, pose: Pose2D) -> tuple[float, float]:
     """Horizontal distance [m] and yaw difference [rad] of ``foot``'s ankle in ``sample`` from ``pose``."""
-    if foot == LEFT:
+    if foot == Side.LEFT:
         position, yaw = sample.position_left_ankle_in_world, sample.yaw_left_foot_in_world  # type: ignore[attr-defined]
     else:
         position, yaw = sample.position_right_ankle_in_world, sample.yaw_right_foot_in_world  # type: ignore[attr-defined]

@@ -21,14 +21,12 @@ from zmpwalk.curves import smoothstep5
 from zmpwalk.footsteps import Pose2D
 from zmpwalk.kinematics import hip_positions_in_world
 from zmpwalk.patterns.result import (
-    SUPPORT_DOUBLE,
-    SUPPORT_LEFT,
-    SUPPORT_RIGHT,
     StepRecord,
     SupportPhase,
     WalkingPattern,
 )
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.sides import Support
 
 Array = NDArray[np.float64]
 
@@ -112,8 +110,8 @@ def capture_pattern(plan: CaptureState, s: Array, settle: float, landing: Array)
     foot_position, foot_velocity = _feet(plan, s, landing)
     yaws, yaw_rates = _foot_yaws(plan, s)
     _crouch(robot, s, pelvis, pelvis_velocity, plan.pelvis_yaw, foot_position)
-    support = np.where(s < plan.swing_time, SUPPORT_LEFT if st == 0 else SUPPORT_RIGHT,
-                       SUPPORT_DOUBLE).astype(np.int8)
+    support = np.where(s < plan.swing_time, Support.LEFT if st == 0 else Support.RIGHT,
+                       Support.DOUBLE).astype(np.int8)
     steps, phases = _record(plan, landing, settle, int(support[0]))
     pattern = WalkingPattern(
         robot=robot, rate=plan.rate, generator="capture", time=plan.time + s, support=support,
@@ -210,7 +208,7 @@ def _record(plan: CaptureState, landing: Array, settle: float,
     sides = (1, -1)
     both = ((st_pose, sides[st]), (sw_pose, sides[sw])) if st == 0 else ((sw_pose, sides[sw]), (st_pose, sides[st]))
     phases = [SupportPhase(time, time + swing_time, single, ((st_pose, sides[st]),)),
-              SupportPhase(time + swing_time, math.inf, SUPPORT_DOUBLE, both)]
+              SupportPhase(time + swing_time, math.inf, Support.DOUBLE, both)]
     step = StepRecord(start=time, duration=swing_time, swing=("left", "right")[sw], kind="capture",
                       landing=(float(landing[0]), float(landing[1]), st_yaw),
                       parameters={"swing_time": swing_time, "settle": settle})

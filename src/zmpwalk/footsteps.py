@@ -30,9 +30,7 @@ from zmpwalk.commands import StepCommand
 from zmpwalk.errors import InvalidParameterError
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule, ShapeParameters
-
-LEFT = 1
-RIGHT = -1
+from zmpwalk.sides import Side
 
 
 @dataclass(frozen=True)
@@ -92,12 +90,12 @@ class Stance:
         return cls(Pose2D(0.0, half, 0.0), Pose2D(0.0, -half, 0.0), 0)
 
     def pose(self, foot: int) -> Pose2D:
-        return self.left if foot == LEFT else self.right
+        return self.left if foot == Side.LEFT else self.right
 
     def with_foot(self, foot: int, pose: Pose2D) -> Stance:
-        if foot == LEFT:
-            return Stance(pose, self.right, RIGHT)
-        return Stance(self.left, pose, LEFT)
+        if foot == Side.LEFT:
+            return Stance(pose, self.right, Side.RIGHT)
+        return Stance(self.left, pose, Side.LEFT)
 
 
 def landing_pose(support: Pose2D, swing: int, spacing: float, forward: float, opening: float,
@@ -125,12 +123,12 @@ def plan_command(
     spacing = robot.hip_spacing
     stages: list[StagePlan] = []
     if command.stop:
-        swing = stance.next_swing or LEFT
+        swing = stance.next_swing or Side.LEFT
         stages.append(_stage(stance, swing, spacing, 0.0, 0.0, 0.0, command, first, "stop"))
         landed = _after(stance, stages)
         stages.append(grounded_stage(landed, swing, command.duration, first, "settle"))
     elif not command.is_two_stage:
-        swing = stance.next_swing or LEFT
+        swing = stance.next_swing or Side.LEFT
         stages.append(_stage(stance, swing, spacing, command.forward, 0.0, 0.0, command, first, "step"))
     else:
         leading = command.leading_side
@@ -312,7 +310,7 @@ def _check_clearance(stage: StagePlan, robot: RobotModel, command: StepCommand) 
         else:
             hint = (f"the robot's soles ({robot.foot_width:g} m wide) do not fit side by side at its hip spacing "
                     f"({robot.hip_spacing:g} m)")
-        sole = "left" if stage.swing == LEFT else "right"
+        sole = Side(stage.swing).label
         raise InvalidParameterError(
             name, value,
             f"a step whose landing foot does not overlap the supporting foot (the {sole} sole would land on the "

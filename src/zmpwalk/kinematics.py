@@ -30,6 +30,7 @@ from zmpwalk.joint_limits import (  # re-exported (__all__): the columns and the
 from zmpwalk.leg_chain import LegChain
 from zmpwalk.leg_chain.rotations import rot_x, rot_y, rot_z  # re-exported (__all__)
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.sides import Side
 from zmpwalk.slices import Parts, whole
 
 Array = NDArray[np.float64]
@@ -62,7 +63,7 @@ def hip_positions_in_world(
     """Left and right hip joint centres in world [m], each (n, 3)."""
     c, s = np.cos(yaw_pelvis_in_world), np.sin(yaw_pelvis_in_world)
     result = []
-    for side in (1, -1):
+    for side in Side:
         x, y, z = robot.hip_in_pelvis(side)
         result.append(position_pelvis_in_world + np.column_stack([c * x - s * y, s * x + c * y, np.full_like(c, z)]))
     return result[0], result[1]
@@ -186,7 +187,7 @@ def joint_trajectory_in_parts(
             time, position_pelvis_in_world, (c, s), yaw_pelvis_in_world, velocity_pelvis_in_world, yaw_rate_pelvis,
             feet, robot, knee_forward)
     else:  # an imported robot's legs: angles from _base_under_com, rates from J q' = twist
-        for index, (side, (position, _, velocity, yaw_rate)) in enumerate(zip((1, -1), feet, strict=True)):
+        for index, (side, (position, _, velocity, yaw_rate)) in enumerate(zip(Side, feet, strict=True)):
             rel = position - position_pelvis_in_world
             v = velocity - velocity_pelvis_in_world  # relative velocity in the (rotating) pelvis frame
             v[:, 0] += yaw_rate_pelvis * rel[:, 1]
@@ -195,7 +196,7 @@ def joint_trajectory_in_parts(
                                      np.zeros(n), np.zeros(n), yaw_rate - yaw_rate_pelvis])
             chain = robot.legs[index]
             leg_angles, excess = solutions[index]
-            _check_reach(excess, time, "left" if side > 0 else "right",
+            _check_reach(excess, time, side.label,
                          "inverse kinematics, " + ("closed form" if chain.closed_form else "numeric"))
             rates = chain.joint_rates(leg_angles, twist)
             order = list(chain.role_order)
@@ -335,7 +336,7 @@ def leg_chains(robot: RobotModel) -> tuple[LegChain, LegChain]:
 def _straight_chain(robot: RobotModel, side: int) -> LegChain:
     """The robot file's left (``side = +1``) or right (-1) leg in the pelvis frame (a robot file has no
     :attr:`~zmpwalk.robots.model.RobotModel.com_offset`: its pattern's pelvis point is the pelvis origin)."""
-    label = "left" if side > 0 else "right"
+    label = Side(side).label
     limits = [robot.limits_of(f"{label}_{joint}") for joint in LEG_JOINTS]
     chain = LegChain.from_lengths(
         side, tuple(f"{label}_{joint}" for joint in LEG_JOINTS),

@@ -95,10 +95,11 @@ from zmpwalk.online_check import (
     row_scalars,
 )
 from zmpwalk.patterns.polynomial import first_sample_at
-from zmpwalk.patterns.result import SUPPORT_NAMES, check_rate
+from zmpwalk.patterns.result import check_rate
 from zmpwalk.patterns.stages import Boundary
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
+from zmpwalk.sides import SUPPORT_LABELS
 from zmpwalk.slices import UNFINISHED, run_for, run_to_end
 
 Array = NDArray[np.float64]
@@ -143,7 +144,7 @@ class WalkingSample:
     joint_velocities: Array | None = None
 
 
-_SUPPORT_OF_CODE = {float(code): name for code, name in enumerate(SUPPORT_NAMES)}
+_SUPPORT_OF_CODE = {float(code): name for code, name in enumerate(SUPPORT_LABELS)}
 _clock = time.perf_counter  # [s] the clock of the budget (a test replaces it with one that counts parts)
 WORK_BUDGET = 50e-6  # [s] a tick runs parts of a check while the next one is expected to end within this
 WORK_FRACTION = 0.01  # [-] ... or within this fraction of the control period, where that is longer (below 200 Hz)

@@ -23,9 +23,10 @@ from zmpwalk.patterns.polynomial import (
     plan_next,
     stage_support_phases,
 )
-from zmpwalk.patterns.result import SUPPORT_DOUBLE, SUPPORT_NAMES, SupportPhase
+from zmpwalk.patterns.result import SupportPhase
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import SWAY_RULE, Schedule
+from zmpwalk.sides import SUPPORT_LABELS, Support
 
 
 @dataclass(frozen=True)
@@ -68,7 +69,7 @@ def condition_margins(
         margin = pattern.zmp_margin()
         index = int(np.nanargmin(margin))
         results.append(ConditionMargin(mode, duration, stride, steps, float(margin[index]),
-                                       float(pattern.time[index]), SUPPORT_NAMES[int(pattern.support[index])]))
+                                       float(pattern.time[index]), SUPPORT_LABELS[int(pattern.support[index])]))
     return results
 
 
@@ -292,7 +293,7 @@ def _sway(walk: _OwnedStages, k: int, time: float, margin: float, robot: RobotMo
     if abs(per_sway) > 1e-9:
         changes.append(_change(walk.label(k), "sway", sway, push / per_sway))
     changes.extend(_step_time(walk, k, schedule, robot, (zmp, push), (a, a2, b, b2, tau, slope)))
-    crossing = support == SUPPORT_DOUBLE and (s < 0.5) == outgoing  # the pelvis near the middle, both feet down
+    crossing = support == Support.DOUBLE and (s < 0.5) == outgoing  # the pelvis near the middle, both feet down
     return "crossing" if crossing else "sway", zmp, changes
 
 
@@ -331,7 +332,7 @@ def _sagittal(stage: Stage, time: float, zmp: NDArray[np.float64], margin: float
     scaling the stride by ``(d + margin) / d`` brings it back (to first order: the soles do not scale)."""
     plan = stage.plan
     reference = np.array([plan.support_pose.x, plan.support_pose.y])
-    if support == SUPPORT_DOUBLE:
+    if support == Support.DOUBLE:
         other = plan.swing_start if time < stage.start + stage.dsp_time / 2 else plan.swing_end
         reference = (reference + np.array([other.x, other.y])) / 2.0
     yaw = plan.support_pose.yaw

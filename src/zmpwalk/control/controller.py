@@ -36,11 +36,11 @@ from zmpwalk.errors import InvalidParameterError, ZmpwalkError
 from zmpwalk.online import OnlineWalker, WalkingSample
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
+from zmpwalk.sides import SUPPORT_OF_LABEL
 from zmpwalk.stabilizer_gains import StabilizerGains
 
 Array = NDArray[np.float64]
 
-SUPPORT_CODES = {"double": 0, "left": 1, "right": 2}  # a sample's support as the stabilizer takes it
 VELOCITY_FIELDS = {"forward": "vx", "side": "vy", "turn": "wz"}  # a step's stride field -> its velocity
 
 
@@ -285,7 +285,7 @@ class WalkingController:
             return None
         try:
             targets = stabilizer.update(
-                support=SUPPORT_CODES[sample.support], position_com_in_world=sample.position_pelvis_in_world,
+                support=SUPPORT_OF_LABEL[sample.support], position_com_in_world=sample.position_pelvis_in_world,
                 yaw_pelvis_in_world=sample.yaw_pelvis_in_world, zmp_in_world=sample.zmp_in_world,
                 ankles_in_world=(sample.position_left_ankle_in_world, sample.position_right_ankle_in_world),
                 foot_yaws=(sample.yaw_left_foot_in_world, sample.yaw_right_foot_in_world), joint_angles=angles,

@@ -63,6 +63,7 @@ from zmpwalk.leg_chain.numeric import solve_numeric
 from zmpwalk.leg_chain.paden_kahan import solve_closed
 from zmpwalk.leg_chain.rotations import Array, cross3, rot_z
 from zmpwalk.leg_chain.straight import StraightLeg
+from zmpwalk.sides import Side
 from zmpwalk.slices import Parts, run_to_end
 
 AXES_MEET_TOLERANCE = 1e-6  # [m] axes closer than this meet (closed form applies)
@@ -168,7 +169,7 @@ class LegChain:
 
     @property
     def label(self) -> str:
-        return "left" if self.side > 0 else "right"
+        return Side(self.side).label
 
     @property
     def hip(self) -> Array:

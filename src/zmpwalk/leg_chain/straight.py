@@ -47,6 +47,7 @@ import numpy as np
 from zmpwalk.errors import InvalidParameterError, UnreachableError
 from zmpwalk.leg_chain.geometry import ChainGeometry
 from zmpwalk.leg_chain.rotations import Array, rot_x, rot_y
+from zmpwalk.sides import Side
 from zmpwalk.slices import Parts
 
 _EX, _EY, _EZ = np.eye(3)
@@ -230,7 +231,7 @@ def solve_flat_one(leg: StraightLeg, ankle: tuple[float, float, float], foot_yaw
     distance = math.sqrt(rx * rx + ry * ry + rz * rz)
     if distance > a + b or distance < abs(a - b):
         excess = max(distance - a - b, abs(a - b) - distance)
-        raise UnreachableError("left" if side > 0 else "right", math.nan, excess)
+        raise UnreachableError(Side(side).label, math.nan, excess)
     q4 = math.acos(max(-1.0, min(1.0, (distance * distance - a * a - b * b) / (2 * a * b))))
     if not knee_forward:
         q4 = -q4

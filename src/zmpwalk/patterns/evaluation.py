@@ -20,10 +20,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk import curves
-from zmpwalk.footsteps import LEFT, StagePlan
+from zmpwalk.footsteps import StagePlan
 from zmpwalk.patterns.lipm_stage import LipmColumns, LipmPelvis
-from zmpwalk.patterns.result import SUPPORT_DOUBLE, SUPPORT_LEFT, SUPPORT_RIGHT
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.sides import Side, Support
 from zmpwalk.slices import Parts, run_to_end, whole
 
 Array = NDArray[np.float64]
@@ -159,7 +159,7 @@ class StageTable:
          self.base0_x, self.base0_y, self.sag_x, self.sag_y, self.lat_x, self.lat_y, self.m0_x, self.m0_y,
          self.m1_x, self.m1_y, self.n_x, self.n_y, self.amp, self.w0, self.w1, self.out_time,
          self.back_time) = numbers
-        flags = np.array([(p.swing == LEFT, s.standing, s.grounded, s.quintic, s.lipm is not None)
+        flags = np.array([(p.swing == Side.LEFT, s.standing, s.grounded, s.quintic, s.lipm is not None)
                           for s, p in zip(stages, plans, strict=True)], dtype=bool).reshape(len(stages), 5).T.copy()
         self.swing_left, self.standing, self.grounded, self.quintic, self.hyperbolic = flags
         self.lat_profile = np.array([s.lateral_profile for s in stages])
@@ -372,7 +372,7 @@ def _feet_in_parts(table: StageTable, k: NDArray[np.intp], n: int, swing: tuple[
     right_yaw = np.where(left_swings, support_yaw, swing_yaw)
     left_rate = swing_yaw_rate * left_swings
     right_rate = swing_yaw_rate * right_swings
-    support = np.where(in_swing, np.where(left_swings, SUPPORT_RIGHT, SUPPORT_LEFT), SUPPORT_DOUBLE)
+    support = np.where(in_swing, np.where(left_swings, Support.RIGHT, Support.LEFT), Support.DOUBLE)
     return support, (left_position, left_velocity, left_yaw, left_rate), (right_position, right_velocity,
                                                                           right_yaw, right_rate)
 

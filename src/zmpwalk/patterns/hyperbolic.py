@@ -51,7 +51,7 @@ from numpy.typing import NDArray
 
 from zmpwalk import curves
 from zmpwalk.errors import InfeasiblePatternError
-from zmpwalk.footsteps import LEFT, RIGHT, Pose2D, foot_corners
+from zmpwalk.footsteps import Pose2D, foot_corners
 from zmpwalk.patterns.pendulum import COAST as COAST  # the pendulum's pieces, where the paper's walk is
 from zmpwalk.patterns.pendulum import Piece as Piece
 from zmpwalk.patterns.pendulum import SteadyStep as SteadyStep
@@ -64,15 +64,13 @@ from zmpwalk.patterns.pendulum import solve_zmps as solve_zmps
 from zmpwalk.patterns.pendulum import steady_step as steady_step
 from zmpwalk.patterns.pendulum import transient_zmps as transient_zmps
 from zmpwalk.patterns.result import (
-    SUPPORT_DOUBLE,
-    SUPPORT_LEFT,
-    SUPPORT_RIGHT,
     StepRecord,
     SupportPhase,
     WalkingPattern,
     sample_times,
 )
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.sides import Side, Support
 from zmpwalk.zmp import convex_hull, signed_margin
 
 Array = NDArray[np.float64]
@@ -230,45 +228,44 @@ class HyperbolicWalk:
         self.stop_zmps: tuple[tuple[float, float], tuple[float, float]] | None = None
         self._build(start, stop)
 
-    def _pose(self, feet: dict[int, float], foot: int) -> tuple[Pose2D, int]:
+    def _pose(self, feet: dict[Side, float], foot: Side) -> tuple[Pose2D, int]:
         return Pose2D(feet[foot], foot * self.y_foot, 0.0), foot
 
-    def _double(self, feet: dict[int, float], duration: float) -> None:
+    def _double(self, feet: dict[Side, float], duration: float) -> None:
         t = self.x_axis.t
-        self.phases.append(SupportPhase(t, t + duration, SUPPORT_DOUBLE,
-                                        (self._pose(feet, LEFT), self._pose(feet, RIGHT))))
+        self.phases.append(SupportPhase(t, t + duration, Support.DOUBLE,
+                                        (self._pose(feet, Side.LEFT), self._pose(feet, Side.RIGHT))))
 
-    def _single(self, feet: dict[int, float], support: int, duration: float, landing: float, kind: str) -> None:
+    def _single(self, feet: dict[Side, float], support: Side, duration: float, landing: float, kind: str) -> None:
         t = self.x_axis.t
-        swing = -support
-        code = SUPPORT_LEFT if support == LEFT else SUPPORT_RIGHT
-        self.phases.append(SupportPhase(t, t + duration, code, (self._pose(feet, support),)))
+        swing = support.other
+        self.phases.append(SupportPhase(t, t + duration, support.single_support, (self._pose(feet, support),)))
         self.swings.append(_Swing(t, duration, swing, feet[swing], landing))
-        self.records.append(StepRecord(t, duration, "left" if swing == LEFT else "right", kind,
+        self.records.append(StepRecord(t, duration, swing.label, kind,
                                        (landing, swing * self.y_foot, 0.0), {}))
         feet[swing] = landing
 
     def _build(self, start: tuple[float, float], stop: tuple[float, float] | None) -> None:
         a, X, Y = self.a, self.x_axis, self.y_axis
         first = self.steps[0]
-        feet = {LEFT: 0.0, RIGHT: 0.0}  # ankle x of each foot
+        feet = {Side.LEFT: 0.0, Side.RIGHT: 0.0}  # ankle x of each foot
         t_star, tau_star = start
         # Start (Eqs. 12-15): shift the body towards the left foot, then swing the right one by x_s/2.
         xd, xs = transient_zmps(a, t_star, tau_star, first.end, first.v_double)
         yd, ys = transient_zmps(a, t_star, tau_star, first.y0, -first.v_y)
         self.start_zmps = ((xd, yd), (xs, ys))
         self._check_zmp("start", "double", (xd, yd), feet, None)
-        self._check_zmp("start", "single", (xs, ys), feet, LEFT)
+        self._check_zmp("start", "single", (xs, ys), feet, Side.LEFT)
         self._double(feet, t_star)
         X.hold_zmp(t_star, xd)  # Eq. 12
         Y.hold_zmp(t_star, yd)
-        self._single(feet, LEFT, tau_star, feet[LEFT] + first.stride / 2, "start")
+        self._single(feet, Side.LEFT, tau_star, feet[Side.LEFT] + first.stride / 2, "start")
         X.hold_zmp(tau_star, xs)  # Eq. 13
         Y.hold_zmp(tau_star, ys)
-        support = RIGHT
+        support = Side.RIGHT
         for step in self.steps[1:]:
             self._steady(step, feet, support)
-            support = -support
+            support = support.other
         if stop is None:
             return
         # Stop: the start reversed in time; the body comes to rest above the middle of the feet.
@@ -292,7 +289,7 @@ class HyperbolicWalk:
         X.hold_zmp(t_star, zmp_double[0])
         Y.hold_zmp(t_star, zmp_double[1])
 
-    def _steady(self, step: SteadyStep, feet: dict[int, float], support: int) -> None:
+    def _steady(self, step: SteadyStep, feet: dict[Side, float], support: Side) -> None:
         """Double support at constant speed (Eq. 7b), then the single support of Fig. 3.
 
         The single-support ZMPs of intervals I and III are solved so that the body ends in this
@@ -313,11 +310,11 @@ class HyperbolicWalk:
         X.hold_zmp(step.t3, zmp2)  # interval III, Eq. 9
         Y.hold_zmp(step.t5, support * step.y_zmp)  # Eq. 10
 
-    def _check_zmp(self, which: str, phase: str, point: tuple[float, float], feet: dict[int, float],
-                   support: int | None) -> None:
+    def _check_zmp(self, which: str, phase: str, point: tuple[float, float], feet: dict[Side, float],
+                   support: Side | None) -> None:
         """A transient ZMP must lie in its support polygon (the check the paper leaves to the user)."""
         if support is None:
-            polygon = convex_hull(np.vstack([foot_corners(*self._pose(feet, f), self.robot) for f in (LEFT, RIGHT)]))
+            polygon = convex_hull(np.vstack([foot_corners(*self._pose(feet, f), self.robot) for f in Side]))
         else:
             polygon = foot_corners(*self._pose(feet, support), self.robot)
         margin = float(signed_margin(np.array([point]), polygon)[0])
@@ -358,12 +355,12 @@ class HyperbolicWalk:
         x, vx, ax = self.x_axis.evaluate(time)
         y, vy, ay = self.y_axis.evaluate(time)
         n = len(time)
-        left, v_left = self.feet_at(time, LEFT)
-        right, v_right = self.feet_at(time, RIGHT)
+        left, v_left = self.feet_at(time, Side.LEFT)
+        right, v_right = self.feet_at(time, Side.RIGHT)
         begins = np.array([p.begin for p in self.phases])
         which = np.clip(np.searchsorted(begins, time, side="right") - 1, 0, len(begins) - 1)
         support = np.array([p.support for p in self.phases], dtype=np.int8)[which]
-        support[time >= self.duration] = SUPPORT_DOUBLE
+        support[time >= self.duration] = Support.DOUBLE
         zeros = np.zeros(n)
         a2 = self.a * self.a
         return WalkingPattern(

@@ -17,7 +17,7 @@ import numpy as np
 
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import UnreachableError, ZmpwalkError
-from zmpwalk.footsteps import LEFT, StagePlan, Stance, grounded_stage, plan_command
+from zmpwalk.footsteps import StagePlan, Stance, grounded_stage, plan_command
 from zmpwalk.kinematics import check_leg_reach
 from zmpwalk.patterns.evaluation import StageTable, evaluate
 from zmpwalk.patterns.pelvis_model import PelvisModel, pelvis_model
@@ -25,6 +25,7 @@ from zmpwalk.patterns.stages import Boundary, Stage, standing_stage
 from zmpwalk.patterns.stride_search import STRIDE_CAUSES, infeasible_command, step_time_rejection
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
+from zmpwalk.sides import Side
 from zmpwalk.slices import ALONE, Parts, whole
 
 REACH_CHECK_POINTS = 25  # samples per stage at which the leg reach is checked
@@ -206,4 +207,4 @@ class _Walk:
 
 def _standing_plan(stance: Stance, robot: RobotModel, schedule: Schedule) -> StagePlan:
     parameters, _ = schedule.stage_parameters(StepCommand(duration=1.0), robot)
-    return StagePlan(LEFT, stance.right, stance.left, stance.left, 0.0, 1.0, parameters, True, "stand")
+    return StagePlan(Side.LEFT, stance.right, stance.left, stance.left, 0.0, 1.0, parameters, True, "stand")

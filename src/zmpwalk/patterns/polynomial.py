@@ -18,7 +18,6 @@ from numpy.typing import NDArray
 
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import InvalidParameterError
-from zmpwalk.footsteps import LEFT
 from zmpwalk.patterns.evaluation import Samples as Samples  # re-exported: other modules import these here
 from zmpwalk.patterns.evaluation import StageTable as StageTable
 from zmpwalk.patterns.evaluation import evaluate as evaluate
@@ -56,6 +55,7 @@ from zmpwalk.patterns.stride_search import names_stride as names_stride
 from zmpwalk.patterns.stride_search import step_time_rejection as step_time_rejection
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
+from zmpwalk.sides import Side
 
 Array = NDArray[np.float64]
 
@@ -168,7 +168,7 @@ def pattern_from_samples(
             plan = stage.plan
             parameters: dict[str, float | str] = dict(vars(plan.parameters))
             steps.append(StepRecord(
-                start=stage.start, duration=stage.duration, swing="left" if plan.swing == LEFT else "right",
+                start=stage.start, duration=stage.duration, swing=Side(plan.swing).label,
                 kind=plan.kind, landing=(plan.swing_end.x, plan.swing_end.y, plan.swing_end.yaw),
                 parameters=parameters,
             ))

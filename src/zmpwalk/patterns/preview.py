@@ -36,9 +36,10 @@ from numpy.typing import NDArray
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import InvalidParameterError
 from zmpwalk.patterns.polynomial import generate
-from zmpwalk.patterns.result import SUPPORT_DOUBLE, WalkingPattern
+from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
+from zmpwalk.sides import Support
 
 Array = NDArray[np.float64]
 
@@ -185,7 +186,7 @@ def zmp_reference(pattern: WalkingPattern, hold: float = 0.0) -> Array:
     anchors_t += [float(pattern.time[0]), max(float(pattern.time[0]), hold)]
     anchors_p += [middle(first.feet), middle(first.feet)]
     for phase in phases:
-        if phase.support == SUPPORT_DOUBLE:
+        if phase.support == Support.DOUBLE:
             continue
         pose, side = phase.feet[0]
         centre = sole_centre(pose, side)

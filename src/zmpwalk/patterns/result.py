@@ -19,12 +19,11 @@ from zmpwalk.errors import InvalidParameterError
 from zmpwalk.files import atomic_output
 from zmpwalk.footsteps import Pose2D, foot_corners, sole_corners
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.sides import SUPPORT_LABELS
 from zmpwalk.zmp import convex_hull, edge_margin, hull_edges
 
 Array = NDArray[np.float64]
 
-SUPPORT_DOUBLE, SUPPORT_LEFT, SUPPORT_RIGHT = 0, 1, 2  # codes of WalkingPattern.support
-SUPPORT_NAMES = ("double", "left", "right")  # indexed by the codes
 MARGIN_CHUNK = 2048  # support phases whose ZMP margins are computed in one vectorised pass
 PHASE_TIME_TOL = 1e-9  # [s] a sample this close to a phase change is at it (times are rounded sums)
 
@@ -224,7 +223,7 @@ class WalkingPattern:
         p, pl, pr = self.position_pelvis_in_world, self.position_left_ankle_in_world, self.position_right_ankle_in_world
         return {
             "t": self.time,
-            "support": np.array(SUPPORT_NAMES)[self.support],
+            "support": np.array(SUPPORT_LABELS)[self.support],
             "pelvis_x": p[:, 0], "pelvis_y": p[:, 1], "pelvis_z": p[:, 2], "pelvis_yaw": self.yaw_pelvis_in_world,
             "left_x": pl[:, 0], "left_y": pl[:, 1], "left_z": pl[:, 2], "left_yaw": self.yaw_left_foot_in_world,
             "right_x": pr[:, 0], "right_y": pr[:, 1], "right_z": pr[:, 2], "right_yaw": self.yaw_right_foot_in_world,

@@ -49,7 +49,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from zmpwalk.footsteps import GROUNDED_STRETCH, LEFT, Pose2D, StagePlan
+from zmpwalk.footsteps import GROUNDED_STRETCH, Pose2D, StagePlan
 from zmpwalk.patterns.evaluation import (
     QUINTIC_SHIFT_END_RATES,
     SHIFT_END_RATES,
@@ -57,8 +57,8 @@ from zmpwalk.patterns.evaluation import (
     SHIFT_PROFILES,
 )
 from zmpwalk.patterns.lipm_stage import LipmPelvis
-from zmpwalk.patterns.result import SUPPORT_DOUBLE, SUPPORT_LEFT, SUPPORT_RIGHT
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.sides import Side, Support
 from zmpwalk.slices import Parts
 
 Array = NDArray[np.float64]
@@ -128,7 +128,7 @@ def build_stage(plan: StagePlan, boundary: Boundary, quintic: bool = False) -> S
     T = plan.duration
     support = plan.support_pose
     nx, ny = -math.sin(support.yaw), math.cos(support.yaw)  # unit vector across the support foot
-    toward_support = 1.0 if plan.swing != LEFT else -1.0  # support is left when the right foot swings
+    toward_support = 1.0 if plan.swing != Side.LEFT else -1.0  # support is left when the right foot swings
     out_time, back_time = sway_times(plan)
     half_time_scale = back_time  # [s] per unit of 2*t_bar of the returning cubic
     v_prev_x, v_prev_y = boundary.pelvis_velocity
@@ -228,14 +228,14 @@ def stage_support_phases(stage: Stage) -> list[tuple[float, float, int, tuple[Po
     plan = stage.plan
     if stage.grounded:
         end = math.inf if stage.standing else stage.stop_time
-        return [(stage.start, end, SUPPORT_DOUBLE, (plan.support_pose, plan.swing_start))]
+        return [(stage.start, end, Support.DOUBLE, (plan.support_pose, plan.swing_start))]
     t1 = stage.start
     half = stage.dsp_time / 2
-    single = SUPPORT_RIGHT if plan.swing == LEFT else SUPPORT_LEFT
+    single = Support.RIGHT if plan.swing == Side.LEFT else Support.LEFT
     return [
-        (t1, t1 + half, SUPPORT_DOUBLE, (plan.support_pose, plan.swing_start)),
+        (t1, t1 + half, Support.DOUBLE, (plan.support_pose, plan.swing_start)),
         (t1 + half, stage.stop_time - half, single, (plan.support_pose,)),
-        (stage.stop_time - half, stage.stop_time, SUPPORT_DOUBLE, (plan.support_pose, plan.swing_end)),
+        (stage.stop_time - half, stage.stop_time, Support.DOUBLE, (plan.support_pose, plan.swing_end)),
     ]
 
 

@@ -59,6 +59,7 @@ from zmpwalk.robots.collision import Sole, foot_sole
 from zmpwalk.robots.description import LegJoint
 from zmpwalk.robots.pd import element_name, joint_actuator
 from zmpwalk.robots.tree import body_path, joint_path
+from zmpwalk.sides import Side
 
 Array = NDArray[np.float64]
 
@@ -179,7 +180,7 @@ def build_leg(model: object, data: object, side: int, foot: int, leg: list[int],
     import mujoco
 
     m, d = model, data
-    label = "left" if side > 0 else "right"
+    label = Side(side).label
     names = [element_name(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in leg]
     axes = np.array([base_rotation.T @ d.xaxis[j] for j in leg])  # type: ignore[attr-defined]
     points = np.array([in_pelvis(d.xanchor[j]) for j in leg])  # type: ignore[attr-defined]

@@ -28,12 +28,12 @@ from numpy.typing import NDArray
 
 from zmpwalk.commands import StepCommand
 from zmpwalk.control import JointTargets, WalkingController
-from zmpwalk.control.controller import SUPPORT_CODES
 from zmpwalk.errors import InvalidParameterError, ZmpwalkError
 from zmpwalk.footsteps import sole_corners
 from zmpwalk.kinematics import JOINT_COLUMNS
 from zmpwalk.online import START_DELAY, OnlineWalker
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.sides import SUPPORT_OF_LABEL
 from zmpwalk.sim.disturbances import Disturbances
 from zmpwalk.sim.measure import AFTER_FALL
 from zmpwalk.sim.mujoco_plant import MujocoPlant
@@ -117,7 +117,7 @@ class _Log:
         self.zmp[k] = sample.zmp_in_world
         self.ankles[k] = (sample.position_left_ankle_in_world, sample.position_right_ankle_in_world)
         self.yaws[k] = (sample.yaw_left_foot_in_world, sample.yaw_right_foot_in_world)
-        self.support[k] = SUPPORT_CODES[sample.support]
+        self.support[k] = SUPPORT_OF_LABEL[sample.support]
         self.walking[k] = controller.walker.walking
         if self.torques is not None and targets.torques is not None:
             self.torques[k] = targets.torques

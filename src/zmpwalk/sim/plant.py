@@ -41,6 +41,7 @@ from zmpwalk.robots.description import PHYSICS_STEP, ModelPlant
 from zmpwalk.robots.imported import load_model_spec
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.robots.pd import is_position_servo
+from zmpwalk.sides import Support
 
 Array = NDArray[np.float64]
 
@@ -376,9 +377,9 @@ def _servo_torques(plant: Plant, qpos: Array, zmp: Array, support: NDArray[np.in
             com = data.subtree_com[0]
             com_acceleration = gravity / max(float(com[2]), 1e-6) * (com[:2] - zmp[k])
         left, right = ankles[0][k, :2], ankles[1][k, :2]
-        if support[k] == 1:
+        if support[k] == Support.LEFT:
             shares = (1.0, 0.0)
-        elif support[k] == 2:
+        elif support[k] == Support.RIGHT:
             shares = (0.0, 1.0)
         else:
             span = right - left

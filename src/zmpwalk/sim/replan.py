@@ -17,6 +17,7 @@ from zmpwalk.capture import CapturePlan, CaptureSettings, capture_step
 from zmpwalk.kinematics import pattern_joint_trajectory
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.sides import Side, Support
 from zmpwalk.sim.plant import Plant
 from zmpwalk.sim.references import CONTROL_RATE, rows_at, servo_controls, tracked_references
 
@@ -53,8 +54,8 @@ class CaptureReplanner:
 
         position_com, velocity_com = sample(source.position_pelvis_in_world), sample(source.velocity_pelvis_in_world)
         dcm = position_com[:2] + velocity_com[:2] / stabilizer.omega + stabilizer.state.dcm_error
-        stance = "left" if stance_support == 1 else "right"
-        swing = "right" if stance == "left" else "left"
+        stance_side = Side.LEFT if stance_support == Support.LEFT else Side.RIGHT
+        stance, swing = stance_side.label, stance_side.other.label
         ankles = [sample(a) for a in (source.position_left_ankle_in_world, source.position_right_ankle_in_world)]
         rates = [sample(v) for v in (source.velocity_left_ankle_in_world, source.velocity_right_ankle_in_world)]
         ankles[0 if swing == "left" else 1][:2] += stabilizer.landing_correction(swing)

@@ -24,7 +24,7 @@ import numpy as np
 from numba import njit
 
 from zmpwalk.stabilizer.freshness import BUILD_KEY
-from zmpwalk.stabilizer.layout import P, S
+from zmpwalk.stabilizer.layout import LEFT_SUPPORT, RIGHT_SUPPORT, P, S
 from zmpwalk.stabilizer.rotations import clip, rotate2, rotate3, rotate3_back
 
 AIRBORNE_AIM = 0.02  # [s] a sole the plan has down that has carried no load this long keeps its landing aim
@@ -99,7 +99,7 @@ def landing_and_stepping(params: np.ndarray, state: np.ndarray, rot: np.ndarray,
     yaw_aim = clip(turn_yaw, params[P.landing_yaw_limit])
     for foot in range(2):
         o = S.landing + 2 * foot
-        swinging = (support == 1 and foot == 1) or (support == 2 and foot == 0)
+        swinging = (support == LEFT_SUPPORT and foot == 1) or (support == RIGHT_SUPPORT and foot == 0)
         loaded = loaded0 if foot == 0 else loaded1
         state[S.airborne + foot] = 0.0 if loaded else state[S.airborne + foot] + dt
         # a sole the plan has put down that has not touched down yet (a late touchdown) keeps aiming

@@ -23,7 +23,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk.errors import InvalidParameterError
+from zmpwalk.sides import Support
 from zmpwalk.stabilizer_gains import StabilizerGains
+
+# The pattern's support codes as plain integers, the constants the compiled loops compare with
+DOUBLE_SUPPORT, LEFT_SUPPORT, RIGHT_SUPPORT = int(Support.DOUBLE), int(Support.LEFT), int(Support.RIGHT)
 
 Fields = tuple[tuple[str, int], ...]
 

@@ -23,7 +23,7 @@ import numpy as np
 from numba import njit
 
 from zmpwalk.stabilizer.freshness import BUILD_KEY
-from zmpwalk.stabilizer.layout import L, P, S
+from zmpwalk.stabilizer.layout import DOUBLE_SUPPORT, LEFT_SUPPORT, RIGHT_SUPPORT, L, P, S
 from zmpwalk.stabilizer.leg import com_in_base
 from zmpwalk.stabilizer.rotations import clip, rotate2
 
@@ -52,8 +52,8 @@ def clamp_zmp(params: np.ndarray, zx: float, zy: float, support: int, c0x: float
     given by their centres ``c0``, ``c1`` in world [m] and yaws [rad]."""
     margin = params[P.zmp_margin]
     lx, ly = max(params[P.half_length] - margin, 0.0), max(params[P.half_width] - margin, 0.0)
-    if support == 1 or support == 2:
-        cx, cy, yaw = (c0x, c0y, yaw_left) if support == 1 else (c1x, c1y, yaw_right)
+    if support in (LEFT_SUPPORT, RIGHT_SUPPORT):
+        cx, cy, yaw = (c0x, c0y, yaw_left) if support == LEFT_SUPPORT else (c1x, c1y, yaw_right)
         local_x, local_y = rotate2(zx - cx, zy - cy, -yaw)
         bx, by = rotate2(min(max(local_x, -lx), lx), min(max(local_y, -ly), ly), yaw)
         return cx + bx, cy + by
@@ -128,9 +128,9 @@ def distribute(zx: float, zy: float, support: int, c0x: float, c0y: float, c1x: 
                c1y: float) -> tuple[float, float, float, float, float, float]:
     """Load shares of the feet and each sole's CoP target [m] for a desired ZMP, given the soles' centres in world
     [m]: (share left, share right, target left x, y, target right x, y)."""
-    if support == 1:
+    if support == LEFT_SUPPORT:
         return 1.0, 0.0, zx, zy, c1x, c1y
-    if support == 2:
+    if support == RIGHT_SUPPORT:
         return 0.0, 1.0, c0x, c0y, zx, zy
     sx, sy = c1x - c0x, c1y - c0y
     ratio = min(max(((zx - c0x) * sx + (zy - c0y) * sy) / max(sx * sx + sy * sy, 1e-12), 0.0), 1.0)
@@ -179,16 +179,16 @@ def foot_force_difference(params: np.ndarray, state: np.ndarray, log: np.ndarray
     [m] (left lowered, right raised by half of it)."""
     dt = params[P.dt]
     weight = f0 + f1
-    if support == 0:
+    if support == DOUBLE_SUPPORT:
         state[S.lifted] = state[S.lifted + 1] = 0.0
-    elif support == 1 and not loaded1:
+    elif support == LEFT_SUPPORT and not loaded1:
         state[S.lifted + 1] = 1.0
-    elif support == 2 and not loaded0:
+    elif support == RIGHT_SUPPORT and not loaded0:
         state[S.lifted] = 1.0
     # the swinging sole touches down early: it carries load after it has lifted (not while it lifts)
-    early = (support == 1 and loaded1 and state[S.lifted + 1] > 0.0) or (support == 2 and loaded0
-                                                                          and state[S.lifted] > 0.0)
-    if (early or (support == 0 and (loaded0 or loaded1))) and weight > 0:
+    early = ((support == LEFT_SUPPORT and loaded1 and state[S.lifted + 1] > 0.0)
+             or (support == RIGHT_SUPPORT and loaded0 and state[S.lifted] > 0.0))
+    if (early or (support == DOUBLE_SUPPORT and (loaded0 or loaded1))) and weight > 0:
         wanted = (share0 - share1) * weight
         rate_gain = params[P.force_gain] if loaded0 and loaded1 and not early else params[P.touchdown_speed]
         state[S.height] += dt * rate_gain * (wanted - (f0 - f1)) / weight
