@@ -30,8 +30,8 @@ import numpy as np
 
 from zmpwalk import OnlineWalker, StepCommand, load_robot
 from zmpwalk.footsteps import Pose2D, Stance, plan_command
-from zmpwalk.sides import Side
 from zmpwalk.schedule import Schedule
+from zmpwalk.sides import Side
 
 PAGE = os.sysconf("SC_PAGE_SIZE")  # [B]
 PLAIN = StepCommand(duration=0.8, forward=0.1)

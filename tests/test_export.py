@@ -1,4 +1,4 @@
-"""zmpwalk export: reference motions in mjlab, LocoMuJoCo, AMP and CSV formats, each replayed and checked.
+"""zmpwalk export: reference motions in mjlab, LocoMuJoCo, AMP, CSV and ROS 2 bag formats, each replayed and checked.
 
 One export (HUBO's box model, one command, six swings at 0.7 s: about 10 s) is shared by the tests.
 """
@@ -56,8 +56,8 @@ def test_manifest_lists_four_verified_clips(exported: tuple[Path, dict[str, Any]
         assert clip["command"] == {"forward": 0.15, "side": 0.0, "turn": 0.0, "step_time": 0.7}
         assert clip["replay"]["slide"] <= MAX_SLIDE and clip["replay"]["penetration"] <= MAX_PENETRATION
         assert clip["cop_rms"] == pytest.approx(0.015, abs=0.015) and clip["zmp_margin"] > 0.0
-        assert set(clip["files"]) == {"mjlab", "locomujoco", "amp", "csv"}
-        assert all((out / name).is_file() for name in clip["files"].values())
+        assert set(clip["files"]) == {"mjlab", "locomujoco", "amp", "csv", "ros2bag"}
+        assert all((out / name).exists() for name in clip["files"].values())
 
 
 def test_cyclic_clip_closes_its_loop(exported: tuple[Path, dict[str, Any]]) -> None:
@@ -162,3 +162,46 @@ def test_locomujoco_loads_the_clip(exported: tuple[Path, dict[str, Any]]) -> Non
     clip = _clip(manifest, "simulated", "cyclic")
     loaded = trajectory.Trajectory.load(str(out / clip["files"]["locomujoco"]), backend=np)
     assert loaded.info.frequency == FPS and loaded.data.qpos.shape[0] == clip["frames"]
+
+
+def test_ros2_bag_topics_read_by_rosbags(exported: tuple[Path, dict[str, Any]], model: mujoco.MjModel) -> None:
+    """The bag opens with rosbags' own reader: MCAP storage, joint states by the model's names at the frame rate,
+    the base and both feet in /tf matching the clip, the ZMP every frame, the CoP and footprints on the floor."""
+    from rosbags.rosbag2 import Reader
+    from rosbags.typesys import Stores, get_typestore
+
+    from zmpwalk.export.amp import read_amp
+
+    out, manifest = exported
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    clip = _clip(manifest, "simulated", "whole")
+    qpos, _ = read_amp(str(out / clip["files"]["amp"]))
+    bag = out / clip["files"]["ros2bag"]
+    assert (bag / "metadata.yaml").is_file() and len(list(bag.glob("*.mcap"))) == 1
+    with Reader(bag) as reader:
+        assert {c.topic: c.msgtype for c in reader.connections} == {
+            "/joint_states": "sensor_msgs/msg/JointState", "/tf": "tf2_msgs/msg/TFMessage",
+            "/zmpwalk/markers": "visualization_msgs/msg/MarkerArray"}
+        messages: dict[str, list[tuple[int, Any]]] = {"/joint_states": [], "/tf": [], "/zmpwalk/markers": []}
+        for connection, stamp, raw in reader.messages():
+            messages[connection.topic].append((stamp, store.deserialize_cdr(raw, connection.msgtype)))
+    n = clip["frames"]
+    assert all(len(rows) == n for rows in messages.values())
+    stamps = np.array([stamp for stamp, _ in messages["/joint_states"]])
+    assert np.abs(np.diff(stamps) - 1e9 / FPS).max() <= 1  # [ns]
+    state = messages["/joint_states"][n // 2][1]
+    assert list(state.name) == joint_names(model)[1:]
+    assert np.abs(np.asarray(state.position) - qpos[n // 2, 7:]).max() < 1e-6  # [rad] (the AMP file's 7 digits)
+    tf = messages["/tf"][n // 2][1].transforms
+    assert [t.child_frame_id for t in tf] == [body_names(model)[0], "left_foot", "right_foot"]
+    base = tf[0].transform
+    assert np.allclose([base.translation.x, base.translation.y, base.translation.z], qpos[n // 2, :3], atol=1e-6)
+    assert np.allclose([base.rotation.w, base.rotation.x, base.rotation.y, base.rotation.z], qpos[n // 2, 3:7],
+                       atol=1e-6)
+    marker_ns = [[m.ns for m in array.markers] for _, array in messages["/zmpwalk/markers"]]
+    assert all("zmp" in names for names in marker_ns)
+    assert sum("cop" in names for names in marker_ns) > 0.9 * n  # the CoP wherever a sole carries load
+    prints = [m for _, array in messages["/zmpwalk/markers"] for m in array.markers if m.ns == "footprints"]
+    assert len(prints) >= 6  # both feet at the start, then every landing of the six swings
+    for marker in prints:
+        assert len(marker.points) == 5 and all(abs(p.z) < 0.01 for p in marker.points)  # [m] closed, on the floor

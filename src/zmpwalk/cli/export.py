@@ -31,7 +31,8 @@ def add_parser(commands: Commands) -> None:
         "export", help="reference motions for learning: walk a grid of commands in MuJoCo and export the clips",
         description="Walk every command of a grid (forward, side, turn velocity; step time) through the walking "
         "controller in MuJoCo with the stabilizer, and write the simulated and the planned motion, whole and cyclic, "
-        "in the model's joint names and order, as mjlab npz, LocoMuJoCo-style npz, AMP JSON and CSV, each replayed "
+        "in the model's joint names and order, as mjlab npz, LocoMuJoCo-style npz, AMP JSON, CSV and a ROS 2 bag "
+        "(MCAP), each replayed "
         "from its file and checked, with manifest.json (docs/export.md). Exit status 3 when a clip fails its check.",
         epilog="example: zmpwalk export --robot ../shared/robots/booster_t1/scene.xml --out t1-motions",
     )

@@ -4,7 +4,8 @@
 (:func:`zmpwalk.sim.loop.simulate_controller`, stabilizer and feedforward on; :mod:`zmpwalk.export.clips`), one
 command per worker process at a time (:func:`zmpwalk.sim.sweep.in_pool`, Dask too), and writes per command four
 clips: the simulated and the planned motion, each whole (start to stop) and cyclic (whole gait cycles of steady
-walking, loop points marked), each in mjlab's npz, a LocoMuJoCo-style npz, AMP JSON and CSV. Every file is read
+walking, loop points marked), each in mjlab's npz, a LocoMuJoCo-style npz, AMP JSON, CSV and a ROS 2 bag (MCAP;
+:mod:`zmpwalk.export.rosbag`). Every file is read
 back and replayed kinematically (:func:`zmpwalk.export.verify.replay_check`); a clip whose file fails is marked
 in the manifest (``manifest.json``), never dropped silently.
 """
@@ -27,13 +28,16 @@ from numpy.typing import NDArray
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import FileFormatError, InvalidParameterError, ZmpwalkError
 from zmpwalk.export.amp import amp_json, read_amp
-from zmpwalk.export.clips import Clip, Command, cyclic_window, walk_clips, walk_start_time
+from zmpwalk.export.clips import CONTROL_RATE, Clip, Command, cyclic_window, walk_clips, walk_start_time
 from zmpwalk.export.locomujoco import locomujoco_npz, read_locomujoco
 from zmpwalk.export.mjlab import mjlab_npz, read_mjlab
 from zmpwalk.export.names import joint_names
+from zmpwalk.export.rosbag import BagExtras, read_bag, write_bag
 from zmpwalk.export.table import clip_csv, read_csv
 from zmpwalk.export.verify import replay_check
 from zmpwalk.files import read_toml, write_bytes, write_text
+from zmpwalk.robots.model import RobotModel
+from zmpwalk.sim.result import SimulationResult
 
 Array = NDArray[np.float64]
 
@@ -41,7 +45,7 @@ SWINGS = 10  # [-] swings walked per command (a side or turn step is two)
 READ_BACK_TOLERANCE = 1e-4  # [rad or m] a file's qpos read back against the clip's (float32 and 7 digits)
 FORMATS: dict[str, tuple[str, Callable[[str], tuple[Array, float]]]] = {
     "mjlab": ("mjlab.npz", read_mjlab), "locomujoco": ("locomujoco.npz", read_locomujoco),
-    "amp": ("amp.json", read_amp), "csv": ("csv", read_csv)}
+    "amp": ("amp.json", read_amp), "csv": ("csv", read_csv), "ros2bag": ("bag", read_bag)}
 
 
 @dataclass(frozen=True)
@@ -163,9 +167,10 @@ def _step(robot_spec: str, command: Command, swings: int) -> tuple[StepCommand, 
     return step, max(1, math.ceil(swings / per_step))
 
 
-def _write_clip(model: mujoco.MjModel, clip: Clip, qpos: Array, cyclic: bool, out: Path,
-                record: ClipRecord) -> None:
-    """Write ``qpos`` in every format, read each back and replay it; fill ``record``."""
+def _write_clip(model: mujoco.MjModel, robot: RobotModel, clip: Clip, frames: slice, cyclic: bool, out: Path,
+                record: ClipRecord, extras: BagExtras) -> None:
+    """Write the clip's ``frames`` in every format, read each back and replay it; fill ``record``."""
+    qpos = clip.qpos[frames]
     record.frames, record.fps = len(qpos), clip.fps
     writers = {"mjlab": lambda: mjlab_npz(model, qpos, clip.fps), "csv": lambda: clip_csv(model, qpos, clip.fps),
                "locomujoco": lambda: locomujoco_npz(model, qpos, clip.fps),
@@ -173,7 +178,11 @@ def _write_clip(model: mujoco.MjModel, clip: Clip, qpos: Array, cyclic: bool, ou
     verified, worst = True, {"slide": 0.0, "penetration": 0.0, "phases": math.inf}
     for key, (suffix, reader) in FORMATS.items():
         name = f"{record.name}.{suffix}"
-        write_bytes(out / name, writers[key]())
+        if key == "ros2bag":
+            cop = None if extras.cop is None else extras.cop[frames]
+            write_bag(out / name, model, robot, qpos, clip.fps, BagExtras(extras.zmp[frames], cop))
+        else:
+            write_bytes(out / name, writers[key]())
         record.files[key] = name
         back, fps = reader(str(out / name))
         same = back.shape == qpos.shape and float(np.abs(back - qpos).max(initial=0.0)) <= READ_BACK_TOLERANCE
@@ -184,6 +193,12 @@ def _write_clip(model: mujoco.MjModel, clip: Clip, qpos: Array, cyclic: bool, ou
                      "penetration": max(worst["penetration"], check.penetration),
                      "phases": min(worst["phases"], check.phases)}
     record.verified, record.replay = verified, worst
+
+
+def _extras(result: SimulationResult, frames: int, fps: float, measured: bool) -> BagExtras:
+    """The reference ZMP and (``measured``) the CoP of the walk's control tick nearest each frame [m]."""
+    rows = np.clip(np.rint(np.arange(frames) * CONTROL_RATE / fps).astype(int), 0, len(result.time) - 1)
+    return BagExtras(result.reference_zmp[rows], result.cop[rows] if measured else None)
 
 
 def export_command(robot_spec: str, command: Command, out: str, fps: float, swings: int = SWINGS) -> list[ClipRecord]:
@@ -210,10 +225,11 @@ def export_command(robot_spec: str, command: Command, out: str, fps: float, swin
     model = build_plant(robot).model
     records = []
     for clip in (simulated, planned):
+        extras = _extras(result, len(clip.qpos), fps, clip.kind == "simulated")
         window = cyclic_window(model, clip.qpos, fps, walk_start_time(), count * (2 if step.side or step.turn else 1),
                                step.duration)
         whole = replace(walk, name=f"{stem}_{clip.kind}_whole", kind=clip.kind, files={}, replay={})
-        _write_clip(model, clip, clip.qpos, False, Path(out), whole)
+        _write_clip(model, robot, clip, slice(None), False, Path(out), whole, extras)
         records.append(whole)
         if window is None:
             continue
@@ -221,7 +237,7 @@ def export_command(robot_spec: str, command: Command, out: str, fps: float, swin
         whole.loop, whole.loop_error = (first, last), errors
         cyclic = replace(walk, name=f"{stem}_{clip.kind}_cyclic", kind=clip.kind, span="cyclic", files={},
                          replay={}, loop=(0, last - first), loop_error=errors)
-        _write_clip(model, clip, clip.qpos[first:last + 1], True, Path(out), cyclic)
+        _write_clip(model, robot, clip, slice(first, last + 1), True, Path(out), cyclic, extras)
         records.append(cyclic)
     return records
 

@@ -54,8 +54,23 @@ def _runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
     return list(zip(np.flatnonzero(edges == 1).tolist(), (np.flatnonzero(edges == -1) - 1).tolist(), strict=True))
 
 
-def replay_check(model: mujoco.MjModel, qpos: Array, fps: float) -> ReplayCheck:
-    """Replay ``qpos`` rows at ``fps`` [Hz] and judge the stance feet (module docstring)."""
+@dataclass(frozen=True)
+class StancePhases:
+    """Where a clip's feet stand (module docstring).
+
+    Attributes:
+        phases: Per foot (left, right), the first and last frame of each stance phase.
+        origin: Each foot's origin in world (n, 2, 2) [m], horizontal.
+        lowest: Each foot's lowest collision point's height (n, 2) [m].
+    """
+
+    phases: tuple[list[tuple[int, int]], list[tuple[int, int]]]
+    origin: Array
+    lowest: Array
+
+
+def stance_phases(model: mujoco.MjModel, qpos: Array, fps: float) -> StancePhases:
+    """Replay ``qpos`` rows at ``fps`` [Hz] and find each foot's stance phases (module docstring)."""
     feet = foot_bodies(model)
     data = mujoco.MjData(model)
     n = len(qpos)
@@ -68,13 +83,20 @@ def replay_check(model: mujoco.MjModel, qpos: Array, fps: float) -> ReplayCheck:
     speed = np.zeros((n, 2))
     if n > 1:
         speed = np.linalg.norm(np.gradient(origin, 1.0 / fps, axis=0), axis=2)
+    runs = [[(a, b) for a, b in _runs((lowest[:, foot] <= STANCE_HEIGHT) & (speed[:, foot] <= STANCE_SPEED))
+             if (b - a + 1) / fps >= MIN_STANCE] for foot in range(2)]
+    return StancePhases((runs[0], runs[1]), origin, lowest)
+
+
+def replay_check(model: mujoco.MjModel, qpos: Array, fps: float) -> ReplayCheck:
+    """Replay ``qpos`` rows at ``fps`` [Hz] and judge the stance feet (module docstring)."""
+    stance = stance_phases(model, qpos, fps)
     phases, slide, penetration = 0, 0.0, 0.0
     for foot in range(2):
-        for a, b in _runs((lowest[:, foot] <= STANCE_HEIGHT) & (speed[:, foot] <= STANCE_SPEED)):
-            if (b - a + 1) / fps < MIN_STANCE:
-                continue
+        for a, b in stance.phases[foot]:
             phases += 1
-            slide = max(slide, float(np.linalg.norm(origin[a:b + 1, foot] - origin[a, foot], axis=1).max()))
-            penetration = max(penetration, float(-lowest[a:b + 1, foot].min()))
+            origin = stance.origin[a:b + 1, foot]
+            slide = max(slide, float(np.linalg.norm(origin - origin[0], axis=1).max()))
+            penetration = max(penetration, float(-stance.lowest[a:b + 1, foot].min()))
     passed = phases > 0 and slide <= MAX_SLIDE and penetration <= MAX_PENETRATION
     return ReplayCheck(passed, phases, slide, penetration)
