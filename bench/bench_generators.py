@@ -24,7 +24,7 @@ from zmpwalk.errors import ZmpwalkError
 from zmpwalk.kinematics import pattern_joint_trajectory
 from zmpwalk.patterns import generator
 from zmpwalk.scenarios import load_scenario
-from zmpwalk.walk import WalkSpec, plan_walk, run_walk
+from zmpwalk.walk import WalkSpec, planned_walk, run_walk
 
 WALKS = ("fig27", "fig28", "fig29", "fig30", "fig31", "turn45", "demo")
 GENERATORS = ("polynomial", "preview", "hyperbolic")
@@ -36,7 +36,7 @@ def case(job: tuple[str, str]) -> tuple[str, str, str]:
     robot = load_robot("hubo")
     spec = WalkSpec(robot, load_scenario(walk), generator=name)
     try:
-        planned = plan_walk(spec)
+        planned = planned_walk(spec)
     except ZmpwalkError as error:
         return walk, name, f"not planned ({str(error).split(';')[0][:40]})"
     pattern = planned.pattern

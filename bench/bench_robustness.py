@@ -24,7 +24,7 @@ from zmpwalk.capture import CaptureSettings
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.scenarios import load_scenario
 from zmpwalk.sim.disturbances import Disturbances
-from zmpwalk.walk import WalkSpec, plan_walk, run_walk
+from zmpwalk.walk import WalkSpec, planned_walk, run_walk
 
 TALOS = Path(__file__).resolve().parents[2] / "shared" / "robots" / "pal_talos" / "scene_position.xml"
 
@@ -55,7 +55,7 @@ def run(job: tuple[str, str, str, float]) -> tuple[str, str, str, float, bool, b
     spec = WalkSpec(model, walk(name), generator="polynomial", balance=balance, feedforward=True,
                     latency=value / 1000.0 if condition == "latency" else 0.0,
                     capture=CaptureSettings() if mode == "capture" else None)
-    planned = plan_walk(spec)
+    planned = planned_walk(spec)
     disturbances = None
     if condition == "mass":
         disturbances = Disturbances(mass_error=value)

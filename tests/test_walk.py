@@ -14,7 +14,7 @@ from zmpwalk.cli.printing import json_safe
 from zmpwalk.patterns import generator
 from zmpwalk.scenarios import load_scenario_with_labels
 from zmpwalk.sim.verdict import controller_words
-from zmpwalk.walk import STAGES, plan_walk
+from zmpwalk.walk import STAGES, planned_walk
 
 
 @pytest.fixture(scope="module")
@@ -58,7 +58,7 @@ def test_balance_chooses_the_stabilizer_or_the_open_loop(hubo) -> None:
 
 def test_the_planned_walk_is_the_generator_s_pattern_and_its_joints(hubo) -> None:
     commands = [StepCommand(0.9, 0.1)] * 2
-    planned = plan_walk(WalkSpec(hubo, commands, generator="preview"))
+    planned = planned_walk(WalkSpec(hubo, commands, generator="preview"))
     pattern = generator("preview")(hubo, commands, rate=1000.0)
     np.testing.assert_array_equal(planned.pattern.zmp_in_world, pattern.zmp_in_world)
     np.testing.assert_array_equal(planned.joints.angles, pattern_joint_trajectory(pattern).angles)

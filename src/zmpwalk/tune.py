@@ -273,12 +273,12 @@ def score_of(cart: float, multibody: float) -> float:
 def walk(robot: RobotModel, data: dict[str, Any], condition: Condition, steps: int) -> tuple[bool, float, float]:
     """Walk a condition in MuJoCo as every walk runs (``zmpwalk simulate``, :func:`zmpwalk.walk.run_walk`, the
     stabilizer on): (passes, largest torso roll or pitch [rad], largest held torque [N m])."""
-    from zmpwalk.walk import WalkSpec, plan_walk, run_walk
+    from zmpwalk.walk import WalkSpec, planned_walk, run_walk
 
     spec = WalkSpec(robot, [condition_command(robot, condition)] * steps, generator="polynomial",
                     schedule=Schedule(data, "<candidate>"), rate=RATE)
     try:
-        planned = plan_walk(spec)
+        planned = planned_walk(spec)
     except ZmpwalkError:
         return False, math.inf, math.inf
     outcome = run_walk(spec, planned=planned)

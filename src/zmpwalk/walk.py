@@ -55,23 +55,25 @@ class WalkSpec:
             the generator's default.
         pelvis: The polynomial generator's pelvis curves, ``"cubic"`` (the paper's) or ``"quintic"``.
         paper_steps: Walk the example of Lim et al. instead of ``commands``: the start, this many steady steps and
-            the stop, hyperbolic (:func:`zmpwalk.patterns.hyperbolic.paper_walk`); None: ``commands``.
-        rate: Sampling rate of the pattern and of the stabilizer.
+            the stop, hyperbolic (:func:`zmpwalk.patterns.hyperbolic.paper_walk`; ``generator``, ``schedule`` and
+            ``pelvis`` do not apply); None: ``commands``.
+        rate: Sampling rate of the pattern and of the stabilizer [Hz].
         zmp_correction: Move the pelvis until the multibody ZMP follows the planned ZMP
             (:func:`zmpwalk.patterns.correction.correct_pattern`; box models with link masses).
         check_limits: Raise :class:`~zmpwalk.kinematics.JointLimitError` where a planned joint angle leaves its
             range (as ``report`` and ``demo`` do); False: the verdict judges the joints instead.
         balance: Close the loop with the stabilizer; False: the pattern alone (open loop).
-        latency: Delay of every measurement the stabilizer gets.
+        latency: Delay of every measurement the stabilizer gets [s] (0 to 0.1).
         noise: Gaussian noise on those measurements; None: none.
         feedforward: The servo feedforwards (gravity, ground reaction, damping); None: the simulation's default
             (on for a robot's own model and with the stabilizer).
-        mass_scale: Every mass and inertia of the model (and the servo gains with them) times this (box models).
+        mass_scale: Every mass and inertia of the model (and the servo gains with them) times this [-] (0.01 to
+            100; box models).
         disturbances: A push, a floor tilt or a mass error of the plant; None: none.
         capture: Capture steps after a push (needs the stabilizer, and a pattern not ZMP-corrected); None: none.
         motors: Each joint's motor (a motor file's, :func:`zmpwalk.sim.motors.load_motors`); None: none.
-        settle: Standing before the walk.
-        hold: Standing after the walk, over which the verdict judges how it ends.
+        settle: Standing before the walk [s] (0 to 10).
+        hold: Standing after the walk [s] (0 to 60), over which the verdict judges how it ends.
         source: How an error of the pattern names the walk (a steps file, ``scenario NAME``); empty: unnamed.
     """
 
@@ -224,16 +226,21 @@ def walk_pattern(spec: WalkSpec) -> tuple[WalkingPattern, ZmpCorrection | None]:
     return correction.pattern, correction
 
 
-def plan_walk(spec: WalkSpec) -> PlannedWalk:
+def planned_walk(spec: WalkSpec) -> PlannedWalk:
     """The pattern of ``spec``, corrected where asked, and the joint angles along it.
 
     Raises:
         ZmpwalkError: The walk cannot be planned, a leg cannot reach, or (``check_limits``) a joint leaves its range.
     """
+    pattern, correction = walk_pattern(spec)
+    return PlannedWalk(pattern, correction, _joints(spec, pattern))
+
+
+def _joints(spec: WalkSpec, pattern: WalkingPattern) -> JointTrajectory:
+    """The joint angles along ``pattern`` (their ranges checked with ``spec.check_limits``)."""
     from zmpwalk.kinematics import pattern_joint_trajectory
 
-    pattern, correction = walk_pattern(spec)
-    return PlannedWalk(pattern, correction, pattern_joint_trajectory(pattern, check_limits=spec.check_limits))
+    return pattern_joint_trajectory(pattern, check_limits=spec.check_limits)
 
 
 def run_walk(spec: WalkSpec, progress: Progress | None = None, planned: PlannedWalk | None = None) -> WalkOutcome:
@@ -243,13 +250,13 @@ def run_walk(spec: WalkSpec, progress: Progress | None = None, planned: PlannedW
         spec: The walk.
         progress: Called as each stage of :data:`STAGES` starts, ``progress(stage, index, len(STAGES))``, and
             while the simulation runs, ``progress("simulation", percent, 100)``.
-        planned: The walk already planned from this spec (:func:`plan_walk`); None: planned here.
+        planned: The walk already planned from this spec (:func:`planned_walk`); None: planned here.
 
     Returns:
         The pattern, the joints, the measurements, the verdict, the motor table and the wall time of each stage.
 
     Raises:
-        ZmpwalkError: As :func:`plan_walk`, or a simulation setting out of range.
+        ZmpwalkError: As :func:`planned_walk`, or a simulation setting out of range.
     """
     from zmpwalk.balance import Stabilizer
     from zmpwalk.sim.actuators import actuator_table
@@ -273,9 +280,7 @@ def run_walk(spec: WalkSpec, progress: Progress | None = None, planned: PlannedW
     if planned is None:
         pattern, correction = walk_pattern(spec)
         stage("joints")
-        from zmpwalk.kinematics import pattern_joint_trajectory
-
-        planned = PlannedWalk(pattern, correction, pattern_joint_trajectory(pattern, check_limits=spec.check_limits))
+        planned = PlannedWalk(pattern, correction, _joints(spec, pattern))
     else:
         stage("joints")
     stage("simulation")

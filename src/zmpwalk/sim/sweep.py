@@ -72,7 +72,7 @@ def walk_scenario(robot: str, scenario: str, balance: bool = True, generator: st
         pelvis: ``"cubic"`` or ``"quintic"`` (the polynomial generator's pelvis curves).
     """
     from zmpwalk.scenarios import load_scenario_with_labels
-    from zmpwalk.walk import WalkSpec, plan_walk, run_walk
+    from zmpwalk.walk import WalkSpec, planned_walk, run_walk
 
     start = time.perf_counter()
     model = loaded_robot(robot)
@@ -86,7 +86,7 @@ def walk_scenario(robot: str, scenario: str, balance: bool = True, generator: st
         tables = Schedule.from_file(Path(schedule))
     spec = WalkSpec(model, commands, labels, generator=generator, schedule=tables, pelvis=pelvis, balance=balance)
     try:
-        planned = plan_walk(spec)
+        planned = planned_walk(spec)
     except ZmpwalkError as error:  # this walk is not possible with this generator: a result, not a crash
         return SweepResult(scenario=scenario, robot=model.name, passed=False, failed=("planned",), fell=False,
                            distance=math.nan, cop_error_rms=math.nan, simulated=0.0,
