@@ -23,7 +23,7 @@ from zmpwalk.kinematics import pattern_joint_trajectory
 from zmpwalk.patterns.polynomial import generate
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.scenarios import load_scenario
-from zmpwalk.sim import simulate
+from zmpwalk.walk import WalkSpec, run_walk
 
 TALOS = Path(__file__).resolve().parents[2] / "shared" / "robots" / "pal_talos" / "scene_position.xml"
 T1 = Path(__file__).resolve().parents[2] / "shared" / "robots" / "booster_t1" / "scene.xml"
@@ -57,12 +57,8 @@ def case(job: tuple[str, float | None, str, bool]) -> str:
     name, kp, walk, balance = job
     model = robot(name, kp)
     commands = WALKS[name][walk] if name in WALKS else load_scenario(walk)
-    pattern = generate(model, commands, rate=1000.0)
-    joints = pattern_joint_trajectory(pattern, check_limits=False)
-    start = time.perf_counter()
-    result = simulate(model, joints, pattern, stabilizer=Stabilizer(model, 1000.0) if balance else None,
-                      settle=0.5, hold=2.0)
-    seconds = time.perf_counter() - start
+    outcome = run_walk(WalkSpec(model, commands, generator="polynomial", balance=balance))
+    result, seconds = outcome.result, outcome.seconds["simulation"]
     rms, _ = result.cop_error_stats()
     state = f"fell at {result.fall_time:.2f} s" if result.fell else "walks"
     label = f"{name} (kp {kp:g})" if kp else name

@@ -8,6 +8,7 @@ simulations run on all cores, the timings on one.
 
 from __future__ import annotations
 
+import dataclasses
 import gc
 import os
 import statistics
@@ -18,14 +19,12 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 from zmpwalk import OnlineWalker, StepCommand, load_robot
-from zmpwalk.balance import Stabilizer
 from zmpwalk.dynamics import compare_zmp
 from zmpwalk.errors import ZmpwalkError
 from zmpwalk.kinematics import pattern_joint_trajectory
 from zmpwalk.patterns import generator
 from zmpwalk.scenarios import load_scenario
-from zmpwalk.sim import actuator_table, simulate
-from zmpwalk.sim.verdict import HOLD, SETTLE, walk_verdict
+from zmpwalk.walk import WalkSpec, planned_walk, run_walk
 
 WALKS = ("fig27", "fig28", "fig29", "fig30", "fig31", "turn45", "demo")
 GENERATORS = ("polynomial", "preview", "hyperbolic")
@@ -35,21 +34,22 @@ def case(job: tuple[str, str]) -> tuple[str, str, str]:
     """One walk with one generator: the table cell's text (margin, multibody, simulation)."""
     walk, name = job
     robot = load_robot("hubo")
+    spec = WalkSpec(robot, load_scenario(walk), generator=name)
     try:
-        pattern = generator(name)(robot, load_scenario(walk), rate=1000.0)
+        planned = planned_walk(spec)
     except ZmpwalkError as error:
         return walk, name, f"not planned ({str(error).split(';')[0][:40]})"
+    pattern = planned.pattern
     margin = float(np.nanmin(pattern.zmp_margin()))
     comparison = compare_zmp(pattern)
-    joints = pattern_joint_trajectory(pattern, check_limits=False)
     cells = [f"{margin * 1e3:+.1f} mm; {comparison.rms * 1e3:.1f} ({comparison.max * 1e3:.0f}) mm"]
-    for stabilizer in (None, Stabilizer(robot, 1000.0)):
-        result = simulate(robot, joints, pattern, stabilizer=stabilizer, settle=SETTLE, hold=HOLD)
-        verdict = walk_verdict(result, HOLD)
+    for balance in (False, True):
+        outcome = run_walk(dataclasses.replace(spec, balance=balance), planned=planned)
+        result, verdict = outcome.result, outcome.verdict
         rms, _ = result.cop_error_stats()
         state = "falls" if result.fell else ("pass" if verdict.passed else "fails " + ", ".join(verdict.failed))
-        top = max(actuator_table(result), key=lambda row: row.peak_torque)
-        loop = "open" if stabilizer is None else "stab."
+        top = max(outcome.rows, key=lambda row: row.peak_torque)
+        loop = "stab." if balance else "open"
         cells.append(f"{loop}: CoP {rms * 1e3:.1f} mm, {state}, {top.peak_torque:.0f} N m ({top.joint})")
     return walk, name, "; ".join(cells)
 

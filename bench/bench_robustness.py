@@ -20,15 +20,11 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from zmpwalk import StepCommand, load_robot
-from zmpwalk.balance import Stabilizer
 from zmpwalk.capture import CaptureSettings
-from zmpwalk.kinematics import pattern_joint_trajectory
-from zmpwalk.patterns.polynomial import generate
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.scenarios import load_scenario
-from zmpwalk.sim import simulate
-from zmpwalk.sim.run import Disturbances
-from zmpwalk.sim.verdict import walk_verdict
+from zmpwalk.sim.disturbances import Disturbances
+from zmpwalk.walk import WalkSpec, planned_walk, run_walk
 
 TALOS = Path(__file__).resolve().parents[2] / "shared" / "robots" / "pal_talos" / "scene_position.xml"
 
@@ -56,9 +52,10 @@ def run(job: tuple[str, str, str, float]) -> tuple[str, str, str, float, bool, b
     name, condition, mode, value = job
     balance = mode != "off"
     model = robot(name)
-    pattern = generate(model, walk(name), rate=1000.0)
-    joints = pattern_joint_trajectory(pattern, check_limits=False)
-    latency = value / 1000.0 if condition == "latency" else 0.0
+    spec = WalkSpec(model, walk(name), generator="polynomial", balance=balance, feedforward=True,
+                    latency=value / 1000.0 if condition == "latency" else 0.0,
+                    capture=CaptureSettings() if mode == "capture" else None)
+    planned = planned_walk(spec)
     disturbances = None
     if condition == "mass":
         disturbances = Disturbances(mass_error=value)
@@ -66,15 +63,14 @@ def run(job: tuple[str, str, str, float]) -> tuple[str, str, str, float, bool, b
         angle = math.radians(value)
         disturbances = Disturbances(floor_tilt=(angle, 0.0) if condition == "tilt-roll" else (0.0, angle))
     elif condition.startswith("push"):
-        step = pattern.steps[4]
+        step = planned.pattern.steps[4]
         middle = step.start + step.duration / 2
         direction = {"push-forward": (1.0, 0.0), "push-backward": (-1.0, 0.0),
                      "push-sideways": (0.0, 1.0 if step.swing == "left" else -1.0)}[condition]
         disturbances = Disturbances(push_time=middle, push_impulse=(direction[0] * value, direction[1] * value, 0.0))
-    result = simulate(model, joints, pattern, stabilizer=Stabilizer(model, 1000.0) if balance else None,
-                      feedforward=True, settle=0.5, hold=2.0, latency=latency, disturbances=disturbances,
-                      capture=CaptureSettings() if mode == "capture" else None)
-    return name, condition, mode, value, result.fell, walk_verdict(result, 2.0).passed
+    outcome = run_walk(dataclasses.replace(spec, disturbances=disturbances), planned=planned)
+    result = outcome.result
+    return name, condition, mode, value, result.fell, outcome.verdict.passed
 
 
 PUSH_STEP = 2.0  # [N s] grid of the push scan

@@ -28,6 +28,7 @@ from zmpwalk.patterns.preview import generate_preview
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots import RobotModel, list_robots, load_robot
 from zmpwalk.schedule import Schedule, ShapeParameters
+from zmpwalk.walk import WalkOutcome, WalkSpec, run_walk
 
 __all__ = [
     "BalanceMeasurement",
@@ -50,6 +51,8 @@ __all__ = [
     "StepCommand",
     "UnknownNameError",
     "UnreachableError",
+    "WalkOutcome",
+    "WalkSpec",
     "WalkingController",
     "WalkingPattern",
     "WalkingSample",
@@ -60,4 +63,5 @@ __all__ = [
     "list_robots",
     "load_robot",
     "pattern_joint_trajectory",
+    "run_walk",
 ]

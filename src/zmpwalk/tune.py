@@ -271,24 +271,22 @@ def score_of(cart: float, multibody: float) -> float:
 
 
 def walk(robot: RobotModel, data: dict[str, Any], condition: Condition, steps: int) -> tuple[bool, float, float]:
-    """Walk a condition in MuJoCo: (passes, largest torso roll or pitch [rad], largest held torque [N m])."""
-    from zmpwalk.balance import Stabilizer
-    from zmpwalk.kinematics import pattern_joint_trajectory
-    from zmpwalk.sim.actuators import actuator_table
-    from zmpwalk.sim.run import simulate
-    from zmpwalk.sim.verdict import HOLD, SETTLE, walk_verdict
+    """Walk a condition in MuJoCo as every walk runs (``zmpwalk simulate``, :func:`zmpwalk.walk.run_walk`, the
+    stabilizer on): (passes, largest torso roll or pitch [rad], largest held torque [N m])."""
+    from zmpwalk.walk import WalkSpec, planned_walk, run_walk
 
+    spec = WalkSpec(robot, [condition_command(robot, condition)] * steps, generator="polynomial",
+                    schedule=Schedule(data, "<candidate>"), rate=RATE)
     try:
-        pattern = condition_walk(robot, data, condition, steps)
-        joints = pattern_joint_trajectory(pattern, check_limits=False)
+        planned = planned_walk(spec)
     except ZmpwalkError:
         return False, math.inf, math.inf
-    stabilizer = Stabilizer(robot, RATE, com_reference=pattern.com_point)  # as every walk runs (zmpwalk simulate)
-    result = simulate(robot, joints, pattern, stabilizer=stabilizer, settle=SETTLE, hold=HOLD)
-    verdict = {c.name: c for c in walk_verdict(result, HOLD).criteria}
+    outcome = run_walk(spec, planned=planned)
+    result = outcome.result
+    verdict = {c.name: c for c in outcome.verdict.criteria}
     passes = verdict["no fall"].passed and verdict["CoP inside the loaded soles"].passed
     attitude = float(np.nanmax(np.abs(result.torso_rpy[:, :2]))) if len(result.torso_rpy) else math.inf
-    peak = max((row.peak_torque for row in actuator_table(result)), default=math.inf)
+    peak = max((row.peak_torque for row in outcome.rows), default=math.inf)
     return passes, attitude, peak
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -25,18 +25,16 @@ from zmpwalk.cli.options import (
     generator_words,
     load_robot_of,
     motors_of,
-    named_source,
-    pattern_options,
+    pelvis_of,
     resolve_generator,
+    schedule_of,
     walk_label,
     walk_of,
 )
 from zmpwalk.cli.printing import cop_margin_words, json_safe, margin_words, print_verdict, progress
 from zmpwalk.files import write_text
-from zmpwalk.kinematics import pattern_joint_trajectory
-from zmpwalk.patterns import generator
-from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.walk import WalkSpec
 
 if TYPE_CHECKING:
     from zmpwalk.patterns.correction import ZmpCorrection
@@ -79,9 +77,9 @@ def add_parser(commands: Commands) -> None:
     add_json_option(parser, "print a JSON summary")
 
 
-def simulated_pattern(args: argparse.Namespace, robot: RobotModel) -> tuple[WalkingPattern, ZmpCorrection | None]:
-    """The pattern ``simulate`` walks (the paper example, a steps file or a scenario) and its ZMP correction."""
-    from zmpwalk.patterns.hyperbolic import paper_walk
+def walk_spec(args: argparse.Namespace, robot: RobotModel) -> WalkSpec:
+    """The walk ``simulate`` runs: the paper example, a steps file or a scenario, with the options given."""
+    from zmpwalk.capture import CaptureSettings
 
     resolve_generator(args, robot)
     if args.paper_example:
@@ -89,61 +87,38 @@ def simulated_pattern(args: argparse.Namespace, robot: RobotModel) -> tuple[Walk
             raise UsageError("--paper-example takes no steps file or scenario")
         if args.steady_steps < 0:
             raise UsageError(f"--steady-steps = {args.steady_steps} must be >= 0")
-        pattern = paper_walk(robot, steps=args.steady_steps).sample(1000.0)
+        walk: dict[str, Any] = {"paper_steps": args.steady_steps}
     else:
         commands, labels = walk_of(args)
-        make = generator(args.generator)
-        options = pattern_options(args)
-        with named_source(walk_label(args)):
-            pattern = make(robot, commands, rate=1000.0, labels=labels, **options)
-    if not args.zmp_correction:
-        return pattern, None
-    from zmpwalk.patterns.correction import correct_pattern
+        walk = {"commands": commands, "labels": labels, "generator": args.generator, "schedule": schedule_of(args),
+                "pelvis": pelvis_of(args), "source": walk_label(args)}
+    balance = balance_of(args)
+    if args.capture and not balance:
+        raise UsageError("--capture needs the stabilizer (--balance on): its DCM estimate triggers the capture step")
+    if args.capture and args.zmp_correction:
+        raise UsageError("--capture plans the pattern's CoM point; it does not combine with --zmp-correction")
+    disturbances = None
+    if args.push is not None:
+        from zmpwalk.sim.disturbances import Disturbances
 
-    correction = correct_pattern(pattern)
-    return correction.pattern, correction
+        disturbances = Disturbances(push_time=args.push[0], push_impulse=(args.push[1], args.push[2], 0.0))
+    return WalkSpec(robot, **walk, zmp_correction=args.zmp_correction, balance=balance,
+                    latency=args.latency, mass_scale=args.mass_scale, disturbances=disturbances,
+                    capture=CaptureSettings() if args.capture else None, motors=motors_of(args))
 
 
 def run(args: argparse.Namespace) -> int:
     """``zmpwalk simulate``: walk the pattern, write the measurements to --out and print the walk and its verdict."""
-    from zmpwalk.balance import Stabilizer
-    from zmpwalk.capture import CaptureSettings
-    from zmpwalk.sim import actuator_markdown, actuator_table, simulate, write_actuator_csv
-    from zmpwalk.sim.motors import motor_fits
-    from zmpwalk.sim.run import Disturbances, write_result_csv
-    from zmpwalk.sim.verdict import HOLD, SETTLE, walk_verdict
+    from zmpwalk.sim import actuator_markdown, write_actuator_csv
+    from zmpwalk.sim.run import write_result_csv
+    from zmpwalk.walk import run_walk
 
     robot = load_robot_of(args)
     show = None if args.json or not sys.stderr.isatty() else progress
-    stages = ("pattern", "joints", "simulation", "measures")
-    if show:
-        show(stages[0], 0, len(stages))
-    pattern, correction = simulated_pattern(args, robot)
-    if show:
-        show(stages[1], 1, len(stages))
-    joints = pattern_joint_trajectory(pattern, check_limits=False)
-    if show:
-        show(stages[2], 2, len(stages))
-    stabilizer = Stabilizer(robot, 1000.0, com_reference=pattern.com_point) if balance_of(args) else None
-    if args.capture and stabilizer is None:
-        raise UsageError("--capture needs the stabilizer (--balance on): its DCM estimate triggers the capture step")
-    if args.capture and correction is not None:
-        raise UsageError("--capture plans the pattern's CoM point; it does not combine with --zmp-correction")
-    disturbances = None
-    if args.push is not None:
-        disturbances = Disturbances(push_time=args.push[0], push_impulse=(args.push[1], args.push[2], 0.0))
-    result = simulate(robot, joints, pattern, mass_scale=args.mass_scale, stabilizer=stabilizer,
-                      latency=args.latency, settle=SETTLE, hold=HOLD, disturbances=disturbances,
-                      capture=CaptureSettings() if args.capture else None,
-                      progress=None if show is None else lambda done: show("simulation", round(100 * done), 100))
-    motors = motors_of(args)
-    verdict = walk_verdict(result, HOLD, motors)
-    if show:
-        show(stages[3], 4, len(stages))
-    rows = actuator_table(result)
-    fits = motor_fits(result, motors) if motors else []
-    summary = {**simulation_summary(result, verdict, rows, fits, correction), "balance": stabilizer is not None,
-               "generator": pattern.generator}
+    walk = run_walk(walk_spec(args, robot), progress=show)
+    result, verdict, rows, fits, correction = walk.result, walk.verdict, walk.rows, walk.fits, walk.correction
+    summary = {**simulation_summary(result, verdict, rows, fits, correction), "balance": walk.spec.balance,
+               "generator": walk.pattern.generator}
     if args.out:
         args.out.mkdir(parents=True, exist_ok=True)
         write_actuator_csv(rows, args.out / "actuators.csv")

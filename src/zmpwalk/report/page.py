@@ -12,33 +12,24 @@ import base64
 import html
 import json
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from zmpwalk.balance import Stabilizer
 from zmpwalk.commands import StepCommand
 from zmpwalk.files import write_bytes, write_text
-from zmpwalk.kinematics import pattern_joint_trajectory
-from zmpwalk.patterns import generator as pattern_generator
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
-from zmpwalk.sim.actuators import (
-    IMPACT_WINDOW,
-    ActuatorRow,
-    actuator_markdown,
-    actuator_table,
-    write_actuator_csv,
-)
-from zmpwalk.sim.motors import Motor, MotorFit, motor_fits
-from zmpwalk.sim.run import SimulationResult, simulate, write_result_csv
-from zmpwalk.sim.verdict import FAIL, HOLD, PASS, SETTLE, SKIP, WARN, Verdict, controller_words, walk_verdict
+from zmpwalk.sim.actuators import IMPACT_WINDOW, ActuatorRow, actuator_markdown, write_actuator_csv
+from zmpwalk.sim.motors import Motor, MotorFit
+from zmpwalk.sim.run import SimulationResult, write_result_csv
+from zmpwalk.sim.verdict import FAIL, PASS, SKIP, WARN, Verdict, controller_words
+from zmpwalk.walk import Progress, WalkSpec, run_walk
 
-Progress = Callable[[str, int, int], None]
 STAGES = ("pattern", "joints", "simulation", "plots", "animation", "page")
 
 
@@ -103,35 +94,25 @@ def build_report(
     """
     folder.mkdir(parents=True, exist_ok=True)
     report = Report(folder, folder / "index.html")
+    spec = WalkSpec(robot, commands, labels, generator=generator, schedule=schedule, pelvis=pelvis,
+                    check_limits=True, balance=balance, latency=latency, motors=motors)
+    walk = run_walk(spec, progress=None if progress is None else _walk_progress(progress))
+    pattern, result, rows, report.verdict = walk.pattern, walk.result, walk.rows, walk.verdict
     clock = time.perf_counter()
+    pattern.write_csv(folder / "pattern.csv")
+    write_actuator_csv(rows, folder / "actuators.csv")
+    write_result_csv(result, folder / "simulation.csv")
+    report.seconds.update(pattern=walk.seconds["pattern"], joints=walk.seconds["joints"],
+                          simulation=walk.seconds["simulation"] + walk.seconds["measures"])
 
     def done(stage: str) -> None:
         nonlocal clock
         now = time.perf_counter()
-        report.seconds[stage] = now - clock
+        report.seconds[stage] = report.seconds.get(stage, 0.0) + now - clock
         clock = now
         if progress:
             progress(stage, STAGES.index(stage) + 1, len(STAGES))
 
-    options: dict[str, object] = {"schedule": schedule} if schedule is not None else {}
-    if pelvis != "cubic":
-        options["pelvis"] = pelvis
-    pattern = pattern_generator(generator)(robot, commands, rate=1000.0, labels=labels, **options)
-    pattern.write_csv(folder / "pattern.csv")
-    done("pattern")
-    joints = pattern_joint_trajectory(pattern)
-    done("joints")
-    stabilizer = Stabilizer(robot, 1000.0, com_reference=pattern.com_point) if balance else None
-    def simulating(done: float) -> None:
-        if progress is not None:
-            progress("simulation", round(100 * done), 100)
-
-    result = simulate(robot, joints, pattern, stabilizer=stabilizer, latency=latency, settle=SETTLE, hold=HOLD,
-                      progress=simulating)
-    report.verdict = walk_verdict(result, HOLD, motors)
-    rows = actuator_table(result)
-    write_actuator_csv(rows, folder / "actuators.csv")
-    write_result_csv(result, folder / "simulation.csv")
     done("simulation")
     images, time_axes = _figures(pattern, result, motors)
     for index, payload in enumerate(images.values()):
@@ -140,7 +121,7 @@ def build_report(
     animation, animation_note = _animation(robot, result, folder, progress) if gif else (None, "")
     replay = _replay(robot, pattern, result, animation, animation_note) if animate else ""
     done("animation")
-    fits = motor_fits(result, motors) if motors else []
+    fits = walk.fits
     report.summary = _summary(pattern, result, report.verdict, fits, generator)
     movie = replay or _movie(animation, animation_note)
     page = _page(title, robot, report.summary, _figure_html(images, time_axes if replay else {}), movie,
@@ -149,6 +130,20 @@ def build_report(
     write_text(folder / "summary.json", json.dumps(report.summary, indent=2))
     done("page")
     return report
+
+
+def _walk_progress(progress: Progress) -> Progress:
+    """The walk's stages (:func:`zmpwalk.walk.run_walk`) as the report's: each stage reported done as the next
+    starts, the simulation's percentage passed on."""
+    previous = {"joints": "pattern", "simulation": "joints"}
+
+    def walking(stage: str, done: int, total: int) -> None:
+        if stage == "simulation" and total == 100:
+            progress(stage, done, total)
+        elif stage in previous:
+            progress(previous[stage], STAGES.index(previous[stage]) + 1, len(STAGES))
+
+    return walking
 
 
 ZMP_TIME = "ZMP and measured CoP against time, with the support polygon's bounds (Figs. 21, 27-31)"

@@ -1,8 +1,9 @@
 """Many simulated walks on all cores: :func:`sweep` runs scenarios in a process pool.
 
-Each walk is the pipeline of ``zmpwalk simulate``: the pattern at 1 kHz, the joint angles, the
-MuJoCo walk (with the stabilizer where asked), standing :data:`SETTLE` before and :data:`HOLD`
-after, and the verdict of :func:`zmpwalk.sim.verdict.walk_verdict`. Workers load the robot
+Each walk is the walk of ``zmpwalk simulate`` (:func:`zmpwalk.walk.run_walk`): the pattern at 1 kHz, the
+joint angles, the MuJoCo walk (with the stabilizer where asked), standing
+:data:`~zmpwalk.sim.verdict.SETTLE` before and :data:`~zmpwalk.sim.verdict.HOLD` after, and the verdict of
+:func:`zmpwalk.sim.verdict.walk_verdict`. Workers load the robot
 themselves (by name or model path), so nothing heavier than a few strings crosses a process
 boundary.
 
@@ -23,7 +24,6 @@ from typing import Any, TypeVar
 
 from zmpwalk.errors import InvalidParameterError, ZmpwalkError
 from zmpwalk.robots import loaded_robot
-from zmpwalk.sim.verdict import HOLD, SETTLE
 
 T = TypeVar("T")
 
@@ -71,35 +71,28 @@ def walk_scenario(robot: str, scenario: str, balance: bool = True, generator: st
         schedule: A schedule file (e.g. from ``zmpwalk tune``) instead of Tables 2-3.
         pelvis: ``"cubic"`` or ``"quintic"`` (the polynomial generator's pelvis curves).
     """
-    from zmpwalk.balance import Stabilizer
-    from zmpwalk.kinematics import pattern_joint_trajectory
-    from zmpwalk.patterns import generator as pattern_generator
     from zmpwalk.scenarios import load_scenario_with_labels
-    from zmpwalk.sim.run import simulate
-    from zmpwalk.sim.verdict import walk_verdict
+    from zmpwalk.walk import WalkSpec, planned_walk, run_walk
 
     start = time.perf_counter()
     model = loaded_robot(robot)
     commands, labels = load_scenario_with_labels(scenario)
-    options: dict[str, object] = {}
+    tables = None
     if schedule is not None:
         from pathlib import Path
 
         from zmpwalk.schedule import Schedule
 
-        options["schedule"] = Schedule.from_file(Path(schedule))
-    if pelvis != "cubic":
-        options["pelvis"] = pelvis
+        tables = Schedule.from_file(Path(schedule))
+    spec = WalkSpec(model, commands, labels, generator=generator, schedule=tables, pelvis=pelvis, balance=balance)
     try:
-        pattern = pattern_generator(generator)(model, commands, rate=1000.0, labels=labels, **options)
+        planned = planned_walk(spec)
     except ZmpwalkError as error:  # this walk is not possible with this generator: a result, not a crash
         return SweepResult(scenario=scenario, robot=model.name, passed=False, failed=("planned",), fell=False,
                            distance=math.nan, cop_error_rms=math.nan, simulated=0.0,
                            seconds=time.perf_counter() - start, error=str(error))
-    joints = pattern_joint_trajectory(pattern, check_limits=False)
-    stabilizer = Stabilizer(model, 1000.0, com_reference=pattern.com_point) if balance else None
-    result = simulate(model, joints, pattern, stabilizer=stabilizer, settle=SETTLE, hold=HOLD)
-    verdict = walk_verdict(result, HOLD)
+    walk = run_walk(spec, planned=planned)
+    result, verdict = walk.result, walk.verdict
     rms, _ = result.cop_error_stats()
     return SweepResult(
         scenario=scenario, robot=model.name, passed=verdict.passed,
