@@ -221,8 +221,8 @@ def test_noisy_delayed_sensors_reach_the_stabilizer_and_bad_noise_is_rejected():
 
 @pytest.mark.slow
 def test_a_sweep_on_two_processes_gives_the_walks_of_one():
-    """zmpwalk.sim.sweep: the same figures whether the walks run in a process pool or one after the other."""
-    from zmpwalk.sim.sweep import sweep
+    """zmpwalk.sweep: the same figures whether the walks run in a process pool or one after the other."""
+    from zmpwalk.sweep import sweep
 
     pooled = sweep("hubo", ["fig10", "turn45"], workers=2)
     inline = sweep("hubo", ["fig10", "turn45"], workers=1)
@@ -238,7 +238,7 @@ def test_a_sweep_on_two_processes_gives_the_walks_of_one():
 def test_a_sweep_on_a_local_dask_cluster_gives_the_walks_of_one_process():
     """Past one machine the same jobs run on Dask (here a local cluster of two processes)."""
     pytest.importorskip("dask.distributed")
-    from zmpwalk.sim.sweep import sweep
+    from zmpwalk.sweep import sweep
 
     on_dask = sweep("hubo", ["fig10", "turn45"], workers=2, scheduler="local")
     inline = sweep("hubo", ["fig10", "turn45"], workers=1)
@@ -251,7 +251,7 @@ def test_a_sweep_on_a_local_dask_cluster_gives_the_walks_of_one_process():
 def test_a_bad_dask_scheduler_or_no_dask_is_one_clear_error(monkeypatch):
     import sys
 
-    from zmpwalk.sim.sweep import sweep
+    from zmpwalk.sweep import sweep
 
     pytest.importorskip("dask.distributed")
     with pytest.raises(InvalidParameterError, match=r"scheduler = 'not an address'.*Dask scheduler reachable"):
@@ -273,7 +273,7 @@ def test_sweep_cli_exit_status_follows_the_verdicts(capsys):
 
 
 def test_a_sweep_reports_a_walk_its_generator_cannot_plan_instead_of_failing():
-    from zmpwalk.sim.sweep import sweep
+    from zmpwalk.sweep import sweep
 
     # the small biped's first 0.2 m step would take the hyperbolic pattern's ZMP out of its feet
     (result,) = sweep("mju-biped", ["fig10"], workers=1, generator="hyperbolic")
@@ -284,7 +284,7 @@ def test_a_sweep_reports_a_walk_its_generator_cannot_plan_instead_of_failing():
 def test_a_sweep_walks_a_tuned_schedule_and_the_quintic_pelvis():
     from pathlib import Path
 
-    from zmpwalk.sim.sweep import sweep
+    from zmpwalk.sweep import sweep
 
     tuned = str(Path(__file__).parent.parent / "examples" / "schedule_hubo_tuned.toml")
     (result,) = sweep("hubo", ["fig28"], workers=1, schedule=tuned)

@@ -48,7 +48,7 @@ from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots import loaded_robot
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import TURN_COLUMNS, Schedule
-from zmpwalk.sim.sweep import in_pool
+from zmpwalk.sweep import in_pool
 
 FORWARD_RANGES = {"sway": (0.02, 0.06), "alpha": (1.0, 2.2), "up_ratio": (0.3, 0.6)}  # [m], [-], [-]
 SIDE_RANGES = {"sway": (0.02, 0.06), "up_ratio": (0.3, 0.6), "alpha1": (0.6, 1.2), "beta1": (0.6, 1.2),
@@ -350,7 +350,7 @@ def tune(robot: str, trials: int = 40, seed: int = 0, workers: int | None = None
         conditions: Only these rows (default: every row).
         progress: Called with (conditions done, of, best score so far [m]).
         scheduler: Tune the conditions on a Dask cluster (its scheduler's address, or ``"local"``;
-            :func:`zmpwalk.sim.sweep.in_pool`). With ``storage``, every worker must reach the same file.
+            :func:`zmpwalk.sweep.in_pool`). With ``storage``, every worker must reach the same file.
         timing: Also tune ``V_y`` and the double-support time ``d`` of Table 2's rows (within
             :data:`TIMING_RANGES`; the columns are added, starting from the robot's values).
 

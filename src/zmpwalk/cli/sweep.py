@@ -56,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
     import os
 
     require_robot_by_name(args)
-    from zmpwalk.sim.sweep import sweep
+    from zmpwalk.sweep import sweep
 
     names = args.scenario or list(list_scenarios())
     for name in names:

@@ -2,7 +2,7 @@
 
 :func:`export_motions` walks every command of a :class:`Grid` through the walking controller
 (:func:`zmpwalk.sim.loop.simulate_controller`, stabilizer and feedforward on; :mod:`zmpwalk.export.clips`), one
-command per worker process at a time (:func:`zmpwalk.sim.sweep.in_pool`, Dask too), and writes per command four
+command per worker process at a time (:func:`zmpwalk.sweep.in_pool`, Dask too), and writes per command four
 clips: the simulated and the planned motion, each whole (start to stop) and cyclic (whole gait cycles of steady
 walking, loop points marked), each in mjlab's npz, a LocoMuJoCo-style npz, AMP JSON, CSV and a ROS 2 bag (MCAP;
 :mod:`zmpwalk.export.rosbag`). Every file is read
@@ -255,7 +255,7 @@ def export_motions(robot: str, grid: Grid | None = None, out: str | Path = "zmpw
         workers: Commands walked at a time (default: one per core).
         swings: Swings walked per command (a side or turn step is two), at least 6 for a cyclic clip (two swings
             of start, one gait cycle, two of stop).
-        scheduler: A Dask scheduler's address or ``"local"`` (:func:`zmpwalk.sim.sweep.in_pool`).
+        scheduler: A Dask scheduler's address or ``"local"`` (:func:`zmpwalk.sweep.in_pool`).
         progress: Called with commands done and their number.
 
     Returns:
@@ -267,7 +267,7 @@ def export_motions(robot: str, grid: Grid | None = None, out: str | Path = "zmpw
         FileFormatError: ``out`` cannot be made.
     """
     from zmpwalk.robots import loaded_robot
-    from zmpwalk.sim.sweep import in_pool
+    from zmpwalk.sweep import in_pool
 
     grid = grid or Grid()
     workers = workers if workers is not None else (os.cpu_count() or 1)
