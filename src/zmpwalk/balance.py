@@ -192,7 +192,7 @@ class Stabilizer:
         if com_reference not in COM_REFERENCES:
             raise InvalidParameterError("com_reference", com_reference, f"one of {', '.join(COM_REFERENCES)}")
         if com_reference == "auto":
-            com_reference = "whole_body" if robot.plant is not None else "pelvis"
+            com_reference = "whole_body" if robot.own_model else "pelvis"
         self.com_reference = com_reference
         from zmpwalk import balance_kernel as kernel  # compiles (or loads) the tick: only where one is wanted
 

@@ -253,12 +253,12 @@ def margins(robot: RobotModel, data: dict[str, Any], condition: Condition, steps
 
     try:
         pattern = condition_walk(robot, data, condition, steps)
-        if robot.plant is not None:
+        if robot.own_model:
             pattern_joint_trajectory(pattern, check_limits=False)
     except ZmpwalkError:
         return -math.inf, -math.inf
     cart = float(np.nanmin(pattern.zmp_margin()))
-    if not robot.links or robot.plant is not None:
+    if not robot.links or robot.own_model:
         return cart, math.nan
     multibody = compare_zmp(pattern).multibody
     return cart, float(np.nanmin(replace(pattern, zmp_in_world=multibody).zmp_margin()))

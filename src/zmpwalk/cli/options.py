@@ -192,7 +192,7 @@ def generator_words(args: argparse.Namespace, robot: RobotModel) -> str:
     if getattr(args, "generator_given", True):
         return f"{args.generator} (--generator)"
     why = ("the robot file's [walking] generator" if robot.generator is not None else
-           "the default for a robot's own model" if robot.plant is not None else "the default for a box model")
+           "the default for a robot's own model" if robot.own_model else "the default for a box model")
     return f"{args.generator} ({why}; --generator to choose)"
 
 

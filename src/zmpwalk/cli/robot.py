@@ -36,7 +36,7 @@ def run(args: argparse.Namespace) -> int:
     args.robot = args.model
     robot = load_robot_of(args)
     statics, no_statics = None, ""
-    if robot.plant is not None:
+    if robot.own_model:
         from zmpwalk.sim.statics import static_torques
 
         try:

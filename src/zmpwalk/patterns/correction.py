@@ -75,7 +75,7 @@ def correct_pattern(pattern: WalkingPattern, passes: int = 3) -> ZmpCorrection:
     if isinstance(passes, bool) or not isinstance(passes, int) or not 1 <= passes <= MAX_PASSES:
         raise InvalidParameterError("passes", passes, f"an integer in [1, {MAX_PASSES}]")
     robot = pattern.robot
-    if robot.plant is not None or not robot.links:
+    if robot.own_model or not robot.links:
         raise InvalidParameterError("robot", robot.name, "a robot file with [bodies] (the multibody ZMP's links); "
                                     "an imported robot is placed by its whole-body centre of mass instead")
     gains = preview_gains(1.0 / pattern.rate, robot.pendulum_length, robot.gravity)

@@ -153,7 +153,7 @@ class WalkingPattern:
         """What a stabilizer tracks as this pattern's CoM (:class:`zmpwalk.balance.Stabilizer`'s
         ``com_reference``): ``"whole_body"`` where it records ``position_com_in_world`` or its robot is imported
         (the base is placed under the pattern's point), else ``"pelvis"`` (a box model's pelvis point)."""
-        return "whole_body" if self.position_com_in_world is not None or self.robot.plant is not None else "pelvis"
+        return "whole_body" if self.position_com_in_world is not None or self.robot.own_model else "pelvis"
 
     @property
     def position_com_point_in_world(self) -> Array:

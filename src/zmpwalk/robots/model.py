@@ -178,14 +178,22 @@ class RobotModel:
     generator: str | None = None  # the robot file's [walking] generator; None: default_generator's rule
 
     @property
+    def own_model(self) -> bool:
+        """Whether the robot is its own MJCF/URDF model (:func:`zmpwalk.robots.imported.import_robot`: the
+        simulation drives that model, its :attr:`legs` are chains found in it, the pattern's point is its
+        whole-body centre of mass) rather than a box model generated from a robot file's data (the pattern's
+        point is the pelvis, the legs the straight closed form of its link lengths)."""
+        return self.plant is not None
+
+    @property
     def default_generator(self) -> str:
         """The pattern generator this robot walks with where none is named (``zmpwalk plan``, ``simulate``,
         ``report``, ``demo``, ``sweep`` without ``--generator``): the robot file's ``[walking] generator``,
-        else :data:`OWN_MODEL_GENERATOR` for a robot built from its own model (it has a :attr:`plant`),
+        else :data:`OWN_MODEL_GENERATOR` for a robot built from its own model (:attr:`own_model`),
         else :data:`BOX_MODEL_GENERATOR`."""
         if self.generator is not None:
             return self.generator
-        return OWN_MODEL_GENERATOR if self.plant is not None else BOX_MODEL_GENERATOR
+        return OWN_MODEL_GENERATOR if self.own_model else BOX_MODEL_GENERATOR
 
     def hip_in_pelvis(self, side: int) -> tuple[float, float, float]:
         """Hip joint centre of the left (``side = +1``) or right (-1) leg relative to the pattern's pelvis

@@ -155,7 +155,7 @@ def _checked_inputs(robot: RobotModel, joints: JointTrajectory, pattern: Walking
 def _settle_and_hold(robot: RobotModel, settle: float | None, hold: float | None) -> tuple[float, float]:
     """The settle before and the hold after the walk [s]: those given, else :data:`OWN_MODEL_SETTLE` and
     :data:`OWN_MODEL_HOLD` for a robot's own model and 0 for the box models (which start at rest on their soles)."""
-    imported = robot.plant is not None
+    imported = robot.own_model
     settle = (OWN_MODEL_SETTLE if imported else 0.0) if settle is None else settle
     hold = (OWN_MODEL_HOLD if imported else 0.0) if hold is None else hold
     if not 0.0 <= settle <= 10.0:
