@@ -71,7 +71,7 @@ def run_for(parts: Parts[T], budget: float, quota: int = 1,
     """
     begin = clock()
     count = 0
-    site = next_site(parts) if costs is not None else None
+    site = next_site(parts) if costs is not None else (None, -1)
     last = begin
     while True:
         try:
@@ -84,7 +84,7 @@ def run_for(parts: Parts[T], budget: float, quota: int = 1,
         elapsed = now - begin
         if costs is not None:
             taken = now - last
-            costs[site] = max(taken, COST_DECAY * costs.get(site, 0.0))  # type: ignore[index]
+            costs[site] = max(taken, COST_DECAY * costs.get(site, 0.0))
             site, last = next_site(parts), now
             if elapsed + costs.get(site, 0.0) > LONGEST_CALL * budget:
                 return UNFINISHED, count
