@@ -25,8 +25,8 @@ Behaviour:
   pelvis axis, the sway, each foot; each leg's angles and rates in parts; the joint ranges). A tick runs
   parts while the next one, taken as long as the mean of the tick's so far, ends within its budget
   (:func:`work_budget`: :data:`WORK_BUDGET`, 50 us, or :data:`WORK_FRACTION` of the control period where
-  that is longer, 100 us at 100 Hz, at most :data:`WORK_LIMIT`), at least one, none begins after the budget
-  is spent, and none expected (from its last runs) to end after twice the budget begins but first: a tick's work
+  that is longer, 100 us at 100 Hz, at most :data:`WORK_LIMIT`), at least one, and none begins after the budget
+  is spent (with a :class:`~zmpwalk.control.WalkingController`, the budget less the tick's own work): a tick's work
   is bounded by its budget and one part, whenever commands come. So a check ends as early as the budget
   allows (a few hundred ticks at 1 kHz), and most ticks have nothing to do. When the check completes the
   command is :attr:`~OnlineWalker.queued`; when it fails the reason is kept in
@@ -216,7 +216,6 @@ class OnlineWalker:
         self._job: CheckJob | None = None
         self._rejection: Rejection | None = None
         self._check_parts = 0  # parts the last completed check took
-        self._part_costs: dict[tuple[object, int], float] = {}  # [s] per part of a check (slices.run_for)
         self._buffers = RowBuffers(self._width, READY_BUFFERS, math.ceil(READY_SECONDS * self.rate))
         self._check = CommandCheck(robot, self._schedule, self._pelvis, self.joints, self._buffers)
         self._set_standing(self._check.standing_row(self._stance))
@@ -372,7 +371,7 @@ class OnlineWalker:
         quota = -(-(expected - job.parts) // ticks_left)  # its share of the parts left
         plan: object
         try:
-            plan, parts = run_for(job.planning, self._budget - spent, quota, _clock, self._part_costs)
+            plan, parts = run_for(job.planning, self._budget - spent, quota, _clock)
             job.parts += parts
         except ZmpwalkError as error:
             self._drop_job()

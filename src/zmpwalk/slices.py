@@ -34,45 +34,21 @@ def run_to_end(parts: Parts[T]) -> T:
 
 
 UNFINISHED = object()  # what :func:`run_for` returns while the computation has parts left
-COST_DECAY = 0.75  # [-] a part's remembered cost falls to this share of itself at each shorter run of it
-LONGEST_CALL = 2.0  # [-] of its budget: with costs, run_for begins no part expected to end after this, but its first
-
-
-def next_site(parts: Parts[Any]) -> tuple[object, int]:
-    """Where a sliced computation stands between two parts (its innermost generator's code and instruction): the
-    part it runs next."""
-    generator: Any = parts
-    while True:
-        inner = generator.gi_yieldfrom
-        if inner is None or not hasattr(inner, "gi_yieldfrom"):
-            break
-        generator = inner
-    frame = generator.gi_frame
-    return (None, -1) if frame is None else (frame.f_code, frame.f_lasti)
 
 
 def run_for(parts: Parts[T], budget: float, quota: int = 1,
-            clock: Callable[[], float] = time.perf_counter, costs: dict[tuple[object, int], float] | None = None,
-            ) -> tuple[T | object, int]:
+            clock: Callable[[], float] = time.perf_counter) -> tuple[T | object, int]:
     """Run parts of a sliced computation within ``budget`` [s] of ``clock``: one, then more while the next one,
     taken as long as the mean of those run so far, ends within ``budget``, or (up to ``quota`` parts) while
     ``budget`` is not spent. No part begins after ``budget`` is spent, so the time taken is bounded by
     ``budget`` and one part, whatever the computation; a part marked :data:`ALONE` begins only while at most
     :data:`LONG_PART_START` of ``budget`` is spent (so it begins the next call instead of ending this one).
 
-    With ``costs`` (kept by the caller from call to call) the time [s] each part (:func:`next_site`) last took is
-    remembered, the longest of its recent runs (an older, longer one weighs :data:`COST_DECAY` less at each
-    shorter run), and a part expected to end after :data:`LONGEST_CALL` times ``budget`` begins the next call
-    instead: a long part runs first in a call, not after the budget's worth of shorter ones, so that a call takes
-    at most about the longer of that and the longest part.
-
     Returns:
         Its result (:data:`UNFINISHED` while it has parts left), and the number of parts run.
     """
     begin = clock()
     count = 0
-    site = next_site(parts) if costs is not None else (None, -1)
-    last = begin
     while True:
         try:
             mark = next(parts)
@@ -80,14 +56,7 @@ def run_for(parts: Parts[T], budget: float, quota: int = 1,
             result: T = done.value
             return result, count + 1
         count += 1
-        now = clock()
-        elapsed = now - begin
-        if costs is not None:
-            taken = now - last
-            costs[site] = max(taken, COST_DECAY * costs.get(site, 0.0))
-            site, last = next_site(parts), now
-            if elapsed + costs.get(site, 0.0) > LONGEST_CALL * budget:
-                return UNFINISHED, count
+        elapsed = clock() - begin
         if elapsed >= budget or (count >= quota and elapsed * (count + 1) > budget * count) or (
                 mark is ALONE and elapsed > LONG_PART_START * budget):
             return UNFINISHED, count
