@@ -46,6 +46,7 @@ CONFIGURATIONS = {  # name: (rate [Hz], joints, generator, the whole controller)
 }
 HOSTILE_KINDS = ("reach", "fast", "stop", "zero")
 HOSTILE_SHARE = 0.2  # [-] of the commands
+KINDS = ("no check", "step", *HOSTILE_KINDS)  # what a tick's check was of
 
 
 def draw_command(rng: np.random.Generator) -> tuple[str, dict[str, float] | None]:
@@ -74,14 +75,17 @@ class Operator:
     """Who gives the commands: one at a random tick of every step (after a random wait while standing), drawn by
     :func:`draw_command` from a seeded rng, and the counts of what became of them (outside the timing)."""
 
-    def __init__(self, rate: float, seed: int) -> None:
+    def __init__(self, rate: float, seed: int, ticks: int) -> None:
         from zmpwalk import StepCommand
 
         self.rate = rate
         self.rng = np.random.default_rng(seed)
         self.counts = dict.fromkeys(("given", "caught", "rejected", "walked", "restarted", "stops"), 0)
-        self.kinds: list[str] = []  # per tick: the kind of the command whose check ran in it, "" where none did
-        self.last = ""  # the kind of the last command given
+        # per tick: the kind of the command whose check ran in it (an index of KINDS), preallocated: a list grown
+        # in the loop would be traversed by every pass of the garbage collector
+        self.kinds = np.zeros(ticks, dtype=np.int8)
+        self.tick = 0
+        self.last = "no check"  # the kind of the last command given
         self.support, self.give_at, self.since = "double", int(self.rng.integers(1, int(0.5 * rate) + 2)), 0
         self.kind, self.fields = draw_command(self.rng)
         self.command = StepCommand(**self.fields) if self.fields and self.kind != "zero" else None
@@ -106,7 +110,8 @@ class Operator:
         counts["restarted"] += job is not None and walker._job is not None and walker._job is not job
         if given:
             self.last = self.kind
-        self.kinds.append(self.last if job is not None else "")
+        self.kinds[self.tick] = KINDS.index(self.last) if job is not None else 0
+        self.tick += 1
         self.since += 1
         if given:
             counts["given"] += 1
@@ -148,7 +153,7 @@ def run_loop(rate: float, joints: bool, ticks: int, seed: int, generator: str = 
     from zmpwalk import OnlineWalker, load_robot
 
     walker = OnlineWalker(load_robot("hubo"), rate=rate, joints=joints, generator=generator)
-    operator = Operator(rate, seed)
+    operator = Operator(rate, seed, ticks)
     times = np.empty(ticks, dtype=np.int64)
     collect(collector)
     clock = time.thread_time_ns
@@ -161,7 +166,7 @@ def run_loop(rate: float, joints: bool, ticks: int, seed: int, generator: str = 
         operator.after(walker, sample, given, job)
     gc.enable()
     gc.unfreeze()
-    return {"us": (times / 1e3).tolist(), "kinds": operator.kinds, **operator.counts}
+    return {"us": (times / 1e3).tolist(), "kinds": operator.kinds.tolist(), **operator.counts}
 
 
 def run_controller(rate: float, ticks: int, seed: int, generator: str = "polynomial",
@@ -176,7 +181,7 @@ def run_controller(rate: float, ticks: int, seed: int, generator: str = "polynom
     controller = WalkingController(robot, rate=rate, generator=generator)
     plant = MockPlant(robot, rate)
     walker = controller.walker
-    operator = Operator(rate, seed)
+    operator = Operator(rate, seed, ticks)
     times, inner = np.empty(ticks, dtype=np.int64), np.empty(ticks, dtype=np.int64)
     collect(collector)
     clock = time.thread_time_ns
@@ -195,7 +200,7 @@ def run_controller(rate: float, ticks: int, seed: int, generator: str = "polynom
         operator.after(walker, targets.sample, given, job)
     gc.enable()
     gc.unfreeze()
-    return {"us": (times / 1e3).tolist(), "update_us": (inner / 1e3).tolist(), "kinds": operator.kinds,
+    return {"us": (times / 1e3).tolist(), "update_us": (inner / 1e3).tolist(), "kinds": operator.kinds.tolist(),
             "faults": controller.faults, **operator.counts}
 
 
@@ -221,13 +226,13 @@ def figures(us: np.ndarray) -> str:
             f"max {us.max():8.1f}  >200us {int((us > 200).sum()):5d}  >1ms {int((us > 1000).sum()):3d}")
 
 
-def by_kind(us: np.ndarray, kinds: list[str]) -> str:
+def by_kind(us: np.ndarray, kinds: list[int]) -> str:
     """The max and the count over 200 us of the ticks in which no check ran, and of those in which the check of
     each kind of command ran."""
-    labels = np.array([kind or "no check" for kind in kinds])
+    codes = np.array(kinds)
     parts = []
-    for label in ["no check", "step", *HOSTILE_KINDS]:
-        chosen = us[labels == label]
+    for code, label in enumerate(KINDS):
+        chosen = us[codes == code]
         if len(chosen):
             parts.append(f"{label} ({len(chosen)}): max {chosen.max():.0f}, >200us {int((chosen > 200).sum())}")
     return "    ticks by the check they ran: " + "; ".join(parts)
