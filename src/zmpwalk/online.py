@@ -149,7 +149,7 @@ _SUPPORT_OF_CODE = {float(code): name for code, name in enumerate(SUPPORT_LABELS
 _clock = time.perf_counter  # [s] the clock of the budget (a test replaces it with one that counts parts)
 WORK_BUDGET = 50e-6  # [s] a tick runs parts of a check while the next one is expected to end within this
 WORK_FRACTION = 0.01  # [-] ... or within this fraction of the control period, where that is longer (below 200 Hz)
-WORK_LIMIT = 400e-6  # [s] ... but never over this (below 25 Hz): a tick's work stays well under a millisecond
+WORK_LIMIT = 500e-6  # [s] ... but never over this (below 20 Hz): a tick's work stays well under a millisecond
 PARTS_PER_BLOCK = 45  # parts of a block of SLICE_ROWS samples (a first guess of a check's length, before one has run)
 FINISH_EARLY = 0.95  # [-] a check is paced to end within this fraction of the ticks before its step begins
 
@@ -187,7 +187,7 @@ class OnlineWalker:
             pendulum pattern of Lim et al., stage by stage: :mod:`zmpwalk.patterns.lipm_stage`; same
             footsteps, swings and continuity; a command whose ZMP would leave the feet is rejected).
         budget: The time [s] a tick may spend on a command's check, one part over at most (default
-            :func:`work_budget`: 50 us, or 1 % of the control period where that is longer, at most 400 us).
+            :func:`work_budget`: 50 us, or 1 % of the control period where that is longer, at most 500 us).
             Smaller: shorter ticks, and checks that take more ticks, so that more commands come too late for the
             step they were given in (and walk a step later: module docstring).
 
