@@ -36,14 +36,17 @@ from pathlib import Path
 
 import numpy as np
 
-CONFIGURATIONS = {  # name: (rate [Hz], joints, generator)
-    "1 kHz, joints": (1000.0, True, "polynomial"),
-    "1 kHz, no joints": (1000.0, False, "polynomial"),
-    "100 Hz, joints": (100.0, True, "polynomial"),
-    "1 kHz, joints, hyperbolic": (1000.0, True, "hyperbolic"),
+CONFIGURATIONS = {  # name: (rate [Hz], joints, generator, the whole controller)
+    "1 kHz, joints": (1000.0, True, "polynomial", False),
+    "1 kHz, no joints": (1000.0, False, "polynomial", False),
+    "100 Hz, joints": (100.0, True, "polynomial", False),
+    "1 kHz, joints, hyperbolic": (1000.0, True, "hyperbolic", False),
+    "controller 1 kHz": (1000.0, True, "polynomial", True),
+    "controller 100 Hz": (100.0, True, "polynomial", True),
 }
 HOSTILE_KINDS = ("reach", "fast", "stop", "zero")
 HOSTILE_SHARE = 0.2  # [-] of the commands
+KINDS = ("no check", "step", *HOSTILE_KINDS)  # what a tick's check was of
 
 
 def draw_command(rng: np.random.Generator) -> tuple[str, dict[str, float] | None]:
@@ -68,64 +71,137 @@ def draw_command(rng: np.random.Generator) -> tuple[str, dict[str, float] | None
                     "turn": float(rng.uniform(-0.15, 0.15))}
 
 
-def run_loop(rate: float, joints: bool, ticks: int, seed: int, generator: str = "polynomial",
-             collector: str = "freeze") -> dict[str, object]:
-    """The loop of the module docstring; per-tick CPU times [us] and counts. ``collector``: ``"freeze"``
-    (``gc.collect(); gc.freeze()`` after setup) or ``"disable"`` (and the collector off during the loop)."""
-    from zmpwalk import OnlineWalker, StepCommand, ZmpwalkError, load_robot
+class Operator:
+    """Who gives the commands: one at a random tick of every step (after a random wait while standing), drawn by
+    :func:`draw_command` from a seeded rng, and the counts of what became of them (outside the timing)."""
 
-    walker = OnlineWalker(load_robot("hubo"), rate=rate, joints=joints, generator=generator)
-    rng = np.random.default_rng(seed)
-    counts = dict.fromkeys(("given", "caught", "rejected", "walked", "restarted", "stops"), 0)
-    times = np.empty(ticks, dtype=np.int64)
-    support, give_at, since = "double", int(rng.integers(1, int(0.5 * rate) + 2)), 0
-    kind, fields = draw_command(rng)
-    command = StepCommand(**fields) if fields and kind != "zero" else None
-    rejection = queued = None
+    def __init__(self, rate: float, seed: int, ticks: int) -> None:
+        from zmpwalk import StepCommand
+
+        self.rate = rate
+        self.rng = np.random.default_rng(seed)
+        self.counts = dict.fromkeys(("given", "caught", "rejected", "walked", "restarted", "stops"), 0)
+        # per tick: the kind of the command whose check ran in it (an index of KINDS), preallocated: a list grown
+        # in the loop would be traversed by every pass of the garbage collector
+        self.kinds = np.zeros(ticks, dtype=np.int8)
+        self.tick = 0
+        self.last = "no check"  # the kind of the last command given
+        self.support, self.give_at, self.since = "double", int(self.rng.integers(1, int(0.5 * rate) + 2)), 0
+        self.kind, self.fields = draw_command(self.rng)
+        self.command = StepCommand(**self.fields) if self.fields and self.kind != "zero" else None
+        self.rejection: object = None
+        self.queued: object = None
+
+    def give(self, target: object) -> bool:
+        """Give the command due at this tick, if any, to ``target`` (a walker or a controller); whether one was."""
+        if self.since != self.give_at:
+            return False
+        if self.command is not None:
+            target.command(self.command)  # type: ignore[attr-defined]
+        elif self.kind == "stop":
+            target.stop()  # type: ignore[attr-defined]
+        return True
+
+    def after(self, walker: object, sample: object, given: bool, job: object) -> None:
+        """After the timed iteration: count, draw the next command and the tick to give it at."""
+        from zmpwalk import StepCommand, ZmpwalkError
+
+        counts, rate = self.counts, self.rate
+        counts["restarted"] += job is not None and walker._job is not None and walker._job is not job
+        if given:
+            self.last = self.kind
+        self.kinds[self.tick] = KINDS.index(self.last) if job is not None else 0
+        self.tick += 1
+        self.since += 1
+        if given:
+            counts["given"] += 1
+            counts["stops"] += self.kind == "stop"
+            if self.kind == "zero":
+                try:
+                    StepCommand(**self.fields)  # type: ignore[arg-type]
+                except ZmpwalkError:
+                    counts["caught"] += 1
+            self.kind, self.fields = draw_command(self.rng)
+            self.command = StepCommand(**self.fields) if self.fields and self.kind != "zero" else None
+            self.give_at = -1
+        if walker.queued is not self.queued:
+            counts["walked"] += self.queued is not None and walker.queued is None
+            self.queued = walker.queued
+        if walker.rejection is not self.rejection:  # names the rejection the first time (outside the timing)
+            self.rejection = walker.rejection
+            counts["rejected"] += self.rejection is not None
+        if sample.support != self.support:
+            if sample.support == "double" and self.support in ("left", "right"):  # a landing: a new step
+                self.give_at, self.since = int(self.rng.integers(1, int(0.8 * rate) + 1)), 0
+            self.support = sample.support
+        elif self.give_at < 0 and not walker.walking and walker.checking is None:  # standing: the next walk
+            self.give_at, self.since = int(self.rng.integers(1, int(0.5 * rate) + 2)), 0
+
+
+def collect(collector: str) -> None:
+    """``gc.collect(); gc.freeze()`` after setup, as the README's loop (and the collector off with ``disable``)."""
     gc.collect()
     gc.freeze()
     if collector == "disable":
         gc.disable()
+
+
+def run_loop(rate: float, joints: bool, ticks: int, seed: int, generator: str = "polynomial",
+             collector: str = "freeze") -> dict[str, object]:
+    """The walker's loop of the module docstring; per-tick CPU times [us] and counts. ``collector``: ``"freeze"``
+    (``gc.collect(); gc.freeze()`` after setup) or ``"disable"`` (and the collector off during the loop)."""
+    from zmpwalk import OnlineWalker, load_robot
+
+    walker = OnlineWalker(load_robot("hubo"), rate=rate, joints=joints, generator=generator)
+    operator = Operator(rate, seed, ticks)
+    times = np.empty(ticks, dtype=np.int64)
+    collect(collector)
     clock = time.thread_time_ns
     for index in range(ticks):
-        give = since == give_at
         start = clock()
-        if give:
-            if command is not None:
-                walker.command(command)
-            elif kind == "stop":
-                walker.stop()
+        given = operator.give(walker)
         job = walker._job  # private: to count the checks restarted in this tick
         sample = walker.tick()
         times[index] = clock() - start
-        counts["restarted"] += job is not None and walker._job is not None and walker._job is not job
-        since += 1
-        if give:  # outside the timing: the operator's bookkeeping and the next command
-            counts["given"] += 1
-            counts["stops"] += kind == "stop"
-            if kind == "zero":
-                try:
-                    StepCommand(**fields)  # type: ignore[arg-type]
-                except ZmpwalkError:
-                    counts["caught"] += 1
-            kind, fields = draw_command(rng)
-            command = StepCommand(**fields) if fields and kind != "zero" else None
-            give_at = -1
-        if walker.queued is not queued:
-            counts["walked"] += queued is not None and walker.queued is None
-            queued = walker.queued
-        if walker.rejection is not rejection:  # names the rejection the first time (outside the timing)
-            rejection = walker.rejection
-            counts["rejected"] += rejection is not None
-        if sample.support != support:
-            if sample.support == "double" and support in ("left", "right"):  # a landing: a new step
-                give_at, since = int(rng.integers(1, int(0.8 * rate) + 1)), 0
-            support = sample.support
-        elif give_at < 0 and not walker.walking and walker.checking is None:  # standing: the next walk
-            give_at, since = int(rng.integers(1, int(0.5 * rate) + 2)), 0
+        operator.after(walker, sample, given, job)
     gc.enable()
     gc.unfreeze()
-    return {"us": (times / 1e3).tolist(), **counts}
+    return {"us": (times / 1e3).tolist(), "kinds": operator.kinds.tolist(), **operator.counts}
+
+
+def run_controller(rate: float, ticks: int, seed: int, generator: str = "polynomial",
+                   collector: str = "freeze") -> dict[str, object]:
+    """The whole controller's loop: a :class:`~zmpwalk.control.WalkingController` (pattern, legs, stabilizer) on
+    a :class:`~zmpwalk.control.MockPlant`; timed per iteration: ``plant.measure()``, the command given in it, if
+    any, ``controller.update()`` and ``plant.apply()``."""
+    from zmpwalk import load_robot
+    from zmpwalk.control import MockPlant, WalkingController
+
+    robot = load_robot("hubo")
+    controller = WalkingController(robot, rate=rate, generator=generator)
+    plant = MockPlant(robot, rate)
+    walker = controller.walker
+    operator = Operator(rate, seed, ticks)
+    times, inner = np.empty(ticks, dtype=np.int64), np.empty(ticks, dtype=np.int64)
+    collect(collector)
+    clock = time.thread_time_ns
+    for index in range(ticks):
+        start = clock()
+        measurement = plant.measure()
+        given = operator.give(controller)
+        job = walker._job  # private: to count the checks restarted in this tick
+        begin = clock()
+        targets = controller.update(measurement)
+        end = clock()
+        plant.apply(targets)
+        times[index] = clock() - start
+        inner[index] = end - begin
+        plant.step()
+        operator.after(walker, targets.sample, given, job)
+    gc.enable()
+    gc.unfreeze()
+    return {"us": (times / 1e3).tolist(), "update_us": (inner / 1e3).tolist(), "kinds": operator.kinds.tolist(),
+            "faults": controller.faults, **operator.counts}
 
 
 def run_floor(ticks: int) -> dict[str, object]:
@@ -150,6 +226,18 @@ def figures(us: np.ndarray) -> str:
             f"max {us.max():8.1f}  >200us {int((us > 200).sum()):5d}  >1ms {int((us > 1000).sum()):3d}")
 
 
+def by_kind(us: np.ndarray, kinds: list[int]) -> str:
+    """The max and the count over 200 us of the ticks in which no check ran, and of those in which the check of
+    each kind of command ran."""
+    codes = np.array(kinds)
+    parts = []
+    for code, label in enumerate(KINDS):
+        chosen = us[codes == code]
+        if len(chosen):
+            parts.append(f"{label} ({len(chosen)}): max {chosen.max():.0f}, >200us {int((chosen > 200).sum())}")
+    return "    ticks by the check they ran: " + "; ".join(parts)
+
+
 def child(configuration: str, ticks: int, seed: int, source: str | None, collector: str) -> dict[str, object]:
     """One configuration in a fresh process (``source``: a src directory put first on PYTHONPATH)."""
     environment = dict(os.environ)
@@ -172,14 +260,17 @@ def main() -> None:
     parser.add_argument("--gc", choices=["freeze", "disable"], default="freeze",
                         help="after setup gc.collect(); gc.freeze() (default, the README's loop), and with "
                              "'disable' the collector off during the loop")
+    parser.add_argument("--by-kind", action="store_true",
+                        help="also the max of the ticks by the kind of command whose check ran in them")
     parser.add_argument("--child", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
         if args.child == "floor":
             result = run_floor(args.ticks)
         else:
-            rate, joints, generator = CONFIGURATIONS[args.child]
-            result = run_loop(rate, joints, args.ticks, args.seed, generator, args.gc)
+            rate, joints, generator, whole = CONFIGURATIONS[args.child]
+            result = (run_controller(rate, args.ticks, args.seed, generator, args.gc) if whole
+                      else run_loop(rate, joints, args.ticks, args.seed, generator, args.gc))
         import zmpwalk
 
         result["source"] = str(Path(zmpwalk.__file__).parent.parent)
@@ -188,8 +279,9 @@ def main() -> None:
     trees: list[tuple[str, str | None]] = [("now", None)]
     if args.before:
         trees.insert(0, ("before", str(Path(args.before) / "src")))
-    print(f"per-iteration CPU time [us] (command() given in it, if any, and tick()), {args.ticks} ticks each, "
-          f"seed {args.seed}, garbage collector: {args.gc}")
+    print(f"per-iteration CPU time [us] (the walker: command() given in it, if any, and tick(); the controller: "
+          f"plant.measure(), command(), update(), plant.apply()), {args.ticks} ticks each, seed {args.seed}, garbage "
+          f"collector: {args.gc}")
     for configuration in args.only or ["floor", *CONFIGURATIONS]:
         for name, source in trees if configuration != "floor" else [("", None)]:
             result = child(configuration, args.ticks, args.seed, source, args.gc)
@@ -199,6 +291,10 @@ def main() -> None:
                 f"restarted, the walk having taken another step)")
             label = f"{configuration} {name}".strip()
             print(f"{label:38} {figures(np.array(result['us']))}{counts}", flush=True)
+            if "update_us" in result:
+                print(f"{'  of which update()':38} {figures(np.array(result['update_us']))}", flush=True)
+            if args.by_kind and configuration != "floor":
+                print(by_kind(np.array(result["us"]), result["kinds"]), flush=True)
 
 
 if __name__ == "__main__":

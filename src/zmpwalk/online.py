@@ -25,7 +25,8 @@ Behaviour:
   pelvis axis, the sway, each foot; each leg's angles and rates in parts; the joint ranges). A tick runs
   parts while the next one, taken as long as the mean of the tick's so far, ends within its budget
   (:func:`work_budget`: :data:`WORK_BUDGET`, 50 us, or :data:`WORK_FRACTION` of the control period where
-  that is longer, 100 us at 100 Hz), at least one, and none begins after the budget is spent: a tick's work
+  that is longer, 100 us at 100 Hz, at most :data:`WORK_LIMIT`), at least one, and none begins after the budget
+  is spent (with a :class:`~zmpwalk.control.WalkingController`, the budget less the tick's own work): a tick's work
   is bounded by its budget and one part, whenever commands come. So a check ends as early as the budget
   allows (a few hundred ticks at 1 kHz), and most ticks have nothing to do. When the check completes the
   command is :attr:`~OnlineWalker.queued`; when it fails the reason is kept in
@@ -148,14 +149,15 @@ _SUPPORT_OF_CODE = {float(code): name for code, name in enumerate(SUPPORT_LABELS
 _clock = time.perf_counter  # [s] the clock of the budget (a test replaces it with one that counts parts)
 WORK_BUDGET = 50e-6  # [s] a tick runs parts of a check while the next one is expected to end within this
 WORK_FRACTION = 0.01  # [-] ... or within this fraction of the control period, where that is longer (below 200 Hz)
+WORK_LIMIT = 500e-6  # [s] ... but never over this (below 20 Hz): a tick's work stays well under a millisecond
 PARTS_PER_BLOCK = 45  # parts of a block of SLICE_ROWS samples (a first guess of a check's length, before one has run)
 FINISH_EARLY = 0.95  # [-] a check is paced to end within this fraction of the ticks before its step begins
 
 
 def work_budget(rate: float) -> float:
     """The time [s] a tick at ``rate`` [Hz] spends on a check's parts: :data:`WORK_BUDGET`, or
-    :data:`WORK_FRACTION` of the control period where that is longer."""
-    return max(WORK_BUDGET, WORK_FRACTION / rate)
+    :data:`WORK_FRACTION` of the control period where that is longer, at most :data:`WORK_LIMIT`."""
+    return min(max(WORK_BUDGET, WORK_FRACTION / rate), WORK_LIMIT)
 
 
 def _checked_budget(budget: object, rate: float) -> float:
@@ -185,9 +187,9 @@ class OnlineWalker:
             pendulum pattern of Lim et al., stage by stage: :mod:`zmpwalk.patterns.lipm_stage`; same
             footsteps, swings and continuity; a command whose ZMP would leave the feet is rejected).
         budget: The time [s] a tick may spend on a command's check, one part over at most (default
-            :func:`work_budget`: 50 us, or 1 % of the control period where that is longer). Smaller: shorter
-            ticks, and checks that take more ticks, so that more commands come too late for the step they were
-            given in (and walk a step later: module docstring).
+            :func:`work_budget`: 50 us, or 1 % of the control period where that is longer, at most 500 us).
+            Smaller: shorter ticks, and checks that take more ticks, so that more commands come too late for the
+            step they were given in (and walk a step later: module docstring).
 
     Raises:
         InvalidParameterError: An unknown ``pelvis`` or ``generator``, ``pelvis="quintic"`` with the
@@ -341,9 +343,16 @@ class OnlineWalker:
             rejection.named = True
         return rejection.error
 
-    def _work(self) -> None:
-        """A few parts of the given command's check (:data:`WORK_BUDGET`, at least its share of the parts left,
-        never its rest at once: the rule of the module docstring for a check not complete when its step begins)."""
+    def work(self, spent: float = 0.0) -> None:
+        """The parts of a command's check that :meth:`tick` runs, where it was called with ``work=False``: within
+        the tick's budget less ``spent`` [s] (the loop's own work in the tick: the stabilizer's), at least one."""
+        if self._job is not None:
+            self._work(spent)
+
+    def _work(self, spent: float = 0.0) -> None:
+        """A few parts of the given command's check (:data:`WORK_BUDGET` less ``spent``, at least its share of the
+        parts left, never its rest at once: the rule of the module docstring for a check not complete when its
+        step begins)."""
         job = self._job
         if job is None:
             return
@@ -362,7 +371,7 @@ class OnlineWalker:
         quota = -(-(expected - job.parts) // ticks_left)  # its share of the parts left
         plan: object
         try:
-            plan, parts = run_for(job.planning, self._budget, quota, _clock)
+            plan, parts = run_for(job.planning, self._budget - spent, quota, _clock)
             job.parts += parts
         except ZmpwalkError as error:
             self._drop_job()
@@ -411,8 +420,9 @@ class OnlineWalker:
             self._pending = None  # the step under way is a stop already
         self._release(dropped)
 
-    def tick(self) -> WalkingSample:
-        """The sample at :attr:`time`, then advance by one control period."""
+    def tick(self, *, work: bool = True) -> WalkingSample:
+        """The sample at :attr:`time`, then advance by one control period; ``work=False``: without the parts of a
+        command's check, which :meth:`work` then runs (a loop that times its own work into the budget)."""
         index = self._index
         current = self._current
         if current is None or index >= current.first_index + len(current.rows):
@@ -426,7 +436,7 @@ class OnlineWalker:
             row, (codes, pelvis_yaws, left_yaws, right_yaws) = current.rows[offset].copy(), current.scalars
             code, pelvis_yaw, left_yaw, right_yaw = codes[offset], pelvis_yaws[offset], left_yaws[offset], \
                 right_yaws[offset]
-        if self._job is not None:
+        if work and self._job is not None:
             self._work()
         return WalkingSample(
             time=index / self.rate,

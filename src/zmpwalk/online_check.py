@@ -295,7 +295,8 @@ class CommandCheck:
                                 samples.right_position, self.robot)
             yield
         standing = None
-        if next_boundary.at_rest:  # the row of standing still (one IK) in a slice of its own
+        if next_boundary.at_rest:  # the row of standing still (one IK and the joint ranges, 50 us): a long part
+            yield ALONE
             standing = self.standing_row(next_stance)
             yield
         return CheckedPlan(command, stages, next_stance, next_boundary, rows, first_index, standing=standing,

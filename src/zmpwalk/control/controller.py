@@ -9,10 +9,11 @@
         plant.apply(targets)                                     # angles [rad], rates [rad/s], tau_ff [N m]
         plant.step()
 
-Per tick :meth:`WalkingController.update` runs one :meth:`~zmpwalk.online.OnlineWalker.tick` (the walker's bounded
-share of a command's check included), one :meth:`~zmpwalk.balance.Stabilizer.update` on the measurement and, where
-one is given, the :class:`Feedforward`'s torques of the tick's sample: no planning beyond what the walker's tick
-does, whatever the timing of commands.
+Per tick :meth:`WalkingController.update` runs one :meth:`~zmpwalk.online.OnlineWalker.tick`, one
+:meth:`~zmpwalk.balance.Stabilizer.update` on the measurement and, where one is given, the :class:`Feedforward`'s
+torques of the tick's sample, then the walker's bounded share of a command's check in what is left of the walker's
+budget (:func:`~zmpwalk.online.work_budget`) after the tick's own work: no planning beyond that, whatever the
+timing of commands.
 
 **Velocity commands** (:meth:`WalkingController.set_velocity`), as joysticks and learned policies give them, become
 one :class:`~zmpwalk.commands.StepCommand` by :func:`velocity_command`'s rule, given to the walker for every step
@@ -29,6 +30,7 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from zmpwalk import online
 from zmpwalk.balance import BalanceMeasurement, Stabilizer
 from zmpwalk.commands import StepCommand
 from zmpwalk.control.plant import JointTargets
@@ -42,6 +44,8 @@ from zmpwalk.stabilizer_gains import StabilizerGains
 Array = NDArray[np.float64]
 
 VELOCITY_FIELDS = {"forward": "vx", "side": "vy", "turn": "wz"}  # a step's stride field -> its velocity
+SUPPORT_CODES = {label: int(code) for label, code in SUPPORT_OF_LABEL.items()}  # plain ints: the compiled
+# stabilizer types an IntEnum member in Python (10 us a tick), a plain int in C
 
 
 class Feedforward(Protocol):
@@ -266,15 +270,19 @@ class WalkingController:
         """
         if not isinstance(measurement, BalanceMeasurement):
             raise InvalidParameterError("measurement", type(measurement).__name__, "a BalanceMeasurement")
-        sample = self.walker.tick()
+        begin = online._clock()
+        walker = self.walker
+        sample = walker.tick(work=False)
         self._sample = sample
-        self._give_velocity_step()
         angles = sample.joint_angles
         velocities = sample.joint_velocities
         if angles is None or velocities is None:  # pragma: no cover - the walker is made with joints
             raise InvalidParameterError("walker.joints", False, "True")
         corrected = self._corrected(sample, angles, measurement)
         torques = None if self.feedforward is None else self.feedforward.torques(sample)
+        if walker.checking is not None:  # the check's parts, in the budget the tick has left
+            walker.work(online._clock() - begin)
+        self._give_velocity_step()
         return JointTargets(sample.time, angles if corrected is None else corrected, velocities, torques, sample,
                             corrected is not None)
 
@@ -285,7 +293,7 @@ class WalkingController:
             return None
         try:
             targets = stabilizer.update(
-                support=SUPPORT_OF_LABEL[sample.support], position_com_in_world=sample.position_pelvis_in_world,
+                support=SUPPORT_CODES[sample.support], position_com_in_world=sample.position_pelvis_in_world,
                 yaw_pelvis_in_world=sample.yaw_pelvis_in_world, zmp_in_world=sample.zmp_in_world,
                 ankles_in_world=(sample.position_left_ankle_in_world, sample.position_right_ankle_in_world),
                 foot_yaws=(sample.yaw_left_foot_in_world, sample.yaw_right_foot_in_world), joint_angles=angles,
