@@ -1,10 +1,17 @@
 """Speed of the leg IK: closed form (scalar and vectorised) against a numerical IK; tick() with joints.
 
 Run: python bench/bench_kinematics.py. Prints figures; asserts nothing.
+
+The vectorised figures allocate tens of megabytes per call. Whether glibc serves those from fresh pages (a page
+fault per 4 kB) or from its heap depends on what the process allocated and freed before (its dynamic mmap
+threshold), which halved or doubled them between two runs of the same code: :func:`steady_allocator` fixes the
+threshold first, so that the figures measure the IK, not the allocator's history.
 """
 
 from __future__ import annotations
 
+import ctypes
+import ctypes.util
 import statistics
 import time
 
@@ -27,7 +34,19 @@ def poses(chain: LegChain, n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarra
     return position, rotation, np.arctan2(rotation[:, 1, 0], rotation[:, 0, 0])
 
 
+M_MMAP_THRESHOLD = -3  # glibc's mallopt parameter
+MMAP_THRESHOLD = 512 * 1024 * 1024  # [B] blocks below this come from the heap
+
+
+def steady_allocator() -> None:
+    """Fix glibc's mmap threshold (no dynamic adjustment); nothing on another C library."""
+    name = ctypes.util.find_library("c")
+    if name is not None and hasattr(ctypes.CDLL(name), "mallopt"):
+        ctypes.CDLL(name).mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD)
+
+
 def main() -> None:
+    steady_allocator()
     robot = load_robot("hubo")
     chain = leg_chains(robot)[0]
     position, rotation, yaw = poses(chain, 200_000)

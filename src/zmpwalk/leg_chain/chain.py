@@ -273,7 +273,9 @@ class LegChain:
         """
         p = np.atleast_2d(position_ankle_in_pelvis)
         # the chain's own rotation g = T_d M^-1: the sole's target turned back by R_s
-        rotation = np.asarray(rotation_foot_in_pelvis).reshape(-1, 3, 3) @ self.sole_rotation.T
+        rotation = np.asarray(rotation_foot_in_pelvis).reshape(-1, 3, 3)
+        if not np.array_equal(self.sole_rotation, np.eye(3)):  # a level sole at zero angles needs no turn
+            rotation = rotation @ self.sole_rotation.T
         if numeric is None:
             numeric = not self.closed_form
         if numeric:
