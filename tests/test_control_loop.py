@@ -9,7 +9,6 @@ step would begin: it walks a step later).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -18,38 +17,11 @@ import pytest
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
+from command_strategies import HOSTILE_STEPS, ORDINARY_STEPS, parts_clock
 from zmpwalk import InvalidParameterError, OnlineWalker, StepCommand, ZmpwalkError
 from zmpwalk.online import work_budget
 
-
-def _parts_clock(monkeypatch: pytest.MonkeyPatch, part: float) -> None:
-    """The walker's budget clock advances ``part`` [s] a call: every part of a check costs ``part``."""
-    now = [0.0]
-
-    def clock() -> float:
-        now[0] += part
-        return now[0]
-
-    monkeypatch.setattr("zmpwalk.online._clock", clock)
-
-
-HOSTILE = st.sampled_from([
-    {"duration": 0.0, "forward": 0.1},  # zero step time: refused when the command is made
-    {"duration": math.nan},
-    {"duration": 0.8, "forward": 0.9},  # beyond the legs' reach
-    {"duration": 0.8, "forward": -0.9},
-    {"duration": 0.15, "forward": 0.3},  # too fast for the foot speed limit
-    {"duration": 0.8, "forward": 0.1, "foot_lift": 0.4},  # lifted too high
-    {"duration": 1.0, "forward": 0.3, "foot_lift": 0.15},  # its stop leaves the ankle pitch range
-    {"duration": 0.8, "side": -0.2},  # feet that would overlap
-    {"duration": 0.8, "turn": 1.5},
-])
-ORDINARY = st.one_of(
-    st.builds(lambda d, f: {"duration": d, "forward": f}, st.floats(0.6, 1.0), st.floats(-0.1, 0.25)),
-    st.builds(lambda d, a: {"duration": d, "side": a}, st.floats(0.7, 1.0), st.floats(-0.06, 0.06)),
-    st.builds(lambda d, t: {"duration": d, "forward": 0.05, "turn": t}, st.floats(0.7, 1.0), st.floats(-0.2, 0.2)),
-)
-ACTION = st.one_of(ORDINARY, ORDINARY, HOSTILE, st.just("stop"))
+ACTION = st.one_of(ORDINARY_STEPS, ORDINARY_STEPS, HOSTILE_STEPS, st.just("stop"))
 
 
 @dataclass
@@ -139,7 +111,7 @@ def test_commands_at_random_ticks_never_make_a_tick_raise_and_accepted_ones_walk
     """Random commands (hostile ones among them) at random ticks, 1 Hz to 1 kHz, on a machine where every part
     of a check costs 2 % to 4 times the tick's budget: no tick raises, every rejection is a ZmpwalkError naming
     a parameter, every accepted command walks unless replaced, and the walk ends standing."""
-    _parts_clock(monkeypatch, part * work_budget(rate))
+    parts_clock(monkeypatch, part * work_budget(rate))
     walker = OnlineWalker(hubo, rate=rate, joints=joints)
     outcomes = Outcomes()
     largest = _loop(walker, actions, outcomes, event)

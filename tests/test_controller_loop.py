@@ -16,25 +16,11 @@ import pytest
 from hypothesis import HealthCheck, assume, event, given, seed, settings
 from hypothesis import strategies as st
 
+from command_strategies import HOSTILE_STEPS, ORDINARY_STEPS, parts_clock
 from zmpwalk import InvalidParameterError, StepCommand, ZmpwalkError
 from zmpwalk.control import MockPlant, WalkingController
 from zmpwalk.online import work_budget
 
-HOSTILE_STEPS = st.sampled_from([
-    {"duration": 0.0, "forward": 0.1},  # zero step time: refused when the command is made
-    {"duration": math.nan},
-    {"duration": 0.8, "forward": 0.9},  # beyond the legs' reach
-    {"duration": 0.8, "forward": -0.9},
-    {"duration": 0.15, "forward": 0.3},  # too fast for the foot speed limit
-    {"duration": 0.8, "forward": 0.1, "foot_lift": 0.4},  # lifted too high
-    {"duration": 0.8, "side": -0.2},  # feet that would overlap
-    {"duration": 0.8, "turn": 1.5},
-])
-ORDINARY_STEPS = st.one_of(
-    st.builds(lambda d, f: {"duration": d, "forward": f}, st.floats(0.6, 1.0), st.floats(-0.1, 0.25)),
-    st.builds(lambda d, a: {"duration": d, "side": a}, st.floats(0.7, 1.0), st.floats(-0.06, 0.06)),
-    st.builds(lambda d, t: {"duration": d, "forward": 0.05, "turn": t}, st.floats(0.7, 1.0), st.floats(-0.2, 0.2)),
-)
 VELOCITIES = st.one_of(
     st.tuples(st.floats(-0.1, 0.25), st.floats(-0.05, 0.05), st.floats(-0.2, 0.2)),  # ordinary
     st.tuples(st.floats(-3.0, 3.0), st.floats(-1.0, 1.0), st.floats(-2.0, 2.0)),  # mostly beyond reach
@@ -48,15 +34,6 @@ ACTION = st.one_of(
 END_SECONDS = 8.0  # [s] after the closing stop(): the step under way, the closing step and the settle end in it
 
 
-def _parts_clock(monkeypatch: pytest.MonkeyPatch, part: float) -> None:
-    """The walker's budget clock advances ``part`` [s] a call: every part of a check costs ``part``."""
-    now = [0.0]
-
-    def clock() -> float:
-        now[0] += part
-        return now[0]
-
-    monkeypatch.setattr("zmpwalk.online._clock", clock)
 
 
 def _act(controller: WalkingController, kind: str, value: object) -> None:
@@ -96,7 +73,7 @@ def test_the_controller_takes_commands_at_random_times_and_no_update_raises(hubo
     names a parameter, the stabilizer has no fault on the mock plant, and after a last stop() the walk ends
     standing."""
     assume(rate >= 10.0 or not balance)  # the stabilizer runs at 10 Hz and more
-    _parts_clock(monkeypatch, part * work_budget(rate))
+    parts_clock(monkeypatch, part * work_budget(rate))
     controller = WalkingController(hubo, rate, balance=balance)
     plant = MockPlant(hubo, rate)
     walked = False
