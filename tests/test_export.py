@@ -205,3 +205,29 @@ def test_ros2_bag_topics_read_by_rosbags(exported: tuple[Path, dict[str, Any]], 
     assert len(prints) >= 6  # both feet at the start, then every landing of the six swings
     for marker in prints:
         assert len(marker.points) == 5 and all(abs(p.z) < 0.01 for p in marker.points)  # [m] closed, on the floor
+
+
+def test_a_bag_replaces_its_folder_whole_and_refuses_a_file(exported: tuple[Path, dict[str, Any]], tmp_path: Path,
+                                                           model: mujoco.MjModel) -> None:
+    """Writing a bag over an old one leaves only the new one (no partial folder beside it); a path that is a file
+    is refused with one FileFormatError and left as it was; a file that is not a bag is one FileFormatError."""
+    from zmpwalk.errors import FileFormatError
+    from zmpwalk.export.amp import read_amp
+    from zmpwalk.export.rosbag import BagExtras, read_bag, write_bag
+
+    out, manifest = exported
+    qpos, fps = read_amp(str(out / _clip(manifest, "planned", "cyclic")["files"]["amp"]))
+    extras = BagExtras(np.zeros((len(qpos), 2)))
+    bag = tmp_path / "clip.bag"
+    write_bag(bag, model, loaded_robot("hubo"), qpos[:10], fps, extras)
+    write_bag(bag, model, loaded_robot("hubo"), qpos, fps, extras)
+    back, back_fps = read_bag(str(bag))
+    assert back.shape == qpos.shape and back_fps == pytest.approx(fps, abs=1e-6)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["clip.bag"]
+    plain = tmp_path / "plain.bag"
+    plain.write_text("not a folder")
+    with pytest.raises(FileFormatError, match=r"plain\.bag"):
+        write_bag(plain, model, loaded_robot("hubo"), qpos, fps, extras)
+    assert plain.read_text() == "not a folder"
+    with pytest.raises(FileFormatError, match=r"plain\.bag"):
+        read_bag(str(plain))

@@ -78,6 +78,8 @@ def test_the_planned_walk_is_the_generator_s_pattern_and_its_joints(hubo) -> Non
     ({"mass_scale": 0.0}, "mass_scale"),
     ({"settle": -1.0}, "settle"),
     ({"hold": 61.0}, "hold"),
+    ({"settle": "1"}, "settle"),
+    ({"mass_scale": None}, "mass_scale"),
 ])
 def test_a_spec_no_walk_can_follow_names_its_field(hubo, fields, parameter) -> None:
     chosen = {"commands": [StepCommand(0.9, 0.1)], **fields}

@@ -150,6 +150,7 @@ _clock = time.perf_counter  # [s] the clock of the budget (a test replaces it wi
 WORK_BUDGET = 50e-6  # [s] a tick runs parts of a check while the next one is expected to end within this
 WORK_FRACTION = 0.01  # [-] ... or within this fraction of the control period, where that is longer (below 200 Hz)
 WORK_LIMIT = 500e-6  # [s] ... but never over this (below 20 Hz): a tick's work stays well under a millisecond
+WORK_SHARE = 0.5  # [-] of the budget a check's parts get however long the loop's own work in the tick took
 PARTS_PER_BLOCK = 45  # parts of a block of SLICE_ROWS samples (a first guess of a check's length, before one has run)
 FINISH_EARLY = 0.95  # [-] a check is paced to end within this fraction of the ticks before its step begins
 
@@ -345,7 +346,8 @@ class OnlineWalker:
 
     def work(self, spent: float = 0.0) -> None:
         """The parts of a command's check that :meth:`tick` runs, where it was called with ``work=False``: within
-        the tick's budget less ``spent`` [s] (the loop's own work in the tick: the stabilizer's), at least one."""
+        the tick's budget less ``spent`` [s] (the loop's own work in the tick: the stabilizer's) but at least
+        :data:`WORK_SHARE` of it, and at least one part."""
         if self._job is not None:
             self._work(spent)
 
@@ -371,7 +373,7 @@ class OnlineWalker:
         quota = -(-(expected - job.parts) // ticks_left)  # its share of the parts left
         plan: object
         try:
-            plan, parts = run_for(job.planning, self._budget - spent, quota, _clock)
+            plan, parts = run_for(job.planning, max(self._budget - spent, WORK_SHARE * self._budget), quota, _clock)
             job.parts += parts
         except ZmpwalkError as error:
             self._drop_job()

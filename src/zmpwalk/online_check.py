@@ -105,7 +105,7 @@ _SCALAR_COLUMNS = (ROW_SUPPORT, ROW_PELVIS_YAW, ROW_LEFT_YAW, ROW_RIGHT_YAW)
 def row_scalars(rows: Array) -> Scalars:
     """The rows' support codes and pelvis, left and right yaws, each column an ``array("d")``: a tick reads Python
     floats from it without numpy's scalar conversion (the walker names the support from its code), and a plan
-    dropped in a tick frees four buffers (lists of Python floats, one per value, took 0.3 ms to free)."""
+    dropped in a tick frees four buffers (lists of Python floats, one object per value, take about 0.3 ms to free)."""
     support, pelvis, left, right = (array("d", np.ascontiguousarray(rows[:, column]).tobytes())
                                     for column in _SCALAR_COLUMNS)
     return support, pelvis, left, right
@@ -181,7 +181,7 @@ class Rejection:
     error: ZmpwalkError
     stance: Stance
     boundary: Boundary
-    named: bool = False  # the parameter to fix is named (:meth:`OnlineWalker._rejected` has run)
+    named: bool = False  # the parameter to fix is named (:attr:`CommandCheck.rejected` has run)
 
 
 class CommandCheck:

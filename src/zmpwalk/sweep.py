@@ -84,8 +84,8 @@ def walk_scenario(robot: str, scenario: str, balance: bool = True, generator: st
         from zmpwalk.schedule import Schedule
 
         tables = Schedule.from_file(Path(schedule))
-    spec = WalkSpec(model, commands, labels, generator=generator, schedule=tables, pelvis=pelvis, balance=balance)
     try:
+        spec = WalkSpec(model, commands, labels, generator=generator, schedule=tables, pelvis=pelvis, balance=balance)
         planned = planned_walk(spec)
     except ZmpwalkError as error:  # this walk is not possible with this generator: a result, not a crash
         return SweepResult(scenario=scenario, robot=model.name, passed=False, failed=("planned",), fell=False,

@@ -13,6 +13,7 @@ Importing this module loads neither MuJoCo nor numba; :func:`run_walk` does.
 
 from __future__ import annotations
 
+import numbers
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -133,8 +134,9 @@ class WalkSpec:
                                          ("hold", 0.0, 60.0, "a time in [0, 60] s"),
                                          ("latency", 0.0, 0.1, "a delay in [0, 0.1] s"),
                                          ("mass_scale", 0.01, 100.0, "a value in [0.01, 100]")):
-            if not low <= getattr(self, name) <= high:  # the ranges of zmpwalk.sim.run.simulate
-                raise InvalidParameterError(name, getattr(self, name), allowed)
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, numbers.Real) or not low <= float(value) <= high:
+                raise InvalidParameterError(name, value, allowed)  # the ranges of zmpwalk.sim.run.simulate
 
     @property
     def generator_name(self) -> str:
@@ -250,7 +252,8 @@ def run_walk(spec: WalkSpec, progress: Progress | None = None, planned: PlannedW
         spec: The walk.
         progress: Called as each stage of :data:`STAGES` starts, ``progress(stage, index, len(STAGES))``, and
             while the simulation runs, ``progress("simulation", percent, 100)``.
-        planned: The walk already planned from this spec (:func:`planned_walk`); None: planned here.
+        planned: The walk already planned from this very spec (:func:`planned_walk`, its rate and generator); None:
+            planned here.
 
     Returns:
         The pattern, the joints, the measurements, the verdict, the motor table and the wall time of each stage.

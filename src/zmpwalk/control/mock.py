@@ -80,7 +80,7 @@ def sole_wrenches(robot: RobotModel, sample: WalkingSample) -> tuple[Array, Arra
     """The ground's wrench on each sole for the linear inverted pendulum of ``sample`` (module docstring): force
     [N] then torque [N m] about the ankle, in the foot frame, (6,) each; zero on a swinging sole.
 
-    In Python floats (a few microseconds a tick: numpy's calls on 3-vectors took 50)."""
+    In Python floats: a few microseconds a tick, where numpy's calls on 3-vectors take about 50."""
     gravity, mass = robot.gravity, robot.mass
     com, zmp = sample.position_pelvis_in_world, sample.zmp_in_world
     zmp_x, zmp_y = float(zmp[0]), float(zmp[1])

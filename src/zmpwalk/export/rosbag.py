@@ -67,8 +67,8 @@ def _typestore() -> Any:
 
 
 def _stamp(store: Any, seconds: float) -> Any:
-    whole = math.floor(seconds)
-    return store.types["builtin_interfaces/msg/Time"](sec=int(whole), nanosec=round((seconds - whole) * 1e9))
+    sec, nanosec = divmod(round(seconds * 1e9), 10**9)
+    return store.types["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec)
 
 
 def _header(store: Any, seconds: float, frame: str) -> Any:
@@ -160,15 +160,18 @@ def write_bag(path: Path, model: mujoco.MjModel, robot: RobotModel, qpos: Array,
     Raises:
         FileFormatError: ``path`` cannot be written.
     """
-    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.rosbag2 import StoragePlugin, Writer, WriterError
 
     store, names, base = _typestore(), joint_names(model)[1:], body_names(model)[0]
     qvel, feet = velocities(model, qpos, fps), _feet(model, qpos)
     prints = _footprints(model, robot, qpos, fps, feet)
+    if path.is_symlink() or (path.exists() and not path.is_dir()):
+        raise FileFormatError(str(path), "is not a folder: a bag is written as a folder")
+    partial = path.with_name(f".{path.name}.partial")
     try:
-        if path.is_dir():
-            shutil.rmtree(path)
-        with Writer(path, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
+        if partial.exists():
+            shutil.rmtree(partial)
+        with Writer(partial, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
             joints = writer.add_connection("/joint_states", "sensor_msgs/msg/JointState", typestore=store)
             tf = writer.add_connection("/tf", "tf2_msgs/msg/TFMessage", typestore=store)
             markers = writer.add_connection("/zmpwalk/markers", "visualization_msgs/msg/MarkerArray",
@@ -187,8 +190,22 @@ def write_bag(path: Path, model: mujoco.MjModel, robot: RobotModel, qpos: Array,
                 writer.write(tf, stamp, store.serialize_cdr(message, message.__msgtype__))
                 array = _markers(store, seconds, i, extras, prints)
                 writer.write(markers, stamp, store.serialize_cdr(array, array.__msgtype__))
-    except OSError as error:
-        raise FileFormatError(str(path), f"cannot be written: {error.strerror or error}") from None
+        _replace_folder(partial, path)
+    except (OSError, WriterError) as error:
+        shutil.rmtree(partial, ignore_errors=True)
+        raise FileFormatError(str(path), f"cannot be written: {getattr(error, 'strerror', None) or error}") from None
+
+
+def _replace_folder(new: Path, path: Path) -> None:
+    """Put the written folder ``new`` at ``path``: an old folder there is renamed away first and removed after,
+    so that ``path`` never holds a bag partly written."""
+    old = path.with_name(f".{path.name}.old")
+    if path.exists():
+        if old.exists():
+            shutil.rmtree(old)
+        path.rename(old)
+    new.rename(path)
+    shutil.rmtree(old, ignore_errors=True)
 
 
 def read_bag(path: str) -> tuple[Array, float]:
@@ -197,7 +214,7 @@ def read_bag(path: str) -> tuple[Array, float]:
     Raises:
         FileFormatError: Not such a bag.
     """
-    from rosbags.rosbag2 import Reader
+    from rosbags.rosbag2 import Reader, ReaderError
 
     store, rows, stamps = _typestore(), [], []
     try:
@@ -214,7 +231,7 @@ def read_bag(path: str) -> tuple[Array, float]:
                     t = message.transforms[0].transform
                     bases.append(np.array([t.translation.x, t.translation.y, t.translation.z, t.rotation.w,
                                            t.rotation.x, t.rotation.y, t.rotation.z]))
-    except (KeyError, OSError, ValueError) as error:
+    except (KeyError, OSError, ValueError, ReaderError) as error:
         raise FileFormatError(path, f"is not a bag of a clip ({error})") from None
     if not rows or len(bases) != len(rows):
         raise FileFormatError(path, "is not a bag of a clip (joint states and base frames do not pair)")

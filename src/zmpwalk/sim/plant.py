@@ -43,6 +43,9 @@ from zmpwalk.robots.model import RobotModel
 from zmpwalk.robots.pd import is_position_servo
 from zmpwalk.sides import Support
 
+LEFT_SUPPORT, RIGHT_SUPPORT = int(Support.LEFT), int(Support.RIGHT)  # plain ints: a numpy integer compares with
+# an IntEnum member a hundred times slower
+
 Array = NDArray[np.float64]
 
 MAX_TIMESTEP = PHYSICS_STEP  # [s]
@@ -377,9 +380,9 @@ def _servo_torques(plant: Plant, qpos: Array, zmp: Array, support: NDArray[np.in
             com = data.subtree_com[0]
             com_acceleration = gravity / max(float(com[2]), 1e-6) * (com[:2] - zmp[k])
         left, right = ankles[0][k, :2], ankles[1][k, :2]
-        if support[k] == Support.LEFT:
+        if support[k] == LEFT_SUPPORT:
             shares = (1.0, 0.0)
-        elif support[k] == Support.RIGHT:
+        elif support[k] == RIGHT_SUPPORT:
             shares = (0.0, 1.0)
         else:
             span = right - left

@@ -8,7 +8,7 @@ field of :class:`~zmpwalk.stabilizer_gains.StabilizerGains`, by name, then the r
 
 numba's disk cache keeps each compiled function's constants and is renewed only when the function's own source
 file changes; :data:`LAYOUT_KEY` fingerprints the tables so that the tick can tell a compiled function that was
-built against other offsets (:func:`zmpwalk.balance_kernel.renew_stale_functions`).
+built against other offsets (:func:`zmpwalk.stabilizer.freshness.renew_stale`).
 """
 
 from __future__ import annotations
