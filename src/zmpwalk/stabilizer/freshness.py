@@ -19,7 +19,8 @@ from numba.core.dispatcher import Dispatcher
 from zmpwalk.stabilizer.layout import LAYOUT_KEY
 
 _PACKAGE = Path(__file__).resolve().parent
-SOURCES = (*sorted(_PACKAGE.glob("*.py")), _PACKAGE.parent / "balance_kernel.py")  # the compiled modules' files
+SOURCES = (*sorted(_PACKAGE.glob("*.py")), _PACKAGE.parent / "balance_kernel.py",  # the compiled modules' files
+           _PACKAGE.parent / "sides.py")  # and the support codes they compare with
 
 
 def _fingerprint() -> int:
