@@ -7,7 +7,7 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from zmpwalk.kinematics import JOINT_COLUMNS
+from zmpwalk.joint_limits import JOINT_COLUMNS
 from zmpwalk.robots.collision import tilt_of
 from zmpwalk.robots.description import PD_BANDWIDTH, PD_DAMPING_RATIO, PD_LOAD_STIFFNESS, Actuator
 from zmpwalk.robots.model import RobotModel
