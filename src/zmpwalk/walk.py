@@ -13,7 +13,6 @@ Importing this module loads neither MuJoCo nor numba; :func:`run_walk` does.
 
 from __future__ import annotations
 
-import numbers
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -24,6 +23,7 @@ from zmpwalk.errors import InvalidParameterError, ZmpwalkError
 from zmpwalk.patterns import GENERATORS
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
+from zmpwalk.sim.ranges import RANGES, check_range
 from zmpwalk.sim.verdict import HOLD, SETTLE
 
 if TYPE_CHECKING:
@@ -130,13 +130,8 @@ class WalkSpec:
         if self.capture is not None and self.zmp_correction:
             raise InvalidParameterError("capture", self.capture, "None with zmp_correction: capture steps plan "
                                         "the pattern's CoM point")
-        for name, low, high, allowed in (("settle", 0.0, 10.0, "a time in [0, 10] s"),
-                                         ("hold", 0.0, 60.0, "a time in [0, 60] s"),
-                                         ("latency", 0.0, 0.1, "a delay in [0, 0.1] s"),
-                                         ("mass_scale", 0.01, 100.0, "a value in [0.01, 100]")):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, numbers.Real) or not low <= float(value) <= high:
-                raise InvalidParameterError(name, value, allowed)  # the ranges of zmpwalk.sim.run.simulate
+        for name in RANGES:  # the ranges of the simulation itself
+            check_range(name, getattr(self, name))
 
     @property
     def generator_name(self) -> str:

@@ -37,6 +37,7 @@ from zmpwalk.sides import SUPPORT_OF_LABEL
 from zmpwalk.sim.disturbances import Disturbances
 from zmpwalk.sim.measure import AFTER_FALL
 from zmpwalk.sim.mujoco_plant import MujocoPlant
+from zmpwalk.sim.ranges import check_range
 from zmpwalk.sim.result import SimulationResult
 from zmpwalk.sim.soles import SoleMeasurements, foot_slip, rpy_from_quaternion, sole_measurements
 from zmpwalk.sim.verdict import HOLD
@@ -168,8 +169,7 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
                                     "or none are given")
     if duration is not None and not 0.0 < duration <= 3600.0:
         raise InvalidParameterError("duration", duration, "a run length in (0, 3600] s")
-    if not 0.0 <= hold <= 60.0:
-        raise InvalidParameterError("hold", hold, "a time in [0, 60] s")
+    check_range("hold", hold)
     plant = plant or MujocoPlant(robot, rate, mass_scale=mass_scale, disturbances=disturbances)
     controller = controller or WalkingController(robot, plant.rate, balance=balance,
                                                  feedforward=plant.feedforward() if feedforward else None)

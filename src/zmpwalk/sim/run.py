@@ -50,6 +50,7 @@ from zmpwalk.sim.disturbances import _MeasurementReader as _MeasurementReader
 from zmpwalk.sim.measure import AFTER_FALL, FALL_HEIGHT_FRACTION, FALL_TILT, measure_walk
 from zmpwalk.sim.mjcf import contact_mapping
 from zmpwalk.sim.plant import Plant, build_plant, set_initial_state
+from zmpwalk.sim.ranges import check_range
 from zmpwalk.sim.references import CONTROL_RATE, rows_at, servo_controls
 from zmpwalk.sim.replan import CaptureReplanner
 from zmpwalk.sim.result import SimulationResult, write_result_csv
@@ -135,11 +136,9 @@ def _checked_inputs(robot: RobotModel, joints: JointTrajectory, pattern: Walking
     checked (the raises of :func:`simulate`)."""
     if len(joints.time) != len(pattern.time) or len(pattern.time) < 2:
         raise InvalidParameterError("joints", len(joints.time), f"{len(pattern.time)} samples, as the pattern")
-    if not (0.01 <= mass_scale <= 100):
-        raise InvalidParameterError("mass_scale", mass_scale, "a value in [0.01, 100]")
+    check_range("mass_scale", mass_scale)
     settle, hold = _settle_and_hold(robot, settle, hold)
-    if not 0.0 <= latency <= 0.1:
-        raise InvalidParameterError("latency", latency, "a delay in [0, 0.1] s")
+    check_range("latency", latency)
     if capture is not None and stabilizer is None:
         raise InvalidParameterError("capture", capture, "None without a stabilizer (its DCM estimate triggers it)")
     if capture is not None and pattern.position_com_in_world is not None:
@@ -158,11 +157,7 @@ def _settle_and_hold(robot: RobotModel, settle: float | None, hold: float | None
     imported = robot.own_model
     settle = (OWN_MODEL_SETTLE if imported else 0.0) if settle is None else settle
     hold = (OWN_MODEL_HOLD if imported else 0.0) if hold is None else hold
-    if not 0.0 <= settle <= 10.0:
-        raise InvalidParameterError("settle", settle, "a time in [0, 10] s")
-    if not 0.0 <= hold <= 60.0:
-        raise InvalidParameterError("hold", hold, "a time in [0, 60] s")
-    return settle, hold
+    return check_range("settle", settle), check_range("hold", hold)
 
 
 def _walk_times(pattern: WalkingPattern, settle: float, hold: float) -> tuple[Array, Array, Array]:
