@@ -1,8 +1,10 @@
 """Reference clips from a walk simulated through the walking controller: the simulated motion and the planned one.
 
 :func:`walk_clips` walks one velocity command (a forward, side and turn velocity at a step time) with
-:func:`zmpwalk.sim.loop.simulate_controller` (stabilizer and feedforward on) and records, at ``fps`` frames a
-second, the whole model's ``qpos`` in two ways:
+:func:`zmpwalk.sim.loop.simulate_controller` (stabilizer and feedforward on; MuJoCo's noslip solver on, so a
+loaded sole holds where it stands as a real one does instead of creeping 2-3 mm a step under the legs' lateral
+push, :class:`~zmpwalk.sim.mujoco_plant.MujocoPlant`) and records, at ``fps`` frames a second, the whole model's
+``qpos`` in two ways:
 
 The walker plans with the robot's default generator (:attr:`~zmpwalk.robots.model.RobotModel.default_generator`:
 the polynomial pattern for HUBO, the hyperbolic one for a robot's own model) unless one is named.
@@ -88,7 +90,7 @@ class _RecordingPlant(MujocoPlant):
     """A :class:`MujocoPlant` that keeps the state after every tick and the planned pose of chosen ticks."""
 
     def __init__(self, robot: RobotModel, rate: float, every: float) -> None:
-        super().__init__(robot, rate)
+        super().__init__(robot, rate, noslip=True)
         self.every = every  # [ticks] between frames
         self.states: list[Array] = []
         self.planned: list[Array] = []

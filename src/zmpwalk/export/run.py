@@ -306,6 +306,7 @@ def write_manifest(path: Path, robot: str, clips: Sequence[ClipRecord], fps: flo
     """The manifest: the robot, its pattern generator, the frame rate, the joint names, every clip's record (JSON;
     nan as null)."""
     from zmpwalk.robots import loaded_robot
+    from zmpwalk.sim.disturbances import NOSLIP_ITERATIONS
     from zmpwalk.sim.plant import build_plant
 
     def finite(value: object) -> object:
@@ -320,6 +321,7 @@ def write_manifest(path: Path, robot: str, clips: Sequence[ClipRecord], fps: flo
     model = loaded_robot(robot)
     document = {"robot": robot, "generator": model.default_generator, "fps": fps,
                 "joint_names": joint_names(build_plant(model).model), "quaternion_order": "wxyz", "seconds": seconds,
+                "noslip_iterations": NOSLIP_ITERATIONS,
                 "clips": [finite(asdict(c)) for c in clips],
                 "verified": sum(c.verified for c in clips), "count": len(clips)}
     write_text(path, json.dumps(document, indent=1, allow_nan=False) + "\n")

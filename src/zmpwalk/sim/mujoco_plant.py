@@ -27,6 +27,7 @@ from zmpwalk.robots.pd import is_position_servo
 from zmpwalk.sim.mjcf import contact_mapping
 from zmpwalk.sim.plant import Plant as SimPlant
 from zmpwalk.sim.plant import build_plant, set_initial_state, static_feedforward
+from zmpwalk.sim.disturbances import NOSLIP_ITERATIONS
 from zmpwalk.sim.run import FALL_HEIGHT_FRACTION, FALL_TILT, Disturbances, _MeasurementReader
 from zmpwalk.sim.soles import SensorSlices
 
@@ -173,6 +174,9 @@ class MujocoPlant:
         mass_scale: Multiply the box model's masses (:func:`zmpwalk.sim.plant.build_plant`).
         disturbances: A push, a floor tilt or a mass error (:class:`~zmpwalk.sim.run.Disturbances`); the
             :meth:`feedforward` keeps the nominal model.
+        noslip: Run MuJoCo's noslip solver (:data:`~zmpwalk.sim.disturbances.NOSLIP_ITERATIONS` iterations): a
+            loaded sole then holds where it stands instead of creeping under a lasting tangential force inside
+            the friction cone, as MuJoCo's soft contacts let it (as on a tilted floor, where it always runs).
 
     Raises:
         InvalidParameterError: A rate whose period is not a whole number of time steps, or as
@@ -180,9 +184,11 @@ class MujocoPlant:
     """
 
     def __init__(self, robot: RobotModel, rate: float = 1000.0, *, mass_scale: float = 1.0,
-                 disturbances: Disturbances | None = None) -> None:
+                 disturbances: Disturbances | None = None, noslip: bool = False) -> None:
         plant = build_plant(robot, mass_scale)
         model = plant.model
+        if noslip:
+            model.opt.noslip_iterations = NOSLIP_ITERATIONS
         steps = 1.0 / (float(rate) * float(model.opt.timestep))
         if not (math.isfinite(steps) and steps >= 1.0 - 1e-9 and abs(steps - round(steps)) < 1e-6):
             raise InvalidParameterError("rate", rate, f"a rate whose period is a whole number of the model's "
