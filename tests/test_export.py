@@ -19,7 +19,7 @@ from zmpwalk.export import Grid, export_motions, replay_check
 from zmpwalk.export.amp import read_amp
 from zmpwalk.export.locomujoco import read_locomujoco
 from zmpwalk.export.names import body_names, joint_names, qpos_names
-from zmpwalk.export.verify import MAX_PENETRATION, MAX_SLIDE
+from zmpwalk.export.verify import CONTACT_HEIGHT, MAX_PENETRATION, MAX_SLIDE, contact_slide
 from zmpwalk.robots import loaded_robot
 from zmpwalk.sim.plant import build_plant
 
@@ -139,6 +139,47 @@ def test_replay_check_passes_a_good_clip_and_fails_a_corrupted_one(exported: tup
     sunk[len(qpos) // 2:, 2] -= 0.004
     deep = replay_check(model, sunk, fps)
     assert not deep.passed and deep.penetration == pytest.approx(0.008, abs=0.001)
+
+
+def _sole_box(frames: int) -> np.ndarray:
+    """The eight corners of a 0.2 x 0.1 x 0.02 m foot box resting on the floor, repeated ``frames`` times."""
+    corners = np.array([[x, y, z] for x in (-0.1, 0.1) for y in (-0.05, 0.05) for z in (0.0, 0.02)])
+    return np.repeat(corners[None], frames, axis=0)
+
+
+def _rotated(points: np.ndarray, axis: int, angles: np.ndarray, about: np.ndarray) -> np.ndarray:
+    """``points`` (n, m, 3) rotated per frame by ``angles`` [rad] about the line through ``about`` along ``axis``."""
+    out = points.copy()
+    for k, angle in enumerate(angles):
+        c, s = np.cos(angle), np.sin(angle)
+        i, j = [a for a in range(3) if a != axis]
+        rel = points[k] - about
+        out[k, :, i] = about[i] + c * rel[:, i] - s * rel[:, j]
+        out[k, :, j] = about[j] + s * rel[:, i] + c * rel[:, j]
+    return out
+
+
+def test_slide_counts_sole_points_moving_on_the_floor_not_a_sole_rocking_on_its_edge() -> None:
+    """A sole rocking 0.06 rad on its heel edge moves a point 0.1 m above it 6 mm, its toe corners lift and its heel
+    corners stay: no slide. The same sole turning 0.06 rad about one corner on the floor slides its other corners
+    (the far one 0.224 m x 0.06 = 13 mm); shifted 3 mm along the floor it slides 3 mm; a foot still 1 mm above the
+    floor while it moves does not slide."""
+    n = 30
+    heel = np.array([-0.1, 0.0, 0.0])
+    pitch = np.linspace(0.0, 0.06, n)  # toe up: rotation about y through the heel edge
+    rocking = _rotated(_sole_box(n), 1, pitch, heel)
+    toes = rocking[-1, _sole_box(1)[0, :, 0] > 0.0]
+    assert toes[:, 2].min() > 0.01 and contact_slide(rocking) == pytest.approx(0.0, abs=1e-12)
+    ankle = _rotated(np.array([[[0.0, 0.0, 0.1]]] * n), 1, pitch, heel)
+    assert np.linalg.norm(ankle[-1, 0, :2] - ankle[0, 0, :2]) > MAX_SLIDE  # what the foot origin would have said
+    turning = _rotated(_sole_box(n), 2, np.linspace(0.0, 0.06, n), np.array([-0.1, -0.05, 0.0]))
+    assert contact_slide(turning) == pytest.approx(np.hypot(0.2, 0.1) * 2 * np.sin(0.03), rel=1e-9)
+    shifted = _sole_box(n)
+    shifted[:, :, 0] += np.linspace(0.0, 0.003, n)[:, None]
+    assert contact_slide(shifted) == pytest.approx(0.003, rel=1e-9)
+    hovering = shifted.copy()
+    hovering[:, :, 2] += CONTACT_HEIGHT + 0.001
+    assert contact_slide(hovering) == 0.0
 
 
 def test_grid_file_and_options(tmp_path: Path) -> None:

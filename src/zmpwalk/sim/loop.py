@@ -13,8 +13,8 @@ tick's planned pose with the planned ground reaction, as :func:`zmpwalk.sim.plan
 for a whole pattern; the planned joint rates go to the servos as their rate reference (the servo damping's
 feedforward). Where the batch path differences the planned poses centrally (it sees the future), the per-tick path
 differences backwards over one tick (0.5-1 ms late); a robot's other servos (arms, torso) hold their pose with the
-static torque of the ready posture (the batch path gives them the walk's inverse dynamics). Not simulated here yet:
-sensor latency and noise, capture steps.
+static torque of the ready posture (the batch path gives them the walk's inverse dynamics). Sensor latency and
+noise are the plant's (:class:`~zmpwalk.sim.mujoco_plant.MujocoPlant`). Not simulated here yet: capture steps.
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ from zmpwalk.kinematics import JOINT_COLUMNS
 from zmpwalk.online import START_DELAY, OnlineWalker
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sides import SUPPORT_OF_LABEL
-from zmpwalk.sim.disturbances import Disturbances
+from zmpwalk.sim.disturbances import Disturbances, SensorNoise
 from zmpwalk.sim.measure import AFTER_FALL
 from zmpwalk.sim.mujoco_plant import MujocoPlant
 from zmpwalk.sim.ranges import check_range
@@ -135,6 +135,7 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
                         command_phase: float = 0.5, duration: float | None = None, hold: float = HOLD,
                         operator: Callable[[WalkingController, int], None] | None = None, balance: bool = True,
                         feedforward: bool = True, mass_scale: float = 1.0, disturbances: Disturbances | None = None,
+                        latency: float = 0.0, noise: SensorNoise | None = None,
                         progress: Callable[[float], None] | None = None) -> ControllerRun:
     """Walk ``commands`` through a walking controller on the MuJoCo plant, tick by tick (module docstring).
 
@@ -145,8 +146,9 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
         controller: The controller (default: a :class:`~zmpwalk.control.WalkingController` with the stabilizer
             where ``balance`` and the plant's :class:`~zmpwalk.sim.mujoco_plant.ModelFeedforward` where
             ``feedforward``).
-        plant: The plant (default: a :class:`~zmpwalk.sim.mujoco_plant.MujocoPlant` with ``mass_scale`` and
-            ``disturbances``).
+        plant: The plant (default: a :class:`~zmpwalk.sim.mujoco_plant.MujocoPlant` with ``mass_scale``,
+            ``disturbances``, ``latency`` [s] and ``noise``: the controller measures the sensors ``latency`` late,
+            with that noise).
         command_phase: Each command after the first is given this fraction of the step time into the step before
             it, in [0, 1).
         duration: Run this long [s]; None: until every command is given and the walker stands still, then ``hold``.
@@ -170,7 +172,8 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
     if duration is not None and not 0.0 < duration <= 3600.0:
         raise InvalidParameterError("duration", duration, "a run length in (0, 3600] s")
     check_range("hold", hold)
-    plant = plant or MujocoPlant(robot, rate, mass_scale=mass_scale, disturbances=disturbances)
+    plant = plant or MujocoPlant(robot, rate, mass_scale=mass_scale, disturbances=disturbances, latency=latency,
+                                 noise=noise)
     controller = controller or WalkingController(robot, plant.rate, balance=balance,
                                                  feedforward=plant.feedforward() if feedforward else None)
     if controller.rate != plant.rate:

@@ -27,7 +27,8 @@ from zmpwalk.robots.pd import is_position_servo
 from zmpwalk.sim.mjcf import contact_mapping
 from zmpwalk.sim.plant import Plant as SimPlant
 from zmpwalk.sim.plant import build_plant, set_initial_state, static_feedforward
-from zmpwalk.sim.disturbances import NOSLIP_ITERATIONS
+from zmpwalk.sim.disturbances import NOSLIP_ITERATIONS, SensorNoise
+from zmpwalk.sim.ranges import check_range
 from zmpwalk.sim.run import FALL_HEIGHT_FRACTION, FALL_TILT, Disturbances, _MeasurementReader
 from zmpwalk.sim.soles import SensorSlices
 
@@ -174,6 +175,11 @@ class MujocoPlant:
         mass_scale: Multiply the box model's masses (:func:`zmpwalk.sim.plant.build_plant`).
         disturbances: A push, a floor tilt or a mass error (:class:`~zmpwalk.sim.run.Disturbances`); the
             :meth:`feedforward` keeps the nominal model.
+        latency: Every measurement is the sensors' reading this long before [s] (a whole number of control
+            periods, 0 to 0.1 s; before the walk's first readings, the first), as the batch walk's
+            (:func:`zmpwalk.sim.run.simulate`).
+        noise: Gaussian noise added to every measurement (:class:`~zmpwalk.sim.disturbances.SensorNoise`, its
+            seed's generator drawn once per :meth:`measure`); None: none.
         noslip: Run MuJoCo's noslip solver (:data:`~zmpwalk.sim.disturbances.NOSLIP_ITERATIONS` iterations): a
             loaded sole then holds where it stands instead of creeping under a lasting tangential force inside
             the friction cone, as MuJoCo's soft contacts let it (as on a tilted floor, where it always runs).
@@ -184,7 +190,9 @@ class MujocoPlant:
     """
 
     def __init__(self, robot: RobotModel, rate: float = 1000.0, *, mass_scale: float = 1.0,
-                 disturbances: Disturbances | None = None, noslip: bool = False) -> None:
+                 disturbances: Disturbances | None = None, latency: float = 0.0, noise: SensorNoise | None = None,
+                 noslip: bool = False) -> None:
+        check_range("latency", latency)
         plant = build_plant(robot, mass_scale)
         model = plant.model
         if noslip:
@@ -215,6 +223,12 @@ class MujocoPlant:
             RobotModel(**{**vars(robot), "mass": robot.link_mass * mass_scale})).penetration
         self.weight = float(model.body_subtreemass[1]) * robot.gravity  # [N]
         self._ticks = 0
+        self._delay = round(latency * self.rate)
+        if abs(self._delay - latency * self.rate) > 1e-6:
+            raise InvalidParameterError("latency", latency, f"a whole number of control periods ({1 / self.rate:g} s)")
+        self._past = np.empty((self._delay + 1, model.nsensordata))  # ring of the last readings, oldest first read
+        self._noise = noise
+        self._rng = np.random.default_rng(noise.seed) if noise is not None else None
 
     @property
     def time(self) -> float:
@@ -245,10 +259,19 @@ class MujocoPlant:
         self._ctrl[plant.leg_actuators] = sample.joint_angles
         self.data.ctrl[:] = self._ctrl
         self._ticks = 0
+        if self._delay:
+            self._past[:] = self.data.sensordata  # set_initial_state ran mj_forward
 
     def measure(self) -> BalanceMeasurement:
-        """The sensors now: each sole's wrench (the ground's, at the ankle, foot frame), the IMU, the encoders."""
-        return self._reader.read(self.data.sensordata)
+        """The sensors (``latency`` ago; now without one): each sole's wrench (the ground's, at the ankle, foot
+        frame), the IMU, the encoders; with ``noise`` added."""
+        if self._delay == 0:
+            measurement = self._reader.read(self.data.sensordata)
+        else:
+            measurement = self._reader.read(self._past[(self._ticks + 1) % (self._delay + 1)])  # after tick t - delay
+        if self._noise is not None and self._rng is not None:
+            self._noise.add_to(measurement, self._rng)
+        return measurement
 
     def apply(self, targets: JointTargets) -> None:
         """Drive the leg servos with the targets (the control of the class docstring)."""
@@ -265,6 +288,8 @@ class MujocoPlant:
         for _ in range(self.steps_per_tick):
             mujoco.mj_step(self.model, self.data)
         self._ticks += 1
+        if self._delay:
+            self._past[self._ticks % (self._delay + 1)] = self.data.sensordata
 
     def fallen(self) -> bool:
         """The fall criterion of :mod:`zmpwalk.sim.run` now (the torso touching the floor, tilted over
