@@ -21,7 +21,7 @@ from numba import njit
 
 from zmpwalk.stabilizer.freshness import BUILD_KEY
 from zmpwalk.stabilizer.layout import L, P, S
-from zmpwalk.stabilizer.leg import ankle_in_base, com_in_base, leg_kinematics, sole_normal
+from zmpwalk.stabilizer.leg import FIRST, SECOND, ankle_in_base, com_in_base, leg_kinematics, sole_normal
 from zmpwalk.stabilizer.rotations import rotate2, rotate3, rotation_zyx
 
 Vector3 = tuple[float, float, float]
@@ -46,14 +46,14 @@ def measured_legs(params: np.ndarray, chain: np.ndarray, work: np.ndarray, encod
     """The measured legs (``work[0]``, ``work[2]``) and the torso's rotation in world (``work[4, 6, 0:9]``) from
     the encoders, the IMU's roll and pitch and the ``heading`` [rad]: each measured ankle in the base frame, the
     whole-body CoM in the base frame, and each sole's normal in the base frame."""
-    leg_kinematics(chain, 0, encoders, work[0])
-    leg_kinematics(chain, 1, encoders, work[2])
+    leg_kinematics(chain, FIRST, encoders, work[0])
+    leg_kinematics(chain, SECOND, encoders, work[2])
     rotation_zyx(heading, attitude[1], attitude[0], work[4, 6, 0:9])
-    a0 = ankle_in_base(params, 0, work[0])
-    a1 = ankle_in_base(params, 1, work[2])
-    com = com_in_base(params, chain, work, 0)
+    a0 = ankle_in_base(params, FIRST, work[0])
+    a1 = ankle_in_base(params, SECOND, work[2])
+    com = com_in_base(params, chain, work, FIRST)
     # each measured sole's normal (its sole frame's z axis)
-    return a0, a1, com, sole_normal(params, 0, work[0]), sole_normal(params, 1, work[2])
+    return a0, a1, com, sole_normal(params, FIRST, work[0]), sole_normal(params, SECOND, work[2])
 
 
 @njit(cache=True, nogil=True, inline="always")

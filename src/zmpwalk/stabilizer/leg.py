@@ -28,6 +28,10 @@ from numba import njit
 from zmpwalk.stabilizer.freshness import BUILD_KEY
 from zmpwalk.stabilizer.layout import P
 
+# The two legs' indices as numpy integers: numba types a Python int constant argument as a literal and compiles
+# the callee once per value; an int64 once for both (one compile less per leg function on the first run).
+FIRST, SECOND = np.int64(0), np.int64(1)
+
 
 @njit(cache=True, nogil=True)
 def leg_kinematics(chain: np.ndarray, leg: int, columns: np.ndarray, frames: np.ndarray) -> None:
@@ -191,10 +195,10 @@ def factor_pattern_legs(params: np.ndarray, chain: np.ndarray, work: np.ndarray,
     Jacobians (``work[4]``, row swaps in ``work[5, 0]``), which map the foot corrections onto the joints; returns
     the first leg (0 left, 1 right) whose Jacobian has a pivot below ``least_pivot`` (a straight knee), else -1,
     and each planned ankle in the base frame [m]."""
-    leg_kinematics(chain, 0, reference, work[1])
-    leg_kinematics(chain, 1, reference, work[3])
-    p0 = ankle_in_base(params, 0, work[1])
-    p1 = ankle_in_base(params, 1, work[3])
+    leg_kinematics(chain, FIRST, reference, work[1])
+    leg_kinematics(chain, SECOND, reference, work[3])
+    p0 = ankle_in_base(params, FIRST, work[1])
+    p1 = ankle_in_base(params, SECOND, work[3])
     for leg in range(2):
         factors, swaps = work[4, 0:6, 6 * leg:6 * leg + 6], work[5, 0, 6 * leg:6 * leg + 6]
         leg_jacobian(chain, leg, work[2 * leg + 1], p0 if leg == 0 else p1, factors)

@@ -24,7 +24,7 @@ from numba import njit
 
 from zmpwalk.stabilizer.freshness import BUILD_KEY
 from zmpwalk.stabilizer.layout import DOUBLE_SUPPORT, LEFT_SUPPORT, RIGHT_SUPPORT, L, P, S
-from zmpwalk.stabilizer.leg import com_in_base
+from zmpwalk.stabilizer.leg import SECOND, com_in_base
 from zmpwalk.stabilizer.rotations import clip, rotate2
 
 MIN_SHARE = 1e-9  # [-] a sole's share of the desired ZMP below which its CoP is not controlled
@@ -38,7 +38,7 @@ def whole_body_rest(params: np.ndarray, chain: np.ndarray, work: np.ndarray, log
     angles and the rest of the body (:mod:`zmpwalk.balance`, step 2)."""
     whole_x = whole_y = 0.0
     if params[P.whole_body_rest] > 0.0:
-        qx, qy, _ = com_in_base(params, chain, work, 1)
+        qx, qy, _ = com_in_base(params, chain, work, SECOND)
         whole_x, whole_y = rotate2(params[P.whole_body_rest] * qx, params[P.whole_body_rest] * qy, yaw)
     log[L.whole_body_offset], log[L.whole_body_offset + 1] = whole_x, whole_y
     return whole_x, whole_y
