@@ -283,12 +283,16 @@ def run_walk(spec: WalkSpec, progress: Progress | None = None, planned: PlannedW
         stage("joints")
     stage("simulation")
     pattern = planned.pattern
-    stabilizer = Stabilizer(spec.robot, spec.rate, com_reference=pattern.com_point) if spec.balance else None
-    result = simulate(spec.robot, planned.joints, pattern, mass_scale=spec.mass_scale, stabilizer=stabilizer,
-                      latency=spec.latency, noise=spec.noise, feedforward=spec.feedforward, settle=spec.settle,
-                      hold=spec.hold, disturbances=spec.disturbances, capture=spec.capture,
-                      progress=None if progress is None else lambda done: progress("simulation", round(100 * done),
-                                                                                   100))
+    report = None if progress is None else (lambda done: progress("simulation", round(100 * done), 100))
+    if through_controller(spec):
+        result = _controller_walk(spec, report)
+        balanced = True
+    else:
+        stabilizer = Stabilizer(spec.robot, spec.rate, com_reference=pattern.com_point) if spec.balance else None
+        result = simulate(spec.robot, planned.joints, pattern, mass_scale=spec.mass_scale, stabilizer=stabilizer,
+                          latency=spec.latency, noise=spec.noise, feedforward=spec.feedforward, settle=spec.settle,
+                          hold=spec.hold, disturbances=spec.disturbances, capture=spec.capture, progress=report)
+        balanced = stabilizer is not None
     motors = None if spec.motors is None else list(spec.motors)
     verdict = walk_verdict(result, spec.hold, motors)
     stage("measures")
@@ -296,4 +300,42 @@ def run_walk(spec: WalkSpec, progress: Progress | None = None, planned: PlannedW
     fits = motor_fits(result, motors) if motors else []
     seconds["measures"] = time.perf_counter() - clock
     return WalkOutcome(spec, pattern, planned.correction, planned.joints, result, verdict, rows, fits,
-                       controller_words(stabilizer is not None), seconds)
+                       controller_words(balanced, through_controller(spec)), seconds)
+
+
+def through_controller(spec: WalkSpec) -> bool:
+    """Whether :func:`run_walk` simulates ``spec`` through the :class:`~zmpwalk.control.WalkingController` (the
+    code a robot's loop runs, commands given mid-walk): every walk with the stabilizer on a generator the walker
+    runs online, but those the batch closed loop (:mod:`zmpwalk.sim.closed_loop`) keeps: the paper's example
+    (``paper_steps``), a ZMP-corrected pattern, capture steps, no feedforward."""
+    from zmpwalk.online_check import ONLINE_GENERATORS
+
+    return (spec.balance and spec.paper_steps is None and not spec.zmp_correction and spec.capture is None
+            and spec.feedforward is not False and spec.generator_name in ONLINE_GENERATORS)
+
+
+def _controller_walk(spec: WalkSpec, progress: Callable[[float], None] | None) -> SimulationResult:
+    """``spec``'s walk through the walking controller in MuJoCo at 1 kHz (:func:`zmpwalk.sim.loop.simulate_controller`),
+    its time 0 where the walk begins, as the pattern's.
+
+    Raises:
+        ZmpwalkError: The walker refused a command (the first refusal, in ``spec.source``'s words).
+    """
+    from zmpwalk.control import WalkingController
+    from zmpwalk.schedule import Schedule
+    from zmpwalk.sim.loop import simulate_controller
+    from zmpwalk.sim.mujoco_plant import MujocoPlant
+    from zmpwalk.sim.references import CONTROL_RATE
+
+    plant = MujocoPlant(spec.robot, CONTROL_RATE, mass_scale=spec.mass_scale, disturbances=spec.disturbances,
+                        latency=spec.latency, noise=spec.noise)
+    controller = WalkingController(spec.robot, CONTROL_RATE, schedule=spec.schedule or Schedule.hubo(),
+                                   generator=spec.generator_name, pelvis=spec.pelvis, feedforward=plant.feedforward())
+    run = simulate_controller(spec.robot, spec.commands, controller=controller, plant=plant, hold=spec.hold,
+                              settle=spec.settle, progress=progress)
+    if run.rejections:
+        index, _, error = run.rejections[0]
+        label = spec.labels[index] if spec.labels is not None else f"command {index + 1}"
+        error = error.in_context(f"{spec.source}: {label}" if spec.source else label)
+        raise error
+    return run.result

@@ -118,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
     walk = run_walk(walk_spec(args, robot), progress=show)
     result, verdict, rows, fits, correction = walk.result, walk.verdict, walk.rows, walk.fits, walk.correction
     summary = {**simulation_summary(result, verdict, rows, fits, correction), "balance": walk.spec.balance,
-               "generator": walk.pattern.generator}
+               "generator": walk.pattern.generator, "controller": walk.controller}
     if args.out:
         args.out.mkdir(parents=True, exist_ok=True)
         write_actuator_csv(rows, args.out / "actuators.csv")
@@ -129,7 +129,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         print("generator: " + ("hyperbolic (the paper example of Lim et al.)" if args.paper_example else
                                generator_words(args, robot)))
-        print_simulation(result, verdict, rows, fits, correction)
+        print_simulation(result, verdict, rows, fits, correction, walk.controller)
     return 0 if verdict.passed else EXIT_FAILED
 
 
@@ -165,12 +165,13 @@ def simulation_summary(result: SimulationResult, verdict: Verdict, rows: list[Ac
 
 
 def print_simulation(result: SimulationResult, verdict: Verdict, rows: list[ActuatorRow], fits: list[MotorFit],
-                     correction: ZmpCorrection | None) -> None:
-    """What ``simulate`` prints: the walk, the plan's ZMP margin, the CoP, the motors, the warnings, the verdict."""
-    from zmpwalk.sim.verdict import controller_words, cop_margin_outside_touchdowns
+                     correction: ZmpCorrection | None, controller: str) -> None:
+    """What ``simulate`` prints: what ran (``controller``, in words), the walk, the plan's ZMP margin, the CoP, the
+    motors, the warnings, the verdict."""
+    from zmpwalk.sim.verdict import cop_margin_outside_touchdowns
 
     state = f"FELL at t = {result.fall_time:.3f} s" if result.fell else "walked to the end without falling"
-    print(f"controller: {controller_words(result.balance is not None)}")
+    print(f"controller: {controller}")
     print(f"{result.robot.name}: {state}; distance {result.distance:.3f} m, average speed "
           f"{result.average_speed * 1e3:.1f} mm/s, foot slip {result.foot_slip * 1e3:.1f} mm")
     if correction is not None:

@@ -27,7 +27,7 @@ from zmpwalk.schedule import Schedule
 from zmpwalk.sim.actuators import IMPACT_WINDOW, ActuatorRow, actuator_markdown, write_actuator_csv
 from zmpwalk.sim.motors import Motor, MotorFit
 from zmpwalk.sim.run import SimulationResult, write_result_csv
-from zmpwalk.sim.verdict import FAIL, PASS, SKIP, WARN, Verdict, controller_words
+from zmpwalk.sim.verdict import FAIL, PASS, SKIP, WARN, Verdict
 from zmpwalk.walk import Progress, WalkSpec, run_walk
 
 STAGES = ("pattern", "joints", "simulation", "plots", "animation", "page")
@@ -122,7 +122,7 @@ def build_report(
     replay = _replay(robot, pattern, result, animation, animation_note) if animate else ""
     done("animation")
     fits = walk.fits
-    report.summary = _summary(pattern, result, report.verdict, fits, generator)
+    report.summary = _summary(pattern, result, report.verdict, fits, generator, walk.controller)
     movie = replay or _movie(animation, animation_note)
     page = _page(title, robot, report.summary, _figure_html(images, time_axes if replay else {}), movie,
                  step_margins(pattern), rows, report.verdict, fits, _step_list(commands, labels))
@@ -218,7 +218,7 @@ def _replay(robot: RobotModel, pattern: WalkingPattern, result: SimulationResult
 
 
 def _summary(pattern: WalkingPattern, result: SimulationResult, verdict: Verdict, fits: list[MotorFit],
-             generator: str) -> dict[str, Any]:
+             generator: str, controller: str) -> dict[str, Any]:
     """The numbers on the page (SI), as ``summary.json`` and ``report --json`` give them."""
     margin, at = pattern.min_zmp_margin()
     rms, largest = result.cop_error_stats()
@@ -227,7 +227,7 @@ def _summary(pattern: WalkingPattern, result: SimulationResult, verdict: Verdict
         "swings": len(pattern.steps), "min_zmp_margin": margin, "min_zmp_margin_time": at, "fell": result.fell,
         "fall_time": result.fall_time, "distance": result.distance, "average_speed": result.average_speed,
         "foot_slip": result.foot_slip, "cop_error_rms": rms, "cop_error_max": largest,
-        "balance": result.balance is not None, "controller": controller_words(result.balance is not None),
+        "balance": result.balance is not None, "controller": controller,
         "verdict": verdict.as_dict(), "warnings": list(verdict.warnings),
         "motors": [{"joint": f.joint, "motor": f.motor, "rms_use": f.rms_use, "peak_use": f.peak_use,
                     "fits": f.fits} for f in fits],

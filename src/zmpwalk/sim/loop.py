@@ -69,12 +69,12 @@ class _Operator:
     """Gives a list of commands as an operator does: the first at once, each next one ``phase`` of the step
     time into the step before it, once that step has begun (or at once after a refusal)."""
 
-    def __init__(self, commands: Sequence[StepCommand], phase: float, rate: float) -> None:
+    def __init__(self, commands: Sequence[StepCommand], phase: float, rate: float, first: int = 0) -> None:
         self.pending = list(commands)
         self.phase, self.rate = phase, rate
         self.index = -1
         self.waiting: StepCommand | None = None  # given, not yet begun or refused
-        self.due = 0  # tick at which the next one is given
+        self.due = first  # tick at which the next one is given
         self.given: list[float] = []
         self.rejections: list[tuple[int, StepCommand, ZmpwalkError]] = []
 
@@ -135,7 +135,7 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
                         command_phase: float = 0.5, duration: float | None = None, hold: float = HOLD,
                         operator: Callable[[WalkingController, int], None] | None = None, balance: bool = True,
                         feedforward: bool = True, mass_scale: float = 1.0, disturbances: Disturbances | None = None,
-                        latency: float = 0.0, noise: SensorNoise | None = None,
+                        latency: float = 0.0, noise: SensorNoise | None = None, settle: float | None = None,
                         progress: Callable[[float], None] | None = None) -> ControllerRun:
     """Walk ``commands`` through a walking controller on the MuJoCo plant, tick by tick (module docstring).
 
@@ -153,6 +153,11 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
             it, in [0, 1).
         duration: Run this long [s]; None: until every command is given and the walker stands still, then ``hold``.
         hold: Standing still after the walk [s] (the verdict judges how the walk ends over it).
+        settle: Standing before the walk begins [s]: the first command is given ``settle -``
+            :data:`~zmpwalk.online.START_DELAY` after the robot is stood (at once where that is negative: a walk
+            begins START_DELAY after its first command), and the result's time is 0 where the walk begins (the
+            walking pattern's time; the standing before it at negative times). None: the first command at once,
+            the result's time from the stand.
         operator: Called every tick before the update with the controller and the tick's index: anything an
             operator does (commands, velocities, stops); needs a ``duration``.
         progress: Called with the fraction done now and then (of the run's longest length).
@@ -172,6 +177,8 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
     if duration is not None and not 0.0 < duration <= 3600.0:
         raise InvalidParameterError("duration", duration, "a run length in (0, 3600] s")
     check_range("hold", hold)
+    if settle is not None:
+        check_range("settle", settle)
     plant = plant or MujocoPlant(robot, rate, mass_scale=mass_scale, disturbances=disturbances, latency=latency,
                                  noise=noise)
     controller = controller or WalkingController(robot, plant.rate, balance=balance,
@@ -183,7 +190,8 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
                                                                                default=0.0) + hold + 5.0
     size = round((duration if duration is not None else longest) * plant.rate)
     log = _Log(size, plant.model.nsensordata, controller.feedforward is not None, controller.stabilizer is not None)
-    giver = _Operator(commands, command_phase, plant.rate)
+    first = 0 if settle is None else max(0, round((settle - START_DELAY) * plant.rate))
+    giver = _Operator(commands, command_phase, plant.rate, first)
     end, fall = size, None
     for k in range(size):
         if progress is not None and k % 1000 == 0:
@@ -201,7 +209,8 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
             end = min(size, k + 1 + round(hold * plant.rate))
         if k + 1 >= end:
             break
-    result = _result(robot, plant, log, k + 1, fall, size / plant.rate, hold)
+    start = 0.0 if settle is None else first / plant.rate + START_DELAY  # [s] the walk begins
+    result = _result(robot, plant, log, k + 1, fall, size / plant.rate, hold, start)
     return ControllerRun(result, giver.given, giver.rejections, controller.faults, controller)
 
 
@@ -223,11 +232,12 @@ def _plan_margin(robot: RobotModel, log: _Log, n: int) -> float:
 
 
 def _result(robot: RobotModel, plant: MujocoPlant, log: _Log, n: int, fall: int | None, planned_end: float,
-            hold: float) -> SimulationResult:
+            hold: float, start: float = 0.0) -> SimulationResult:
     """The run's :class:`~zmpwalk.sim.result.SimulationResult` from its first ``n`` ticks (row ``k``: the state at the
-    end of tick ``k``, labelled with the tick's time ``k / rate``, as :func:`~zmpwalk.sim.run.simulate` labels it)."""
+    end of tick ``k``, labelled with the tick's time ``k / rate - start``, as :func:`~zmpwalk.sim.run.simulate` labels
+    it)."""
     sensors, readings = plant.sensors, log.readings[:n]
-    time = np.arange(n) / plant.rate
+    time = np.arange(n) / plant.rate - start
     pelvis, rpy = sensors.take(readings, "pelvis_pos"), rpy_from_quaternion(sensors.take(readings, "pelvis_quat"))
     soles = sole_measurements(robot, plant.sensors, readings, plant.weight)
     angles, velocities, torques = (sensors.columns(readings, [f"{c}_{s}" for c in JOINT_COLUMNS])
@@ -245,7 +255,8 @@ def _result(robot: RobotModel, plant: MujocoPlant, log: _Log, n: int, fall: int 
         balance=None if log.balance is None else {k: v[:n].copy() for k, v in log.balance.items()},
         ankle_positions=np.stack([sensors.take(readings, f"{s}_ankle_pos") for s in ("left", "right")], axis=1),
         planned_torques=None if log.torques is None else log.torques[:n].copy(),
-        plan_zmp_margin=_plan_margin(robot, log, n), planned_end=planned_end if fall is not None else float(time[-1]),
+        plan_zmp_margin=_plan_margin(robot, log, n),
+        planned_end=planned_end - start if fall is not None else float(time[-1]),
         final_feet_error=end[0], final_feet_yaw_error=end[1], end_min_sole_force=end[2], end_max_speed=end[3],
         end_attitude_range=end[4])
 

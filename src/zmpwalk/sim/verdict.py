@@ -305,8 +305,12 @@ def walk_warnings(rows: list[ActuatorRow], fits: list[MotorFit]) -> list[str]:
     return warnings
 
 
-def controller_words(balance: bool) -> str:
-    """What ran in the simulation's loop, in words (the console's and the page's summary)."""
+def controller_words(balance: bool, controller: bool = False) -> str:
+    """What ran in the simulation's loop, in words (the console's and the page's summary): ``controller``, the
+    walking controller a robot's loop runs (walker, stabilizer, feedforward; commands given mid-walk)."""
+    if balance and controller:
+        return ("the walking controller, as a robot's loop runs it: the online walker (commands given mid-walk), "
+                "the stabilizer (DCM, ankle, force and attitude loops) and the feedforward, at 1 kHz")
     if balance:
         return "the walking pattern with the stabilizer in the loop (DCM, ankle, force and attitude loops)"
     return "the walking pattern alone, open loop (--balance off: no stabilizer, as the papers walk it)"
