@@ -229,3 +229,33 @@ def test_capture_without_what_it_needs_is_refused(hubo, walk, capsys):
                  capture=CaptureSettings())
     assert main(["simulate", "--scenario", "fig10", "--balance", "off", "--capture"]) == 2
     assert "--capture needs the stabilizer" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_the_controller_takes_the_capture_step_that_saves_a_pushed_walk(hubo, walk):
+    """The same push through the walking controller (commands given in the loop, the capture policy in the
+    controller): without capture steps HUBO falls; with them it steps back within the push's first 0.2 s, comes to
+    rest on both feet with them within 20 mm of the capture's plan (measured 8.6 mm; the batch walk's 4.5 mm)."""
+    from zmpwalk.online import START_DELAY
+    from zmpwalk.sim.disturbances import Disturbances
+    from zmpwalk.sim.loop import simulate_controller
+
+    pattern, index = walk
+    commands = load_scenario("fig10")[:1] + [StepCommand(duration=0.95, forward=0.2)] * 8
+    push_time = float(pattern.time[index]) + START_DELAY  # the controller's clock starts START_DELAY earlier
+    push = Disturbances(push_time=push_time, push_impulse=(-36.0, 0.0, 0.0))
+    runs = [simulate_controller(hubo, commands, disturbances=push, capture=capture)
+            for capture in (None, CaptureSettings())]
+    assert runs[0].result.fell and not runs[0].result.captures
+    result = runs[1].result
+    assert not result.fell
+    assert 1 <= len(result.captures) <= 5
+    first = result.captures[0]
+    assert first.swing == pattern.steps[4].swing
+    assert push_time < first.time < push_time + 0.2
+    assert result.final_feet_error < 0.02  # [m]
+    assert result.end_min_sole_force > 0.0 and result.end_max_speed < 0.05  # ends standing still on both feet
+    standing = runs[1].controller.walker.tick()  # the walker stands where the capture left the feet
+    landing = first if len(result.captures) == 1 else result.captures[-1]
+    side = standing.position_left_ankle_in_world if landing.swing == "left" else standing.position_right_ankle_in_world
+    np.testing.assert_allclose(side[:2], landing.landing[:2], atol=1e-9, rtol=0)

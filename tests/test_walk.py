@@ -46,7 +46,7 @@ def test_balance_chooses_the_stabilizer_or_the_open_loop(hubo) -> None:
     closed = run_walk(WalkSpec(hubo, commands, labels), progress=lambda *stage: stages.append(stage))
     open_loop = run_walk(WalkSpec(hubo, commands, labels, balance=False))
     assert closed.result.balance is not None and open_loop.result.balance is None
-    assert (closed.controller, open_loop.controller) == (controller_words(True), controller_words(False))
+    assert (closed.controller, open_loop.controller) == (controller_words(True, True), controller_words(False))
     assert closed.verdict.passed
     rms_closed, _ = closed.result.cop_error_stats()
     rms_open, _ = open_loop.result.cop_error_stats()

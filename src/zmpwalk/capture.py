@@ -54,6 +54,7 @@ Array = NDArray[np.float64]
 SWING_GRID = 0.01  # [s] the capture swing's duration is searched on this grid
 REACH_SHRINK = 0.9  # [-] a landing out of reach is pulled towards the stance foot by this factor, then checked
 REACH_TRIES = 12  # pulls before the landing is given up as out of reach
+CAPTURE_INTERVAL = 0.02  # [s] least time between two capture steps planned in one single support
 SETTLE_TRIES = 3  # the settle is doubled up to this many times to keep the ZMP in the feet
 ZMP_TOLERANCE = 1e-9  # [m]
 LEAST_REPLANNED_SWING = 0.08  # [s] a capture step re-planned during its swing lands at least this much later

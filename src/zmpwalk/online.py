@@ -422,6 +422,15 @@ class OnlineWalker:
             self._pending = None  # the step under way is a stop already
         self._release(dropped)
 
+    def stand_at(self, stance: Stance) -> None:
+        """Stand still with the feet at ``stance`` from the next tick (where a capture step that the walking
+        controller played left them); every command given, being checked or queued is dropped."""
+        self._drop_job()
+        self._release(self._current, self._pending)
+        self._current = self._pending = self._rejection = None
+        self._stance, self._boundary = stance, Boundary(self.time)
+        self._set_standing(self._check.standing_row(stance))
+
     def tick(self, *, work: bool = True) -> WalkingSample:
         """The sample at :attr:`time`, then advance by one control period; ``work=False``: without the parts of a
         command's check, which :meth:`work` then runs (a loop that times its own work into the budget)."""

@@ -13,6 +13,7 @@ Importing this module loads neither MuJoCo nor numba; :func:`run_walk` does.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -306,11 +307,12 @@ def run_walk(spec: WalkSpec, progress: Progress | None = None, planned: PlannedW
 def through_controller(spec: WalkSpec) -> bool:
     """Whether :func:`run_walk` simulates ``spec`` through the :class:`~zmpwalk.control.WalkingController` (the
     code a robot's loop runs, commands given mid-walk): every walk with the stabilizer on a generator the walker
-    runs online, but those the batch closed loop (:mod:`zmpwalk.sim.closed_loop`) keeps: the paper's example
-    (``paper_steps``), a ZMP-corrected pattern, capture steps, no feedforward."""
+    runs online (capture steps included), but those the batch closed loop (:mod:`zmpwalk.sim.closed_loop`)
+    keeps: the paper's example (``paper_steps``), a ZMP-corrected pattern, the preview generator, no
+    feedforward."""
     from zmpwalk.online_check import ONLINE_GENERATORS
 
-    return (spec.balance and spec.paper_steps is None and not spec.zmp_correction and spec.capture is None
+    return (spec.balance and spec.paper_steps is None and not spec.zmp_correction
             and spec.feedforward is not False and spec.generator_name in ONLINE_GENERATORS)
 
 
@@ -323,14 +325,19 @@ def _controller_walk(spec: WalkSpec, progress: Callable[[float], None] | None) -
     """
     from zmpwalk.control import WalkingController
     from zmpwalk.schedule import Schedule
-    from zmpwalk.sim.loop import simulate_controller
+    from zmpwalk.sim.loop import simulate_controller, walk_start
     from zmpwalk.sim.mujoco_plant import MujocoPlant
     from zmpwalk.sim.references import CONTROL_RATE
 
-    plant = MujocoPlant(spec.robot, CONTROL_RATE, mass_scale=spec.mass_scale, disturbances=spec.disturbances,
+    disturbances = spec.disturbances  # a push at the walk's time, on the plant's clock from the stand
+    if disturbances is not None and disturbances.push_time is not None:
+        disturbances = dataclasses.replace(disturbances,
+                                           push_time=disturbances.push_time + walk_start(spec.settle, CONTROL_RATE))
+    plant = MujocoPlant(spec.robot, CONTROL_RATE, mass_scale=spec.mass_scale, disturbances=disturbances,
                         latency=spec.latency, noise=spec.noise)
     controller = WalkingController(spec.robot, CONTROL_RATE, schedule=spec.schedule or Schedule.hubo(),
-                                   generator=spec.generator_name, pelvis=spec.pelvis, feedforward=plant.feedforward())
+                                   generator=spec.generator_name, pelvis=spec.pelvis, feedforward=plant.feedforward(),
+                                   capture=spec.capture)
     run = simulate_controller(spec.robot, spec.commands, controller=controller, plant=plant, hold=spec.hold,
                               settle=spec.settle, progress=progress)
     if run.rejections:

@@ -34,7 +34,9 @@ from zmpwalk import online
 from zmpwalk.balance import BalanceMeasurement, Stabilizer
 from zmpwalk.commands import StepCommand
 from zmpwalk.control.plant import JointTargets
-from zmpwalk.errors import InvalidParameterError, ZmpwalkError
+from zmpwalk.capture import CapturePlan, CaptureSettings
+from zmpwalk.control.capture import CaptureMotion, CapturePolicy
+from zmpwalk.errors import InfeasiblePatternError, InvalidParameterError, UnreachableError, ZmpwalkError
 from zmpwalk.online import OnlineWalker, WalkingSample
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
@@ -136,10 +138,14 @@ class WalkingController:
         gains: The stabilizer's gains (default: the robot file's, :class:`~zmpwalk.balance.Stabilizer`).
         feedforward: Torques of the planned motion per tick (:class:`Feedforward`), sent as
             :attr:`JointTargets.torques`; None: no torques (the targets' ``torques`` is None).
+        capture: Take capture steps (:mod:`zmpwalk.control.capture`: when the stabilizer's DCM error passes the
+            trigger in a single support, the rest of the walk becomes one capture step and a stop; the walker
+            then stands where it left the feet); None: none.
 
     Raises:
         InvalidParameterError: As :class:`~zmpwalk.online.OnlineWalker` and :class:`~zmpwalk.balance.Stabilizer`
-            (a rate outside [10, 10000] Hz, an unknown generator or pelvis).
+            (a rate outside [10, 10000] Hz, an unknown generator or pelvis), or ``capture`` without the
+            stabilizer (its DCM estimate triggers a capture).
 
     Attributes:
         walker: The :class:`~zmpwalk.online.OnlineWalker` (read its state; command through the controller).
@@ -151,7 +157,11 @@ class WalkingController:
 
     def __init__(self, robot: RobotModel, rate: float = 1000.0, *, schedule: Schedule | None = None,
                  generator: str = "polynomial", pelvis: str = "cubic", balance: bool = True,
-                 gains: StabilizerGains | None = None, feedforward: Feedforward | None = None) -> None:
+                 gains: StabilizerGains | None = None, feedforward: Feedforward | None = None,
+                 capture: CaptureSettings | None = None) -> None:
+        if capture is not None and not balance:
+            raise InvalidParameterError("capture", capture, "None without the stabilizer (balance=False): its DCM "
+                                        "estimate triggers the capture step")
         self.robot = robot
         self.schedule = schedule or Schedule.hubo()
         self.walker = OnlineWalker(robot, rate, self.schedule, joints=True, pelvis=pelvis, generator=generator)
@@ -164,6 +174,20 @@ class WalkingController:
         self._velocity_step: StepCommand | None = None
         self._velocity_refused = False
         self._sample: WalkingSample | None = None
+        self._capture = None if capture is None else CapturePolicy(robot, self.rate, capture)
+        self._motion: CaptureMotion | None = None
+        self._deferred: StepCommand | None = None  # a command given during a capture
+        self._ticks = 0
+
+    @property
+    def walking(self) -> bool:
+        """True while a walk or a capture step is under way or a walk is queued."""
+        return self._motion is not None or self.walker.walking
+
+    @property
+    def captures(self) -> list[CapturePlan]:
+        """The capture steps taken, in order (empty without ``capture``)."""
+        return [] if self._capture is None else self._capture.captures
 
     @property
     def time(self) -> float:
@@ -199,16 +223,24 @@ class WalkingController:
 
     def command(self, step: StepCommand) -> None:
         """Give the step that follows the one under way (:meth:`OnlineWalker.command`: stored in microseconds,
-        checked a little per :meth:`update`; a refusal is :attr:`rejection`). Leaves velocity mode.
+        checked a little per :meth:`update`; a refusal is :attr:`rejection`; during a capture step, given to the
+        walker when the capture is over). Leaves velocity mode.
 
         Raises:
             InvalidParameterError: ``step`` is not a :class:`~zmpwalk.commands.StepCommand`.
         """
-        self.walker.command(step)
+        if self._motion is not None:
+            if not isinstance(step, StepCommand):
+                raise InvalidParameterError("step", type(step).__name__, "a StepCommand")
+            self._deferred = step  # given to the walker once the capture is over
+        else:
+            self.walker.command(step)
         self._leave_velocity()
 
     def stop(self) -> None:
-        """Stop after the step under way (:meth:`OnlineWalker.stop`); leaves velocity mode."""
+        """Stop after the step under way (:meth:`OnlineWalker.stop`; a capture step ends standing anyway, and a
+        command given during it is dropped); leaves velocity mode."""
+        self._deferred = None
         self.walker.stop()
         self._leave_velocity()
 
@@ -248,7 +280,7 @@ class WalkingController:
         compares commands and stores one."""
         step = self._velocity_step
         walker = self.walker
-        if step is None or self._velocity_refused or walker.checking is not None:
+        if step is None or self._velocity_refused or walker.checking is not None or self._motion is not None:
             return
         if walker.rejected == step:
             self._velocity_refused = True
@@ -271,20 +303,41 @@ class WalkingController:
         if not isinstance(measurement, BalanceMeasurement):
             raise InvalidParameterError("measurement", type(measurement).__name__, "a BalanceMeasurement")
         begin = online._clock()
-        walker = self.walker
-        sample = walker.tick(work=False)
+        walker, tick, previous = self.walker, self._ticks, self._sample
+        sample = walker.tick(work=False)  # ticked during a capture too: its clock runs on, standing
+        if self._motion is not None:
+            sample = self._motion.sample(tick, sample)
         self._sample = sample
+        self._ticks = tick + 1
         angles = sample.joint_angles
         velocities = sample.joint_velocities
         if angles is None or velocities is None:  # pragma: no cover - the walker is made with joints
             raise InvalidParameterError("walker.joints", False, "True")
         corrected = self._corrected(sample, angles, measurement)
+        if corrected is not None and previous is not None:
+            self._capture_step(tick, sample, previous)
+        if self._motion is not None and self._motion.done(tick):
+            self._motion = None
+            if self._deferred is not None:
+                walker.command(self._deferred)
+                self._deferred = None
         torques = None if self.feedforward is None else self.feedforward.torques(sample)
         if walker.checking is not None:  # the check's parts, in the budget the tick has left
             walker.work(online._clock() - begin)
         self._give_velocity_step()
         return JointTargets(sample.time, angles if corrected is None else corrected, velocities, torques, sample,
                             corrected is not None)
+
+    def _capture_step(self, tick: int, sample: WalkingSample, previous: WalkingSample) -> None:
+        """Plan a capture step from the next tick where one is due (:mod:`zmpwalk.control.capture`)."""
+        policy, stabilizer = self._capture, self.stabilizer
+        if policy is None or stabilizer is None or not policy.due(tick, sample, stabilizer):
+            return
+        try:
+            self._motion = policy.plan(tick, sample, previous, stabilizer, self._motion)
+        except (UnreachableError, InfeasiblePatternError):
+            return  # no capture step fits: the walk goes on as planned
+        self.walker.stand_at(self._motion.stance())
 
     def _corrected(self, sample: WalkingSample, angles: Array, measurement: BalanceMeasurement) -> Array | None:
         """The stabilizer's targets (a copy), or None without a stabilizer or on a fault."""

@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk.balance import BalanceMeasurement, BalanceState, Stabilizer
+from zmpwalk.capture import CAPTURE_INTERVAL
 from zmpwalk.errors import InfeasiblePatternError, UnreachableError
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.sim.disturbances import Disturbances, SensorNoise, _MeasurementReader
@@ -27,9 +28,6 @@ from zmpwalk.sim.soles import SensorSlices
 
 Array = NDArray[np.float64]
 Tail = Callable[[int, Stabilizer, int], dict[str, NDArray[np.generic]]]
-
-CAPTURE_INTERVAL = 0.02  # [s] least time between two capture steps planned in one single support
-
 
 @dataclass
 class _Tracks:

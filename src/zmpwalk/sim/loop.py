@@ -14,11 +14,14 @@ for a whole pattern; the planned joint rates go to the servos as their rate refe
 feedforward). Where the batch path differences the planned poses centrally (it sees the future), the per-tick path
 differences backwards over one tick (0.5-1 ms late); a robot's other servos (arms, torso) hold their pose with the
 static torque of the ready posture (the batch path gives them the walk's inverse dynamics). Sensor latency and
-noise are the plant's (:class:`~zmpwalk.sim.mujoco_plant.MujocoPlant`). Not simulated here yet: capture steps.
+noise are the plant's (:class:`~zmpwalk.sim.mujoco_plant.MujocoPlant`); capture steps the controller's
+(:mod:`zmpwalk.control.capture`): after one, the operator gives no more commands (the walk ends with the capture's
+stop, as the batch walk's does).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -26,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from zmpwalk.capture import CaptureSettings
 from zmpwalk.commands import StepCommand
 from zmpwalk.control import JointTargets, WalkingController
 from zmpwalk.errors import InvalidParameterError, ZmpwalkError
@@ -84,6 +88,9 @@ class _Operator:
 
     def __call__(self, controller: WalkingController, tick: int) -> None:
         walker = controller.walker
+        if controller.captures:  # a capture step ends the walk, as the batch walk's does
+            self.pending, self.waiting = [], None
+            return
         if self.waiting is not None:
             if walker.checking is not None or walker.queued is not None:
                 return
@@ -119,7 +126,7 @@ class _Log:
         self.ankles[k] = (sample.position_left_ankle_in_world, sample.position_right_ankle_in_world)
         self.yaws[k] = (sample.yaw_left_foot_in_world, sample.yaw_right_foot_in_world)
         self.support[k] = SUPPORT_OF_LABEL[sample.support]
-        self.walking[k] = controller.walker.walking
+        self.walking[k] = controller.walking
         if self.torques is not None and targets.torques is not None:
             self.torques[k] = targets.torques
         if self.balance is not None and controller.stabilizer is not None:
@@ -130,13 +137,19 @@ class _Log:
                 self.balance[name][k] = value
 
 
+def walk_start(settle: float, rate: float) -> float:
+    """When a walk given ``settle`` [s] begins [s] after the robot is stood (:func:`simulate_controller`): its
+    first command ``settle - START_DELAY`` after (at once where that is negative), the walk START_DELAY later."""
+    return max(0, round((settle - START_DELAY) * rate)) / rate + START_DELAY
+
+
 def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (), *, rate: float = 1000.0,
                         controller: WalkingController | None = None, plant: MujocoPlant | None = None,
                         command_phase: float = 0.5, duration: float | None = None, hold: float = HOLD,
                         operator: Callable[[WalkingController, int], None] | None = None, balance: bool = True,
                         feedforward: bool = True, mass_scale: float = 1.0, disturbances: Disturbances | None = None,
                         latency: float = 0.0, noise: SensorNoise | None = None, settle: float | None = None,
-                        progress: Callable[[float], None] | None = None) -> ControllerRun:
+                        capture: CaptureSettings | None = None, progress: Callable[[float], None] | None = None) -> ControllerRun:
     """Walk ``commands`` through a walking controller on the MuJoCo plant, tick by tick (module docstring).
 
     Args:
@@ -144,8 +157,8 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
         commands: The steps, given one by one during the walk (a steps file's, :func:`zmpwalk.scenarios.load_scenario`).
         rate: Control rate [Hz].
         controller: The controller (default: a :class:`~zmpwalk.control.WalkingController` with the stabilizer
-            where ``balance`` and the plant's :class:`~zmpwalk.sim.mujoco_plant.ModelFeedforward` where
-            ``feedforward``).
+            where ``balance``, capture steps with ``capture`` and the plant's
+            :class:`~zmpwalk.sim.mujoco_plant.ModelFeedforward` where ``feedforward``).
         plant: The plant (default: a :class:`~zmpwalk.sim.mujoco_plant.MujocoPlant` with ``mass_scale``,
             ``disturbances``, ``latency`` [s] and ``noise``: the controller measures the sensors ``latency`` late,
             with that noise).
@@ -157,7 +170,8 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
             :data:`~zmpwalk.online.START_DELAY` after the robot is stood (at once where that is negative: a walk
             begins START_DELAY after its first command), and the result's time is 0 where the walk begins (the
             walking pattern's time; the standing before it at negative times). None: the first command at once,
-            the result's time from the stand.
+            the result's time from the stand. A push's time (``disturbances``) is on the plant's clock, from the
+            stand (:func:`walk_start` shifts it).
         operator: Called every tick before the update with the controller and the tick's index: anything an
             operator does (commands, velocities, stops); needs a ``duration``.
         progress: Called with the fraction done now and then (of the run's longest length).
@@ -181,7 +195,7 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
         check_range("settle", settle)
     plant = plant or MujocoPlant(robot, rate, mass_scale=mass_scale, disturbances=disturbances, latency=latency,
                                  noise=noise)
-    controller = controller or WalkingController(robot, plant.rate, balance=balance,
+    controller = controller or WalkingController(robot, plant.rate, balance=balance, capture=capture,
                                                  feedforward=plant.feedforward() if feedforward else None)
     if controller.rate != plant.rate:
         raise InvalidParameterError("controller.rate", controller.rate, f"the plant's rate, {plant.rate:g} Hz")
@@ -190,7 +204,8 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
                                                                                default=0.0) + hold + 5.0
     size = round((duration if duration is not None else longest) * plant.rate)
     log = _Log(size, plant.model.nsensordata, controller.feedforward is not None, controller.stabilizer is not None)
-    first = 0 if settle is None else max(0, round((settle - START_DELAY) * plant.rate))
+    start = 0.0 if settle is None else walk_start(settle, plant.rate)  # [s] the walk begins
+    first = 0 if settle is None else round((start - START_DELAY) * plant.rate)
     giver = _Operator(commands, command_phase, plant.rate, first)
     end, fall = size, None
     for k in range(size):
@@ -205,12 +220,12 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
         log.record(k, plant, controller, targets)
         if fall is None and plant.fallen():
             fall, end = k, min(end, k + round(AFTER_FALL * plant.rate) + 1)
-        if duration is None and end == size and giver.done and not controller.walker.walking:
+        if duration is None and end == size and giver.done and not controller.walking:
             end = min(size, k + 1 + round(hold * plant.rate))
         if k + 1 >= end:
             break
-    start = 0.0 if settle is None else first / plant.rate + START_DELAY  # [s] the walk begins
     result = _result(robot, plant, log, k + 1, fall, size / plant.rate, hold, start)
+    result.captures = [dataclasses.replace(plan, time=plan.time - start) for plan in controller.captures]
     return ControllerRun(result, giver.given, giver.rejections, controller.faults, controller)
 
 
