@@ -259,3 +259,32 @@ def test_the_controller_takes_the_capture_step_that_saves_a_pushed_walk(hubo, wa
     landing = first if len(result.captures) == 1 else result.captures[-1]
     side = standing.position_left_ankle_in_world if landing.swing == "left" else standing.position_right_ankle_in_world
     np.testing.assert_allclose(side[:2], landing.landing[:2], atol=1e-9, rtol=0)
+
+
+@pytest.mark.slow
+def test_a_joystick_walk_walks_on_after_the_controller_s_capture_step(hubo):
+    """Velocity commands through a push: the controller takes a capture step, the walker stands where it left the
+    feet, and the velocity's steps walk on from there until the stop (the capture's stop is not the walk's end)."""
+    from zmpwalk.control import WalkingController
+    from zmpwalk.sim.disturbances import Disturbances
+    from zmpwalk.sim.loop import simulate_controller
+    from zmpwalk.sim.mujoco_plant import MujocoPlant
+
+    plant = MujocoPlant(hubo, RATE, disturbances=Disturbances(push_time=3.2, push_impulse=(-36.0, 0.0, 0.0)))
+    controller = WalkingController(hubo, RATE, feedforward=plant.feedforward(), capture=CaptureSettings())
+    captured_at: list[float] = []
+
+    def joystick(controller: WalkingController, tick: int) -> None:
+        if tick == 0:
+            controller.set_velocity(0.15, 0.0, 0.0)
+        if controller.captures and not captured_at:
+            captured_at.append(float(controller.sample.position_left_ankle_in_world[0]) if controller.sample else 0.0)
+        if tick == 11000:
+            controller.set_velocity(0.0, 0.0, 0.0)
+
+    run = simulate_controller(hubo, operator=joystick, duration=16.0, controller=controller, plant=plant)
+    result = run.result
+    assert not result.fell and len(result.captures) >= 1
+    assert 3.2 < result.captures[0].time < 3.4  # [s] within the push's first 0.2 s
+    assert result.ankle_positions[-1, :, 0].min() > captured_at[0] + 0.3  # [m] walked on after the capture
+    assert result.final_feet_error < 0.02 and result.end_max_speed < 0.05  # [m], [m/s] ends standing as planned

@@ -104,7 +104,9 @@ class ModelFeedforward:
         self._previous_qpos: Array | None = None
         self._qvel, self._previous_qvel = np.zeros(model.nv), np.zeros(model.nv)
         self._tau = np.zeros(model.nv)
-        self._jacobian, self._wrench = np.zeros((6, model.nv)), np.zeros(6)  # [translation; rotation], [N; N m]
+        self._feet = tuple(int(model.site_bodyid[site]) for site in self._sites)  # the ankle sites' bodies
+        self._reaction, self._force, self._point = np.zeros(model.nv), np.zeros(3), np.zeros(3)
+        self._no_torque = np.zeros(3)
         self.servo_torques = np.zeros(model.nu)
 
     def torques(self, sample: WalkingSample) -> Array:
@@ -134,13 +136,14 @@ class ModelFeedforward:
         return np.array(self.servo_torques[plant.leg_actuators], dtype=np.float64)
 
     def _subtract_reaction(self, sample: WalkingSample) -> None:
-        """Take the planned ground wrench's share of each sole off the torques (``tau -= J^T w``; scalar arithmetic:
-        numpy's cross product of two 3-vectors costs 30 us)."""
+        """Take the planned ground wrench's share of each sole off the torques: ``tau -= J_p^T f``, the share's force
+        ``f`` at its CoP ``p`` on the floor (MuJoCo's ``mj_applyFT``; scalar arithmetic: numpy's cross product of two
+        3-vectors costs 30 us)."""
         data, gravity = self._data, self._gravity
         zx, zy = float(sample.zmp_in_world[0]), float(sample.zmp_in_world[1])
-        cx, cy, cz = (float(v) for v in data.subtree_com[0])
+        cx, cy, cz = data.subtree_com[0].tolist()
         scale = self._mass * gravity / max(cz, 1e-6)  # cart-table: m c'' = m (g / z)(c - p)
-        force = (scale * (cx - zx), scale * (cy - zy), self._mass * gravity)
+        fx, fy, fz = scale * (cx - zx), scale * (cy - zy), self._mass * gravity
         (lx, ly), (rx, ry) = sample.position_left_ankle_in_world[:2].tolist(), \
             sample.position_right_ankle_in_world[:2].tolist()
         if sample.support == "left":
@@ -151,17 +154,15 @@ class ModelFeedforward:
             sx, sy = rx - lx, ry - ly
             ratio = min(max(((zx - lx) * sx + (zy - ly) * sy) / max(sx * sx + sy * sy, 1e-12), 0.0), 1.0)
         bx, by = lx + (rx - lx) * ratio, ly + (ry - ly) * ratio  # the ZMP's foot of the line between the ankles
-        wrench, jacobian = self._wrench, self._jacobian
-        for site, share, (ax, ay) in ((self._sites[0], 1.0 - ratio, (lx, ly)), (self._sites[1], ratio, (rx, ry))):
+        reaction, force, point = self._reaction, self._force, self._point
+        reaction[:] = 0.0
+        for body, share, (ax, ay) in ((self._feet[0], 1.0 - ratio, (lx, ly)), (self._feet[1], ratio, (rx, ry))):
             if share == 0.0:
                 continue
-            fx, fy, fz = share * force[0], share * force[1], share * force[2]
-            sx, sy, sz = (float(v) for v in data.site_xpos[site])
-            # this sole's CoP (keeping the total at the ZMP) relative to the ankle site
-            px, py, pz = ax + zx - bx - sx, ay + zy - by - sy, -sz
-            wrench[:] = (fx, fy, fz, py * fz - pz * fy, pz * fx - px * fz, px * fy - py * fx)
-            mujoco.mj_jacSite(self.plant.model, data, jacobian[:3], jacobian[3:], site)
-            self._tau -= jacobian.T @ wrench
+            force[:] = (share * fx, share * fy, share * fz)
+            point[:] = (ax + zx - bx, ay + zy - by, 0.0)  # this sole's CoP, keeping the total at the ZMP
+            mujoco.mj_applyFT(self.plant.model, data, force, self._no_torque, point, body, reaction)
+        self._tau -= reaction
 
 class MujocoPlant:
     """The MuJoCo model of a robot as a :class:`~zmpwalk.control.plant.Plant`: its sensors read as the robot's
