@@ -129,7 +129,7 @@ def test_a_plan_outside_the_soles_fails_the_verdict_and_simulate_says_outside(
     steps.write_text(FAST, encoding="utf-8")
     assert main(["simulate", str(steps), *PAPER]) == EXIT_FAILED
     printed = capsys.readouterr().out
-    assert "controller: the walking pattern with the stabilizer in the loop" in printed  # the default
+    assert "controller: the walking controller, as a robot's loop runs it" in printed  # the default
     assert "plan: min ZMP margin -12.7 mm (OUTSIDE the support polygon)" in printed
     assert "FAIL the plan keeps its ZMP inside the soles: -12.7 mm (limit: at least 0.0 mm)" in printed
     assert main(["simulate", str(steps), *PAPER, "--json"]) == EXIT_FAILED
