@@ -239,6 +239,12 @@ class Stabilizer:
         self.reset()
 
     @property
+    def log(self) -> Array:
+        """The last update's log, (LOG_SIZE,), overwritten by every update: :attr:`state`'s arrays are views into
+        it (:func:`balance_state` names its parts); a loop that keeps every tick's state copies this one row."""
+        return self._log
+
+    @property
     def _anchor(self) -> int:
         """The odometry's reference sole: 0 left, 1 right."""
         return int(self._state[S.anchor])

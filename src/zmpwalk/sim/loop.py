@@ -38,6 +38,7 @@ from zmpwalk.kinematics import JOINT_COLUMNS
 from zmpwalk.online import START_DELAY, OnlineWalker
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sides import SUPPORT_OF_LABEL
+from zmpwalk.stabilizer.layout import LOG_SIZE, L
 from zmpwalk.sim.disturbances import Disturbances, SensorNoise
 from zmpwalk.sim.measure import AFTER_FALL
 from zmpwalk.sim.mujoco_plant import MujocoPlant
@@ -115,26 +116,32 @@ class _Log:
         self.zmp, self.ankles, self.yaws = np.empty((size, 2)), np.empty((size, 2, 3)), np.empty((size, 2))
         self.support, self.walking = np.empty(size, dtype=np.intp), np.empty(size, dtype=bool)
         self.torques = np.empty((size, 12)) if feedforward else None
-        self.balance = {"zmp_desired": np.empty((size, 2)), "com_offset": np.empty((size, 2)),
-                        "ankle_offsets": np.empty((size, 4)), "height_difference": np.empty(size),
-                        "pelvis_turn": np.empty((size, 2))} if balance else None
+        self.stabilizer = np.empty((size, LOG_SIZE)) if balance else None  # the stabilizer's log, a row a tick
 
     def record(self, k: int, plant: MujocoPlant, controller: WalkingController, targets: JointTargets) -> None:
         sample = targets.sample
         self.readings[k] = plant.data.sensordata
         self.zmp[k] = sample.zmp_in_world
-        self.ankles[k] = (sample.position_left_ankle_in_world, sample.position_right_ankle_in_world)
-        self.yaws[k] = (sample.yaw_left_foot_in_world, sample.yaw_right_foot_in_world)
+        self.ankles[k, 0] = sample.position_left_ankle_in_world
+        self.ankles[k, 1] = sample.position_right_ankle_in_world
+        self.yaws[k, 0], self.yaws[k, 1] = sample.yaw_left_foot_in_world, sample.yaw_right_foot_in_world
         self.support[k] = SUPPORT_OF_LABEL[sample.support]
         self.walking[k] = controller.walking
         if self.torques is not None and targets.torques is not None:
             self.torques[k] = targets.torques
-        if self.balance is not None and controller.stabilizer is not None:
-            state = controller.stabilizer.state
-            for name, value in (("zmp_desired", state.zmp_desired), ("com_offset", state.com_offset),
-                                ("ankle_offsets", state.ankle_offsets.ravel()),
-                                ("height_difference", state.height_difference), ("pelvis_turn", state.pelvis_turn)):
-                self.balance[name][k] = value
+        if self.stabilizer is not None and controller.stabilizer is not None:
+            self.stabilizer[k] = controller.stabilizer.log
+
+    def balance(self, n: int) -> dict[str, Array] | None:
+        """The stabilizer's state over the first ``n`` ticks, by name (:class:`~zmpwalk.balance.BalanceState`'s)."""
+        if self.stabilizer is None:
+            return None
+        rows = self.stabilizer[:n]
+        return {"zmp_desired": rows[:, L.zmp_desired:L.zmp_desired + 2].copy(),
+                "com_offset": rows[:, L.com_offset:L.com_offset + 2].copy(),
+                "ankle_offsets": rows[:, L.ankle_offsets:L.ankle_offsets + 4].copy(),
+                "height_difference": rows[:, L.height_difference].copy(),
+                "pelvis_turn": rows[:, L.pelvis_turn:L.pelvis_turn + 2].copy()}
 
 
 def walk_start(settle: float, rate: float) -> float:
@@ -267,7 +274,7 @@ def _result(robot: RobotModel, plant: MujocoPlant, log: _Log, n: int, fall: int 
         cop=soles.cop, force_left=soles.forces[:, 0], force_right=soles.forces[:, 1],
         reference_zmp=log.zmp[:n].copy(), cop_margin=soles.margin,
         joint_angles=angles, joint_velocities=velocities, joint_torques=torques, joint_power=torques * velocities,
-        balance=None if log.balance is None else {k: v[:n].copy() for k, v in log.balance.items()},
+        balance=log.balance(n),
         ankle_positions=np.stack([sensors.take(readings, f"{s}_ankle_pos") for s in ("left", "right")], axis=1),
         planned_torques=None if log.torques is None else log.torques[:n].copy(),
         plan_zmp_margin=_plan_margin(robot, log, n),

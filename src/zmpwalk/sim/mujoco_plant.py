@@ -223,6 +223,7 @@ class MujocoPlant:
         self._penetration = 0.0 if plant.imported else contact_mapping(
             RobotModel(**{**vars(robot), "mass": robot.link_mass * mass_scale})).penetration
         self.weight = float(model.body_subtreemass[1]) * robot.gravity  # [N]
+        self._upright_least, self._least_height = math.cos(FALL_TILT), FALL_HEIGHT_FRACTION * robot.pelvis_height
         self._ticks = 0
         self._delay = round(latency * self.rate)
         if abs(self._delay - latency * self.rate) > 1e-6:
@@ -295,11 +296,10 @@ class MujocoPlant:
     def fallen(self) -> bool:
         """The fall criterion of :mod:`zmpwalk.sim.run` now (the torso touching the floor, tilted over
         :data:`~zmpwalk.sim.run.FALL_TILT` or sunk below :data:`~zmpwalk.sim.run.FALL_HEIGHT_FRACTION` of the pelvis
-        height), or a state that is no longer finite."""
+        height), or a state that is no longer finite (scalar reads: this runs every tick)."""
         row = self.data.sensordata
-        _, x, y, _ = row[self._quaternion]
+        x, y = float(row[self._quaternion.start + 1]), float(row[self._quaternion.start + 2])
         upright = 1.0 - 2.0 * (x * x + y * y)  # cos(tilt): the torso's z axis against the vertical
-        touched = self._touch is not None and row[self._touch][0] > 0
-        return bool(touched or upright < math.cos(FALL_TILT) or not np.isfinite(self.data.qpos).all()
-                    or row[self._pelvis][2] < FALL_HEIGHT_FRACTION * self.robot.pelvis_height)
-
+        touched = self._touch is not None and row[self._touch.start] > 0
+        return bool(touched or upright < self._upright_least or row[self._pelvis.start + 2] < self._least_height
+                    or not math.isfinite(float(self.data.qpos.sum())))
