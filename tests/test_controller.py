@@ -14,8 +14,8 @@ from zmpwalk.balance import BalanceMeasurement, Stabilizer
 from zmpwalk.control import MockPlant, WalkingController, sole_wrenches, velocity_command, velocity_step_time
 from zmpwalk.online import START_DELAY
 from zmpwalk.sim import simulate
-from zmpwalk.sim.loop import simulate_controller
 from zmpwalk.sim.disturbances import SensorNoise
+from zmpwalk.sim.loop import simulate_controller
 from zmpwalk.sim.mujoco_plant import MujocoPlant
 from zmpwalk.sim.verdict import HOLD, walk_verdict
 
@@ -301,7 +301,7 @@ def test_the_plant_measures_its_sensors_late_and_noisy_as_asked(hubo):
     readings = []
     for k in range(40):
         if k == 5:
-            for plant, controller in (plain, late):
+            for _, controller in (plain, late):
                 controller.command(StepCommand(0.8, 0.1))
         now, delayed = plain[0].measure(), late[0].measure()
         readings.append(now)

@@ -184,9 +184,10 @@ class OnlineWalker:
             pattern leaves the legs' reach or joint ranges is rejected).
         pelvis: ``"cubic"`` (the paper's curves) or ``"quintic"`` (jerk-continuous: the cart-table ZMP
             is continuous at every stage boundary).
-        generator: ``"polynomial"`` (the HUBO pattern, default) or ``"hyperbolic"`` (the linear inverted
+        generator: ``"polynomial"`` (the HUBO pattern) or ``"hyperbolic"`` (the linear inverted
             pendulum pattern of Lim et al., stage by stage: :mod:`zmpwalk.patterns.lipm_stage`; same
-            footsteps, swings and continuity; a command whose ZMP would leave the feet is rejected).
+            footsteps, swings and continuity; a command whose ZMP would leave the feet is rejected); None: the
+            robot's :attr:`~zmpwalk.robots.model.RobotModel.default_generator`, as the command line's.
         budget: The time [s] a tick may spend on a command's check, one part over at most (default
             :func:`work_budget`: 50 us, or 1 % of the control period where that is longer, at most 500 us).
             Smaller: shorter ticks, and checks that take more ticks, so that more commands come too late for the
@@ -199,14 +200,12 @@ class OnlineWalker:
     """
 
     def __init__(self, robot: RobotModel, rate: float = 100.0, schedule: Schedule | None = None,
-                 joints: bool = False, pelvis: str = "cubic", generator: str = "polynomial",
+                 joints: bool = False, pelvis: str = "cubic", generator: str | None = None,
                  budget: float | None = None) -> None:
         check_rate(rate)
         self._budget = work_budget(rate) if budget is None else _checked_budget(budget, rate)
-        self._pelvis = online_pelvis(pelvis, generator)
-        self.robot = robot
-        self.rate = float(rate)
-        self.joints = bool(joints)
+        self._pelvis = online_pelvis(pelvis, robot.default_generator if generator is None else generator)
+        self.robot, self.rate, self.joints = robot, float(rate), bool(joints)
         self._width = ROW_WIDTH_WITH_JOINTS if self.joints else ROW_WIDTH
         self._schedule = schedule or Schedule.hubo()
         self._index = 0

@@ -59,7 +59,7 @@ class SweepResult:
     error: str = ""
 
 
-def walk_scenario(robot: str, scenario: str, balance: bool = True, generator: str = "polynomial",
+def walk_scenario(robot: str, scenario: str, balance: bool = True, generator: str | None = None,
                   schedule: str | None = None, pelvis: str = "cubic") -> SweepResult:
     """Simulate one built-in scenario on a robot (name, robot file or model path) and judge it.
 
@@ -67,7 +67,7 @@ def walk_scenario(robot: str, scenario: str, balance: bool = True, generator: st
         robot: What ``--robot`` takes.
         scenario: A built-in scenario name.
         balance: Close the loop with the stabilizer (the default, for every robot); False: open loop.
-        generator: The pattern generator's name (:data:`zmpwalk.patterns.GENERATORS`).
+        generator: The pattern generator's name (:data:`zmpwalk.patterns.GENERATORS`); None: the robot's own.
         schedule: A schedule file (e.g. from ``zmpwalk tune``) instead of Tables 2-3.
         pelvis: ``"cubic"`` or ``"quintic"`` (the polynomial generator's pelvis curves).
     """
@@ -154,7 +154,7 @@ def _on_dask(function: Callable[..., T], arguments: dict[int, tuple[Any, ...]], 
 
 
 def sweep(robot: str, scenarios: Sequence[str], balance: bool = True, workers: int | None = None,
-          progress: Callable[[int, int], None] | None = None, generator: str = "polynomial",
+          progress: Callable[[int, int], None] | None = None, generator: str | None = None,
           schedule: str | None = None, pelvis: str = "cubic", scheduler: str | None = None) -> list[SweepResult]:
     """Simulate every scenario on ``robot``, ``workers`` walks at a time (default: one per core), or on a
     Dask cluster (``scheduler``, see the module docstring).

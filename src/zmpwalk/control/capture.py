@@ -156,9 +156,9 @@ class CapturePolicy:
         touchdown = None if under_way is None else under_way.plan.time + under_way.plan.swing_time
         start = sample.time + dt
         pattern, plan = capture_step(
-            self.robot, time=start, rate=self.rate, end=start + REST, stance=stance, position_com_in_world=position_next,
-            dcm_in_world=dcm, yaw_pelvis_in_world=sample.yaw_pelvis_in_world, ankles_in_world=(ankles[0], ankles[1]),
-            ankle_velocities_in_world=(rates[0], rates[1]),
+            self.robot, time=start, rate=self.rate, end=start + REST, stance=stance,
+            position_com_in_world=position_next, dcm_in_world=dcm, yaw_pelvis_in_world=sample.yaw_pelvis_in_world,
+            ankles_in_world=(ankles[0], ankles[1]), ankle_velocities_in_world=(rates[0], rates[1]),
             foot_yaws=(sample.yaw_left_foot_in_world, sample.yaw_right_foot_in_world), settings=self.settings,
             touchdown=touchdown)
         stabilizer.hand_over_landing(swing)  # the capture's swing starts where the correction aimed it

@@ -32,10 +32,10 @@ from numpy.typing import NDArray
 
 from zmpwalk import online
 from zmpwalk.balance import BalanceMeasurement, Stabilizer
-from zmpwalk.commands import StepCommand
-from zmpwalk.control.plant import JointTargets
 from zmpwalk.capture import CapturePlan, CaptureSettings
+from zmpwalk.commands import StepCommand
 from zmpwalk.control.capture import CaptureMotion, CapturePolicy
+from zmpwalk.control.plant import JointTargets
 from zmpwalk.errors import InfeasiblePatternError, InvalidParameterError, UnreachableError, ZmpwalkError
 from zmpwalk.online import OnlineWalker, WalkingSample
 from zmpwalk.robots.model import RobotModel
@@ -132,7 +132,7 @@ class WalkingController:
         robot: The robot.
         rate: Control rate [Hz] (the walker's and the stabilizer's).
         schedule: The walker's parameter tables (default: HUBO's, :meth:`Schedule.hubo`).
-        generator: ``"polynomial"`` or ``"hyperbolic"`` (:class:`~zmpwalk.online.OnlineWalker`).
+        generator: ``"polynomial"`` or ``"hyperbolic"``; None: the robot's own (:class:`~zmpwalk.online.OnlineWalker`).
         pelvis: ``"cubic"`` or ``"quintic"`` (polynomial generator).
         balance: Run the stabilizer (False: the pattern's angles, open loop).
         gains: The stabilizer's gains (default: the robot file's, :class:`~zmpwalk.balance.Stabilizer`).
@@ -156,7 +156,7 @@ class WalkingController:
     """
 
     def __init__(self, robot: RobotModel, rate: float = 1000.0, *, schedule: Schedule | None = None,
-                 generator: str = "polynomial", pelvis: str = "cubic", balance: bool = True,
+                 generator: str | None = None, pelvis: str = "cubic", balance: bool = True,
                  gains: StabilizerGains | None = None, feedforward: Feedforward | None = None,
                  capture: CaptureSettings | None = None) -> None:
         if capture is not None and not balance:

@@ -74,7 +74,7 @@ def build_report(
     folder: Path,
     *,
     title: str,
-    generator: str = "polynomial",
+    generator: str | None = None,
     animate: bool = True,
     gif: bool = False,
     progress: Progress | None = None,
@@ -85,9 +85,10 @@ def build_report(
     motors: list[Motor] | None = None,
     pelvis: str = "cubic",
 ) -> Report:
-    """Generate, check, simulate and report a walk into ``folder`` (``pelvis``: the polynomial
-    generator's pelvis curves, ``"cubic"`` or ``"quintic"``). ``animate``: the interactive replay (three.js);
-    ``gif``: also the offscreen-rendered GIF (``walk.gif``, shown where WebGL is missing).
+    """Generate, check, simulate and report a walk into ``folder`` (``generator``: None for the robot's own;
+    ``pelvis``: the polynomial generator's pelvis curves, ``"cubic"`` or ``"quintic"``). ``animate``: the
+    interactive replay (three.js); ``gif``: also the offscreen-rendered GIF (``walk.gif``, shown where WebGL is
+    missing).
 
     Raises:
         ZmpwalkError: The walk cannot be generated (the message says why).
@@ -122,7 +123,7 @@ def build_report(
     replay = _replay(robot, pattern, result, animation, animation_note) if animate else ""
     done("animation")
     fits = walk.fits
-    report.summary = _summary(pattern, result, report.verdict, fits, generator, walk.controller)
+    report.summary = _summary(pattern, result, report.verdict, fits, spec.generator_name, walk.controller)
     movie = replay or _movie(animation, animation_note)
     page = _page(title, robot, report.summary, _figure_html(images, time_axes if replay else {}), movie,
                  step_margins(pattern), rows, report.verdict, fits, _step_list(commands, labels))

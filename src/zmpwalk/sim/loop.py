@@ -38,7 +38,6 @@ from zmpwalk.kinematics import JOINT_COLUMNS
 from zmpwalk.online import START_DELAY, OnlineWalker
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sides import SUPPORT_OF_LABEL
-from zmpwalk.stabilizer.layout import LOG_SIZE, L
 from zmpwalk.sim.disturbances import Disturbances, SensorNoise
 from zmpwalk.sim.measure import AFTER_FALL
 from zmpwalk.sim.mujoco_plant import MujocoPlant
@@ -46,6 +45,7 @@ from zmpwalk.sim.ranges import check_range
 from zmpwalk.sim.result import SimulationResult
 from zmpwalk.sim.soles import SoleMeasurements, foot_slip, rpy_from_quaternion, sole_measurements
 from zmpwalk.sim.verdict import HOLD
+from zmpwalk.stabilizer.layout import LOG_SIZE, L
 from zmpwalk.zmp import batch_hull_margin, edge_margin
 
 Array = NDArray[np.float64]
@@ -156,7 +156,8 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
                         operator: Callable[[WalkingController, int], None] | None = None, balance: bool = True,
                         feedforward: bool = True, mass_scale: float = 1.0, disturbances: Disturbances | None = None,
                         latency: float = 0.0, noise: SensorNoise | None = None, settle: float | None = None,
-                        capture: CaptureSettings | None = None, progress: Callable[[float], None] | None = None) -> ControllerRun:
+                        capture: CaptureSettings | None = None,
+                        progress: Callable[[float], None] | None = None) -> ControllerRun:
     """Walk ``commands`` through a walking controller on the MuJoCo plant, tick by tick (module docstring).
 
     Args:

@@ -24,10 +24,10 @@ from zmpwalk.errors import InvalidParameterError
 from zmpwalk.online import WalkingSample
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.robots.pd import is_position_servo
+from zmpwalk.sim.disturbances import NOSLIP_ITERATIONS, SensorNoise
 from zmpwalk.sim.mjcf import contact_mapping
 from zmpwalk.sim.plant import Plant as SimPlant
 from zmpwalk.sim.plant import build_plant, set_initial_state, static_feedforward
-from zmpwalk.sim.disturbances import NOSLIP_ITERATIONS, SensorNoise
 from zmpwalk.sim.ranges import check_range
 from zmpwalk.sim.run import FALL_HEIGHT_FRACTION, FALL_TILT, Disturbances, _MeasurementReader
 from zmpwalk.sim.soles import SensorSlices

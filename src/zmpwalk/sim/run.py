@@ -39,12 +39,12 @@ from mujoco import rollout
 from numpy.typing import NDArray
 
 from zmpwalk.balance import Stabilizer
-from zmpwalk.capture import CaptureSettings
+from zmpwalk.capture import CAPTURE_INTERVAL, CaptureSettings
 from zmpwalk.errors import InvalidParameterError
 from zmpwalk.kinematics import JointTrajectory, check_sole_roll
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
-from zmpwalk.sim.closed_loop import CAPTURE_INTERVAL, closed_loop
+from zmpwalk.sim.closed_loop import closed_loop
 from zmpwalk.sim.disturbances import NOSLIP_ITERATIONS, Disturbances, SensorNoise
 from zmpwalk.sim.disturbances import _MeasurementReader as _MeasurementReader
 from zmpwalk.sim.measure import AFTER_FALL, FALL_HEIGHT_FRACTION, FALL_TILT, measure_walk
@@ -96,7 +96,7 @@ def simulate(robot: RobotModel, joints: JointTrajectory, pattern: WalkingPattern
             rest of the walk is replaced by a capture step planned from its estimate
             (:func:`zmpwalk.capture.capture_step`; the joint references and the feedforward re-made for it),
             re-planned while its swing lasts whenever the error passes the trigger again (a push still acting),
-            at most every :data:`~zmpwalk.sim.closed_loop.CAPTURE_INTERVAL`; the result's ``captures`` lists them,
+            at most every :data:`~zmpwalk.capture.CAPTURE_INTERVAL`; the result's ``captures`` lists them,
             and the walk's end (final feet, the reference ZMP) is the last one's. None (default): the pattern is
             played to its end.
 

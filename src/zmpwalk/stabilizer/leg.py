@@ -21,6 +21,7 @@ Arrays (all float64):
 from __future__ import annotations
 
 import math
+from typing import cast
 
 import numpy as np
 from numba import njit
@@ -30,7 +31,7 @@ from zmpwalk.stabilizer.layout import P
 
 # The two legs' indices as numpy integers: numba types a Python int constant argument as a literal and compiles
 # the callee once per value; an int64 once for both (one compile less per leg function on the first run).
-FIRST, SECOND = np.int64(0), np.int64(1)
+FIRST, SECOND = cast(int, np.int64(0)), cast(int, np.int64(1))  # typed int64 by numba, int by mypy
 
 
 @njit(cache=True, nogil=True)
