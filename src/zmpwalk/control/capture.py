@@ -62,13 +62,14 @@ class CaptureMotion:
     first: int
     rate: float  # [Hz]
 
-    def sample(self, tick: int, standing: WalkingSample) -> WalkingSample:
+    def sample(self, tick: int, standing: WalkingSample | None) -> WalkingSample:
         """The sample of controller tick ``tick``: the pattern's; after its end, a linear blend over
         :data:`BLEND` from its last sample to the walker's ``standing`` one (its pose at rest over the same feet:
-        the capture's rest point is the soles' midpoint, the walker's the ankles', 3 mm apart on HUBO)."""
+        the capture's rest point is the soles' midpoint, the walker's the ankles', 3 mm apart on HUBO), or its
+        last sample held where there is none (the walker cannot stand there)."""
         i = tick - self.first
-        if i < len(self.pattern.time):
-            return self._row(max(i, 0))
+        if i < len(self.pattern.time) or standing is None:
+            return self._row(min(max(i, 0), len(self.pattern.time) - 1))
         share = min((i - len(self.pattern.time) + 1) / (BLEND * self.rate), 1.0)
         last = self._row(len(self.pattern.time) - 1)
         return WalkingSample(
@@ -83,6 +84,10 @@ class CaptureMotion:
             joint_angles=_mix(last.joint_angles, standing.joint_angles, share),
             joint_velocities=(standing.joint_angles - last.joint_angles) / BLEND if share < 1.0  # type: ignore[operator]
             else np.zeros(12))
+
+    def ended(self, tick: int) -> bool:
+        """Whether the pattern has ended by controller tick ``tick`` (the robot at rest on both feet)."""
+        return tick - self.first >= len(self.pattern.time) - 1
 
     def done(self, tick: int) -> bool:
         """Whether the pattern and the blend after it have ended by controller tick ``tick``."""

@@ -177,12 +177,21 @@ class WalkingController:
         self._capture = None if capture is None else CapturePolicy(robot, self.rate, capture)
         self._motion: CaptureMotion | None = None
         self._deferred: StepCommand | None = None  # a command given during a capture
+        self._stranded = False  # the last capture left the feet where the walker cannot stand
         self._ticks = 0
 
     @property
     def walking(self) -> bool:
         """True while a walk or a capture step is under way or a walk is queued."""
-        return self._motion is not None or self.walker.walking
+        if self._motion is not None and not self._motion.ended(self._ticks):
+            return True
+        return self.walker.walking
+
+    @property
+    def stranded(self) -> bool:
+        """True when the last capture step left the feet where the walker's standing pose cannot reach (a wide
+        sideways capture): the controller holds the capture's rest pose and gives no command to the walker."""
+        return self._stranded
 
     @property
     def captures(self) -> list[CapturePlan]:
@@ -306,7 +315,7 @@ class WalkingController:
         walker, tick, previous = self.walker, self._ticks, self._sample
         sample = walker.tick(work=False)  # ticked during a capture too: its clock runs on, standing
         if self._motion is not None:
-            sample = self._motion.sample(tick, sample)
+            sample = self._motion.sample(tick, None if self._stranded else sample)
         self._sample = sample
         self._ticks = tick + 1
         angles = sample.joint_angles
@@ -316,7 +325,7 @@ class WalkingController:
         corrected = self._corrected(sample, angles, measurement)
         if corrected is not None and previous is not None:
             self._capture_step(tick, sample, previous)
-        if self._motion is not None and self._motion.done(tick):
+        if self._motion is not None and not self._stranded and self._motion.done(tick):
             self._motion = None
             if self._deferred is not None:
                 walker.command(self._deferred)
@@ -337,7 +346,11 @@ class WalkingController:
             self._motion = policy.plan(tick, sample, previous, stabilizer, self._motion)
         except (UnreachableError, InfeasiblePatternError):
             return  # no capture step fits: the walk goes on as planned
-        self.walker.stand_at(self._motion.stance())
+        try:
+            self.walker.stand_at(self._motion.stance())
+            self._stranded = False
+        except (UnreachableError, InfeasiblePatternError):
+            self._stranded = True  # the walker cannot stand over these feet: the capture's rest pose is held
 
     def _corrected(self, sample: WalkingSample, angles: Array, measurement: BalanceMeasurement) -> Array | None:
         """The stabilizer's targets (a copy), or None without a stabilizer or on a fault."""
