@@ -288,3 +288,26 @@ def test_a_joystick_walk_walks_on_after_the_controller_s_capture_step(hubo):
     assert 3.2 < result.captures[0].time < 3.4  # [s] within the push's first 0.2 s
     assert result.ankle_positions[-1, :, 0].min() > captured_at[0] + 0.3  # [m] walked on after the capture
     assert result.final_feet_error < 0.02 and result.end_max_speed < 0.05  # [m], [m/s] ends standing as planned
+
+
+@pytest.mark.slow
+def test_a_capture_the_walker_cannot_stand_after_holds_its_rest_pose(hubo, walk, monkeypatch):
+    """Where the walker's standing pose cannot reach the capture's feet (a wide sideways capture; here made so),
+    no tick raises: the controller holds the capture's rest pose (``stranded``) and the robot ends standing."""
+    from zmpwalk.errors import UnreachableError
+    from zmpwalk.online import START_DELAY, OnlineWalker
+    from zmpwalk.sim.disturbances import Disturbances
+    from zmpwalk.sim.loop import simulate_controller
+
+    def unreachable(self, stance):
+        raise UnreachableError("left", math.nan, 0.0067)
+
+    monkeypatch.setattr(OnlineWalker, "stand_at", unreachable)
+    pattern, index = walk
+    commands = load_scenario("fig10")[:1] + [StepCommand(duration=0.95, forward=0.2)] * 8
+    push = Disturbances(push_time=float(pattern.time[index]) + START_DELAY, push_impulse=(-36.0, 0.0, 0.0))
+    run = simulate_controller(hubo, commands, disturbances=push, capture=CaptureSettings())
+    assert run.controller.stranded and run.result.captures and not run.result.fell
+    assert run.result.final_feet_error < 0.02 and run.result.end_max_speed < 0.05  # [m], [m/s]
+    held = run.controller.sample  # the capture's last sample: its pelvis point 0.2 mm from where the DCM rests
+    np.testing.assert_allclose(held.position_pelvis_in_world[:2], run.controller.captures[-1].rest, atol=1e-3, rtol=0)

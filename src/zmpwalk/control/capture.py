@@ -10,7 +10,7 @@ dcm_error``, the swinging ankle aimed where the stabilizer's landing correction 
 on; a later trigger in the capture's own single support re-plans from it, landing no later than the capture under
 way needs. When the capture has come to rest the walker stands where it left the feet
 (:meth:`~zmpwalk.online.OnlineWalker.stand_at`, from the plan on; the capture's rest pose blends into the walker's
-standing one over :data:`BLEND`), and commands given meanwhile are given to the walker once it has (they walk on
+standing one over :data:`BLEND`: the capture's pattern has not quite come to rest), and commands given meanwhile are given to the walker once it has (they walk on
 from there).
 
 As the batch walk's (:class:`zmpwalk.sim.replan.CaptureReplanner`), the plan is made inside the tick that
@@ -65,8 +65,9 @@ class CaptureMotion:
     def sample(self, tick: int, standing: WalkingSample | None) -> WalkingSample:
         """The sample of controller tick ``tick``: the pattern's; after its end, a linear blend over
         :data:`BLEND` from its last sample to the walker's ``standing`` one (its pose at rest over the same feet:
-        the capture's rest point is the soles' midpoint, the walker's the ankles', 3 mm apart on HUBO), or its
-        last sample held where there is none (the walker cannot stand there)."""
+        the capture's pelvis point, :data:`REST` after the plan, is still 0.2 mm from its rest on HUBO, and the
+        legs' angles differ by as much), or its last sample held where there is none (the walker cannot stand
+        there)."""
         i = tick - self.first
         if i < len(self.pattern.time) or standing is None:
             return self._row(min(max(i, 0), len(self.pattern.time) - 1))
