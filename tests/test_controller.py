@@ -339,3 +339,25 @@ def test_the_controller_with_late_sensors_walks_as_the_batch_simulation(hubo):
         assert verdict.passed, verdict.lines()
     assert run.result.cop_error_stats()[0] == pytest.approx(batch.cop_error_stats()[0], abs=0.002)  # [m]
     assert run.result.cop_error_stats()[0] > 0.025  # [m] the latency does cost: 16 mm without it
+
+
+def test_the_walk_s_clock_and_settle(hubo):
+    """With ``settle`` the first command waits ``settle - START_DELAY``; the result's time and the plant's clock (a
+    push's) are 0 where the walk begins, on whole ticks, as the batch walk's; a capture needs its settings."""
+    from zmpwalk.sim.loop import walk_start
+
+    assert walk_start(0.5, RATE) == pytest.approx(START_DELAY) and walk_start(1.0, RATE) == pytest.approx(1.0)
+    plant = MujocoPlant(hubo, RATE, time_origin=1.0)
+    plant.stand(WalkingController(hubo, RATE, balance=False).walker.tick())
+    assert plant.time == -1.0
+    for _ in range(1000):
+        plant.step()
+    assert plant.time == 0.0
+    run = simulate_controller(hubo, WALK[:2] + WALK[-1:], settle=1.0)
+    assert run.result.time[0] == -1.0 and run.given[0] == pytest.approx(-START_DELAY)  # [s] given 0.6 s before
+    moved = np.flatnonzero(np.abs(run.result.reference_zmp[:, 1] - run.result.reference_zmp[0, 1]) > 1e-6)
+    assert run.result.time[moved[0]] == pytest.approx(0.0, abs=0.002)  # [s] the ZMP leaves the middle at 0
+    with pytest.raises(InvalidParameterError, match="capture"):
+        WalkingController(hubo, RATE, capture=True)  # type: ignore[arg-type]
+    with pytest.raises(InvalidParameterError, match="noise"):
+        MujocoPlant(hubo, RATE, noise=0.1)  # type: ignore[arg-type]

@@ -422,13 +422,14 @@ class OnlineWalker:
         self._release(dropped)
 
     def stand_at(self, stance: Stance) -> None:
-        """Stand still with the feet at ``stance`` from the next tick (where a capture step that the walking
-        controller played left them); every command given, being checked or queued is dropped."""
+        """Stand still with the feet at ``stance`` from the next tick (the walking controller's capture step left
+        them there), dropping every command; raises as the standing pose's legs do, the walker then unchanged."""
+        row = self._check.standing_row(stance)
         self._drop_job()
-        self._release(self._current, self._pending)
-        self._current = self._pending = self._rejection = None
+        dropped, self._current, self._pending, self._rejection = (self._current, self._pending), None, None, None
+        self._release(*dropped)
         self._stance, self._boundary = stance, Boundary(self.time)
-        self._set_standing(self._check.standing_row(stance))
+        self._set_standing(row)
 
     def tick(self, *, work: bool = True) -> WalkingSample:
         """The sample at :attr:`time`, then advance by one control period; ``work=False``: without the parts of a

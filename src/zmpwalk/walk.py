@@ -13,7 +13,6 @@ Importing this module loads neither MuJoCo nor numba; :func:`run_walk` does.
 
 from __future__ import annotations
 
-import dataclasses
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -329,12 +328,9 @@ def _controller_walk(spec: WalkSpec, progress: Callable[[float], None] | None) -
     from zmpwalk.sim.mujoco_plant import MujocoPlant
     from zmpwalk.sim.references import CONTROL_RATE
 
-    disturbances = spec.disturbances  # a push at the walk's time, on the plant's clock from the stand
-    if disturbances is not None and disturbances.push_time is not None:
-        disturbances = dataclasses.replace(disturbances,
-                                           push_time=disturbances.push_time + walk_start(spec.settle, CONTROL_RATE))
-    plant = MujocoPlant(spec.robot, CONTROL_RATE, mass_scale=spec.mass_scale, disturbances=disturbances,
-                        latency=spec.latency, noise=spec.noise)
+    plant = MujocoPlant(spec.robot, CONTROL_RATE, mass_scale=spec.mass_scale, disturbances=spec.disturbances,
+                        latency=spec.latency, noise=spec.noise,
+                        time_origin=walk_start(spec.settle, CONTROL_RATE))  # a push at the walk's time
     controller = WalkingController(spec.robot, CONTROL_RATE, schedule=spec.schedule or Schedule.hubo(),
                                    generator=spec.generator_name, pelvis=spec.pelvis, feedforward=plant.feedforward(),
                                    capture=spec.capture)
@@ -342,7 +338,7 @@ def _controller_walk(spec: WalkSpec, progress: Callable[[float], None] | None) -
                               settle=spec.settle, progress=progress)
     if run.rejections:
         index, _, error = run.rejections[0]
-        label = spec.labels[index] if spec.labels is not None else f"command {index + 1}"
+        label = spec.labels[index] if spec.labels is not None and index < len(spec.labels) else f"step {index + 1}"
         error = error.in_context(f"{spec.source}: {label}" if spec.source else label)
         raise error
     return run.result

@@ -8,10 +8,11 @@ measured DCM can come to rest) from the tick's planned state and the measured DC
 dcm_error``, the swinging ankle aimed where the stabilizer's landing correction put it. The
 :class:`CaptureMotion` (that pattern and its joint angles) then replaces the walker's samples from the next tick
 on; a later trigger in the capture's own single support re-plans from it, landing no later than the capture under
-way needs. When the capture has come to rest the walker stands where it left the feet
-(:meth:`~zmpwalk.online.OnlineWalker.stand_at`, from the plan on; the capture's rest pose blends into the walker's
-standing one over :data:`BLEND`: the capture's pattern has not quite come to rest), and commands given meanwhile are given to the walker once it has (they walk on
-from there).
+way needs. The walker stands where the capture leaves the feet from the plan on
+(:meth:`~zmpwalk.online.OnlineWalker.stand_at`); the capture's last pose blends into the walker's standing one
+over :data:`BLEND` (the capture's pattern has not quite come to rest); a step given before the push or during the
+capture is given to the walker after it and walks on from there. Where the walker's standing pose cannot reach
+those feet, the controller holds the capture's last pose (:attr:`WalkingController.stranded`).
 
 As the batch walk's (:class:`zmpwalk.sim.replan.CaptureReplanner`), the plan is made inside the tick that
 triggers it (25-35 ms of CPU on a 2-core machine): a capture is not yet bounded work.
@@ -167,6 +168,7 @@ class CapturePolicy:
             ankles_in_world=(ankles[0], ankles[1]), ankle_velocities_in_world=(rates[0], rates[1]),
             foot_yaws=(sample.yaw_left_foot_in_world, sample.yaw_right_foot_in_world), settings=self.settings,
             touchdown=touchdown)
+        joints = pattern_joint_trajectory(pattern, check_limits=False)  # may raise: before any side effect
         stabilizer.hand_over_landing(swing)  # the capture's swing starts where the correction aimed it
         self.captures.append(plan)
-        return CaptureMotion(plan, pattern, pattern_joint_trajectory(pattern, check_limits=False), tick + 1, self.rate)
+        return CaptureMotion(plan, pattern, joints, tick + 1, self.rate)

@@ -36,7 +36,7 @@ from zmpwalk.capture import CapturePlan, CaptureSettings
 from zmpwalk.commands import StepCommand
 from zmpwalk.control.capture import CaptureMotion, CapturePolicy
 from zmpwalk.control.plant import JointTargets
-from zmpwalk.errors import InfeasiblePatternError, InvalidParameterError, UnreachableError, ZmpwalkError
+from zmpwalk.errors import InvalidParameterError, ZmpwalkError
 from zmpwalk.online import OnlineWalker, WalkingSample
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
@@ -159,6 +159,8 @@ class WalkingController:
                  generator: str | None = None, pelvis: str = "cubic", balance: bool = True,
                  gains: StabilizerGains | None = None, feedforward: Feedforward | None = None,
                  capture: CaptureSettings | None = None) -> None:
+        if capture is not None and not isinstance(capture, CaptureSettings):
+            raise InvalidParameterError("capture", capture, "a CaptureSettings, or None")
         if capture is not None and not balance:
             raise InvalidParameterError("capture", capture, "None without the stabilizer (balance=False): its DCM "
                                         "estimate triggers the capture step")
@@ -182,10 +184,10 @@ class WalkingController:
 
     @property
     def walking(self) -> bool:
-        """True while a walk or a capture step is under way or a walk is queued."""
+        """True while a walk or a capture step is under way or a walk is queued (or waits for a capture's end)."""
         if self._motion is not None and not self._motion.ended(self._ticks):
             return True
-        return self.walker.walking
+        return self.walker.walking or self._deferred is not None
 
     @property
     def stranded(self) -> bool:
@@ -236,11 +238,15 @@ class WalkingController:
         walker when the capture is over). Leaves velocity mode.
 
         Raises:
-            InvalidParameterError: ``step`` is not a :class:`~zmpwalk.commands.StepCommand`.
+            InvalidParameterError: ``step`` is not a :class:`~zmpwalk.commands.StepCommand`, or the last capture
+                step left the feet where the walker cannot stand (:attr:`stranded`).
         """
         if self._motion is not None:
             if not isinstance(step, StepCommand):
-                raise InvalidParameterError("step", type(step).__name__, "a StepCommand")
+                raise InvalidParameterError("command", type(step).__name__, "a StepCommand")
+            if self._stranded:
+                raise InvalidParameterError("command", step, "none: the last capture step left the feet where the "
+                                            "walker's standing pose cannot reach (controller.stranded)")
             self._deferred = step  # given to the walker once the capture is over
         else:
             self.walker.command(step)
@@ -343,14 +349,20 @@ class WalkingController:
         if policy is None or stabilizer is None or not policy.due(tick, sample, stabilizer):
             return
         try:
-            self._motion = policy.plan(tick, sample, previous, stabilizer, self._motion)
-        except (UnreachableError, InfeasiblePatternError):
+            motion = policy.plan(tick, sample, previous, stabilizer, self._motion)
+        except ZmpwalkError:
             return  # no capture step fits: the walk goes on as planned
+        walker = self.walker
+        waiting = walker.checking or walker.queued  # a step given before the push: walked after the capture
+        if self._deferred is None and waiting is not None and not waiting.stop:
+            self._deferred = waiting
+        self._motion = motion
         try:
-            self.walker.stand_at(self._motion.stance())
+            walker.stand_at(motion.stance())
             self._stranded = False
-        except (UnreachableError, InfeasiblePatternError):
-            self._stranded = True  # the walker cannot stand over these feet: the capture's rest pose is held
+        except ZmpwalkError:  # the walker's standing pose cannot reach these feet: the capture's last pose is held
+            self._stranded = True
+            self._deferred = None
 
     def _corrected(self, sample: WalkingSample, angles: Array, measurement: BalanceMeasurement) -> Array | None:
         """The stabilizer's targets (a copy), or None without a stabilizer or on a fault."""

@@ -57,7 +57,7 @@ class ControllerRun:
 
     Attributes:
         result: The measurements (:func:`zmpwalk.sim.verdict.walk_verdict` judges them).
-        given: When each command was given [s], in order.
+        given: When each command was given [s], in order, on the result's clock.
         rejections: The commands refused: their index in the list, the command and the rejection.
         faults: Ticks the stabilizer could not correct (:attr:`WalkingController.faults`).
         controller: The controller, as the run left it.
@@ -90,7 +90,9 @@ class _Operator:
     def __call__(self, controller: WalkingController, tick: int) -> None:
         walker = controller.walker
         if controller.captures:  # a capture step ends the walk, as the batch walk's does
-            self.pending, self.waiting = [], None
+            if self.pending or self.waiting is not None:
+                controller.stop()  # drops a step given before the push, which would walk after the capture
+                self.pending, self.waiting = [], None
             return
         if self.waiting is not None:
             if walker.checking is not None or walker.queued is not None:
@@ -178,8 +180,8 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
             :data:`~zmpwalk.online.START_DELAY` after the robot is stood (at once where that is negative: a walk
             begins START_DELAY after its first command), and the result's time is 0 where the walk begins (the
             walking pattern's time; the standing before it at negative times). None: the first command at once,
-            the result's time from the stand. A push's time (``disturbances``) is on the plant's clock, from the
-            stand (:func:`walk_start` shifts it).
+            the result's time from the stand. A push's time (``disturbances``) is on the result's clock (the
+            plant made here counts from the walk's start, ``time_origin``).
         operator: Called every tick before the update with the controller and the tick's index: anything an
             operator does (commands, velocities, stops); needs a ``duration``.
         progress: Called with the fraction done now and then (of the run's longest length).
@@ -201,18 +203,19 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
     check_range("hold", hold)
     if settle is not None:
         check_range("settle", settle)
+    start = 0.0 if settle is None else walk_start(settle, rate)  # [s] the walk begins
     plant = plant or MujocoPlant(robot, rate, mass_scale=mass_scale, disturbances=disturbances, latency=latency,
-                                 noise=noise)
+                                 noise=noise, time_origin=start)
     controller = controller or WalkingController(robot, plant.rate, balance=balance, capture=capture,
                                                  feedforward=plant.feedforward() if feedforward else None)
     if controller.rate != plant.rate:
         raise InvalidParameterError("controller.rate", controller.rate, f"the plant's rate, {plant.rate:g} Hz")
     plant.stand(OnlineWalker(robot, plant.rate, controller.schedule, joints=True).tick())
-    longest = START_DELAY + sum(3.0 * c.duration for c in commands) + 3.0 * max((c.duration for c in commands),
+    begins = start if settle is not None else START_DELAY  # [s] after the stand
+    longest = begins + sum(3.0 * c.duration for c in commands) + 3.0 * max((c.duration for c in commands),
                                                                                default=0.0) + hold + 5.0
     size = round((duration if duration is not None else longest) * plant.rate)
     log = _Log(size, plant.model.nsensordata, controller.feedforward is not None, controller.stabilizer is not None)
-    start = 0.0 if settle is None else walk_start(settle, plant.rate)  # [s] the walk begins
     first = 0 if settle is None else round((start - START_DELAY) * plant.rate)
     giver = _Operator(commands, command_phase, plant.rate, first)
     end, fall = size, None
@@ -234,7 +237,7 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
             break
     result = _result(robot, plant, log, k + 1, fall, size / plant.rate, hold, start)
     result.captures = [dataclasses.replace(plan, time=plan.time - start) for plan in controller.captures]
-    return ControllerRun(result, giver.given, giver.rejections, controller.faults, controller)
+    return ControllerRun(result, [t - start for t in giver.given], giver.rejections, controller.faults, controller)
 
 
 def _plan_margin(robot: RobotModel, log: _Log, n: int) -> float:

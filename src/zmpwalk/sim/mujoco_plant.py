@@ -181,6 +181,8 @@ class MujocoPlant:
             (:func:`zmpwalk.sim.run.simulate`).
         noise: Gaussian noise added to every measurement (:class:`~zmpwalk.sim.disturbances.SensorNoise`, its
             seed's generator drawn once per :meth:`measure`); None: none.
+        time_origin: Where :attr:`time` is 0 [s] after :meth:`stand` (a walk's start: a push's time then counts
+            from there, as on the batch walk's clock; whole control periods).
         noslip: Run MuJoCo's noslip solver (:data:`~zmpwalk.sim.disturbances.NOSLIP_ITERATIONS` iterations): a
             loaded sole then holds where it stands instead of creeping under a lasting tangential force inside
             the friction cone, as MuJoCo's soft contacts let it (as on a tilted floor, where it always runs).
@@ -192,8 +194,10 @@ class MujocoPlant:
 
     def __init__(self, robot: RobotModel, rate: float = 1000.0, *, mass_scale: float = 1.0,
                  disturbances: Disturbances | None = None, latency: float = 0.0, noise: SensorNoise | None = None,
-                 noslip: bool = False) -> None:
+                 noslip: bool = False, time_origin: float = 0.0) -> None:
         check_range("latency", latency)
+        if noise is not None and not isinstance(noise, SensorNoise):
+            raise InvalidParameterError("noise", noise, "a SensorNoise, or None")
         plant = build_plant(robot, mass_scale)
         model = plant.model
         if noslip:
@@ -225,6 +229,7 @@ class MujocoPlant:
         self.weight = float(model.body_subtreemass[1]) * robot.gravity  # [N]
         self._upright_least, self._least_height = math.cos(FALL_TILT), FALL_HEIGHT_FRACTION * robot.pelvis_height
         self._ticks = 0
+        self._origin = round(time_origin * self.rate)  # [ticks]
         self._delay = round(latency * self.rate)
         if abs(self._delay - latency * self.rate) > 1e-6:
             raise InvalidParameterError("latency", latency, f"a whole number of control periods ({1 / self.rate:g} s)")
@@ -234,8 +239,8 @@ class MujocoPlant:
 
     @property
     def time(self) -> float:
-        """[s] since :meth:`stand`."""
-        return self._ticks / self.rate
+        """[s] since :meth:`stand`, less ``time_origin``."""
+        return (self._ticks - self._origin) / self.rate
 
     def feedforward(self) -> ModelFeedforward:
         """A :class:`ModelFeedforward` on this plant's nominal model (before its disturbances)."""
