@@ -14,10 +14,10 @@ from numpy.typing import NDArray
 from zmpwalk.kinematics import JointTrajectory
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.sim.plant import Plant, damping_feedforward, plant_qpos, servo_offsets, servo_torques
+from zmpwalk.sim.ranges import CONTROL_RATE as CONTROL_RATE  # [Hz] servo reference and measurement rate
 
 Array = NDArray[np.float64]
 
-CONTROL_RATE = 1000.0  # [Hz] servo reference rate and measurement rate
 
 
 def rows_at(times: Array, pattern_times: Array, values: Array) -> Array:
