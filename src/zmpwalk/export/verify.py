@@ -11,7 +11,9 @@ moves horizontally at most :data:`STANCE_SPEED`, at least :data:`MIN_STANCE` lon
   :data:`CONTACT_HEIGHT` above the floor) and the first of them; the phase's slide is the largest over its points.
   A sole that rocks on an edge moves its origin (a foot 0.1 m above its sole pitched 0.05 rad moves it 5 mm)
   and the points that lift, not the points that stay down; a sole that turns about one corner moves the others;
-  a foot still coming down (above the floor) is not sliding yet;
+  a foot still coming down (above the floor) is not sliding yet. A sphere's, capsule's or cylinder's lowest point
+  is not a point of the sole: its rolling counts as slide (on the safe side). A phase in which no point touches
+  (the foot hovering within the stance band) takes its origin's largest horizontal distance instead;
 - **penetration**: the deepest its lowest point goes below the floor [m].
 
 A clip passes when every phase slides at most :data:`MAX_SLIDE` and penetrates at most :data:`MAX_PENETRATION`
@@ -121,7 +123,12 @@ def replay_check(model: mujoco.MjModel, qpos: Array, fps: float) -> ReplayCheck:
     for foot in range(2):
         for a, b in stance.phases[foot]:
             phases += 1
-            slide = max(slide, contact_slide(stance.points[foot][a:b + 1]))
+            points = stance.points[foot][a:b + 1]
+            if (points[:, :, 2] <= CONTACT_HEIGHT).any():
+                slide = max(slide, contact_slide(points))
+            else:  # the foot hovers within the stance band without touching: its origin's way
+                origin = stance.origin[a:b + 1, foot]
+                slide = max(slide, float(np.linalg.norm(origin - origin[0], axis=1).max()))
             penetration = max(penetration, float(-stance.lowest[a:b + 1, foot].min()))
     passed = phases > 0 and slide <= MAX_SLIDE and penetration <= MAX_PENETRATION
     return ReplayCheck(passed, phases, slide, penetration)
