@@ -20,5 +20,5 @@ def test_a_latency_is_whole_control_periods() -> None:
     """The sensors are read once a millisecond: 2 ms and 10 ms are delays, 2.5 ms is refused by name (the batch
     walk used to round it silently)."""
     assert check_range("latency", 0.002) == 0.002 and check_range("latency", 0.01) == 0.01
-    with pytest.raises(InvalidParameterError, match="latency = 0.0025"):
+    with pytest.raises(InvalidParameterError, match=r"latency = 0\.0025"):
         check_range("latency", 0.0025)
