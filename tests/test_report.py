@@ -36,7 +36,8 @@ def test_demo_writes_the_report_folder(demo):
     assert "walk.gif" not in names  # the GIF is opt-in (--gif): the page has the interactive replay
     summary = json.loads((demo / "summary.json").read_text())
     assert summary["fell"] is False and summary["min_zmp_margin"] > 0
-    assert summary["balance"] is True  # the demo runs the stabilizer
+    assert summary["balance"] is True  # the demo runs the stabilizer, through the walking controller
+    assert summary["controller"].startswith("the walking controller, as a robot's loop runs it")
     assert summary["verdict"]["passed"] is True  # and ends standing still where planned
     page = (demo / "index.html").read_text()
     assert "http://" not in page and "https://" not in page  # opens offline: everything is embedded

@@ -112,6 +112,7 @@ def run(args: argparse.Namespace) -> int:
         s = report.summary
         state = f"FELL at t = {s['fall_time']:.2f} s" if s["fell"] else "no fall"
         print(f"generator: {generator_words(args, robot)}")
+        print(f"controller: {s['controller']}")
         print(f"{robot.name}, {name}: {verdict.state} ({state}); plan's min ZMP margin "
               f"{margin_words(float(s['min_zmp_margin']))} -> {report.index}")
         print_verdict(verdict)
