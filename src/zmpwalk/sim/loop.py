@@ -152,6 +152,29 @@ def walk_start(settle: float, rate: float) -> float:
     return max(0, round((settle - START_DELAY) * rate)) / rate + START_DELAY
 
 
+def _check_run(commands: Sequence[StepCommand], command_phase: float, duration: float | None, hold: float,
+               settle: float | None, operated: bool) -> None:
+    """Raise :class:`InvalidParameterError` for a run :func:`simulate_controller` cannot make (its Raises)."""
+    if not 0.0 <= command_phase < 1.0:
+        raise InvalidParameterError("command_phase", command_phase, "a fraction of the step time in [0, 1)")
+    if duration is None and (operated or not commands):
+        raise InvalidParameterError("duration", duration, "a run length [s] where an operator gives the commands "
+                                    "or none are given")
+    if duration is not None and not 0.0 < duration <= 3600.0:
+        raise InvalidParameterError("duration", duration, "a run length in (0, 3600] s")
+    check_range("hold", hold)
+    if settle is not None:
+        check_range("settle", settle)
+
+
+def _longest(commands: Sequence[StepCommand], settle: float | None, start: float, hold: float) -> float:
+    """The longest a run of ``commands`` may take [s] from the stand: its start, three times each step, the hold
+    and 5 s (a refused command walks a step later; the stop takes up to three step times)."""
+    begins = start if settle is not None else START_DELAY  # [s] after the stand
+    steps = sum(3.0 * c.duration for c in commands) + 3.0 * max((c.duration for c in commands), default=0.0)
+    return begins + steps + hold + 5.0
+
+
 def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (), *, rate: float = 1000.0,
                         controller: WalkingController | None = None, plant: MujocoPlant | None = None,
                         command_phase: float = 0.5, duration: float | None = None, hold: float = HOLD,
@@ -191,18 +214,10 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
 
     Raises:
         InvalidParameterError: No commands and no duration, an operator without a duration, a phase outside
-            [0, 1), a hold outside [0, 60] s, a controller whose rate is not the plant's.
+            [0, 1), a hold outside [0, 60] s, a settle outside [0, 10] s, a latency that is not whole control
+            periods, a controller whose rate is not the plant's.
     """
-    if not 0.0 <= command_phase < 1.0:
-        raise InvalidParameterError("command_phase", command_phase, "a fraction of the step time in [0, 1)")
-    if duration is None and (operator is not None or not commands):
-        raise InvalidParameterError("duration", duration, "a run length [s] where an operator gives the commands "
-                                    "or none are given")
-    if duration is not None and not 0.0 < duration <= 3600.0:
-        raise InvalidParameterError("duration", duration, "a run length in (0, 3600] s")
-    check_range("hold", hold)
-    if settle is not None:
-        check_range("settle", settle)
+    _check_run(commands, command_phase, duration, hold, settle, operator is not None)
     start = 0.0 if settle is None else walk_start(settle, rate)  # [s] the walk begins
     plant = plant or MujocoPlant(robot, rate, mass_scale=mass_scale, disturbances=disturbances, latency=latency,
                                  noise=noise, time_origin=start)
@@ -211,10 +226,7 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
     if controller.rate != plant.rate:
         raise InvalidParameterError("controller.rate", controller.rate, f"the plant's rate, {plant.rate:g} Hz")
     plant.stand(OnlineWalker(robot, plant.rate, controller.schedule, joints=True).tick())
-    begins = start if settle is not None else START_DELAY  # [s] after the stand
-    longest = begins + sum(3.0 * c.duration for c in commands) + 3.0 * max((c.duration for c in commands),
-                                                                               default=0.0) + hold + 5.0
-    size = round((duration if duration is not None else longest) * plant.rate)
+    size = round((duration if duration is not None else _longest(commands, settle, start, hold)) * plant.rate)
     log = _Log(size, plant.model.nsensordata, controller.feedforward is not None, controller.stabilizer is not None)
     first = 0 if settle is None else round((start - START_DELAY) * plant.rate)
     giver = _Operator(commands, command_phase, plant.rate, first)
