@@ -324,7 +324,6 @@ def _controller_walk(spec: WalkSpec, progress: Callable[[float], None] | None) -
         ZmpwalkError: The walker refused a command (the first refusal, in ``spec.source``'s words).
     """
     from zmpwalk.control import WalkingController
-    from zmpwalk.schedule import Schedule
     from zmpwalk.sim.loop import simulate_controller, walk_start
     from zmpwalk.sim.mujoco_plant import MujocoPlant
     from zmpwalk.sim.references import CONTROL_RATE
@@ -332,7 +331,7 @@ def _controller_walk(spec: WalkSpec, progress: Callable[[float], None] | None) -
     plant = MujocoPlant(spec.robot, CONTROL_RATE, mass_scale=spec.mass_scale, disturbances=spec.disturbances,
                         latency=spec.latency, noise=spec.noise,
                         time_origin=walk_start(spec.settle, CONTROL_RATE))  # a push at the walk's time
-    controller = WalkingController(spec.robot, CONTROL_RATE, schedule=spec.schedule or Schedule.hubo(),
+    controller = WalkingController(spec.robot, CONTROL_RATE, schedule=spec.schedule,
                                    generator=spec.generator_name, pelvis=spec.pelvis, feedforward=plant.feedforward(),
                                    capture=spec.capture)
     run = simulate_controller(spec.robot, spec.commands, controller=controller, plant=plant, hold=spec.hold,

@@ -329,8 +329,8 @@ class WalkingController:
         if angles is None or velocities is None:  # pragma: no cover - the walker is made with joints
             raise InvalidParameterError("walker.joints", False, "True")
         corrected = self._corrected(sample, angles, measurement)
-        if corrected is not None and previous is not None:
-            self._capture_step(tick, sample, previous)
+        if self._capture is not None and corrected is not None and previous is not None:
+            self._capture_step(tick, sample, previous)  # no call per tick without a capture policy
         if self._motion is not None and not self._stranded and self._motion.done(tick):
             self._motion = None
             if self._deferred is not None:
