@@ -24,7 +24,7 @@ between the feet:
 3. **Double support for** :attr:`CaptureSettings.settle`: the DCM moves from ``xi(T)`` to the midpoint ``m``
    of the soles along a quintic, ``xi = m + (xi(T) - m)(1 - s(tau))``, whose ZMP is
    ``p = xi - xi' / omega``; then it stays at ``m`` with the ZMP, and the CoM converges to it
-   (``c' = omega (xi - c)``, integrated with RK4 at the pattern's rate).
+   (``c' = omega (xi - c)``, in closed form: :func:`zmpwalk.capture_pattern._com_path`).
 
 The CoM plan starts where the pattern's CoM point is (its joint references are continuous) with the measured
 DCM: the stabilizer's DCM error is then zero, and what is left of the push is in the plan. The swinging foot
