@@ -8,6 +8,11 @@ backward and sideways (towards the swinging foot's side), open loop (the feedfor
 stabilizer, and with the stabilizer and capture steps (:func:`zmpwalk.capture.capture_step`: the rest of the walk
 re-planned from the stabilizer's DCM estimate once its error passes the trigger). TALOS needs ../shared/robots
 (skipped when absent).
+
+Survival is not monotonic in the impulse (a walk that survives 20 N s may fall at 12): ``--grid STEP`` also walks
+every push on a STEP grid up to the search's ceiling and prints how many of them each loop survives, the falls
+marked (``.`` survived, ``x`` fell). ``--batch`` walks them in the batch closed loop instead of the walking
+controller (:func:`zmpwalk.walk.through_controller` forced off: the reference the controller is compared with).
 """
 
 from __future__ import annotations
@@ -89,6 +94,16 @@ def largest_push(name: str, direction: str, mode: str, high: float) -> float:
     return survived
 
 
+def grid_job(job: tuple[str, str, str, float, bool]) -> tuple[str, str, str, float, bool]:
+    """(robot, push, mode, impulse, batch) -> (..., fell): one push of the ``--grid`` scan."""
+    name, direction, mode, value, batch = job
+    if batch:
+        import zmpwalk.walk
+
+        zmpwalk.walk.through_controller = lambda spec: False  # the reference loop, in this worker only
+    return name, direction, mode, value, run((name, direction, mode, value))[4]
+
+
 def push_job(job: tuple[str, str, str, float]) -> tuple[str, str, str, float]:
     name, direction, mode, high = job
     return name, direction, mode, largest_push(name, direction, mode, high)
@@ -111,7 +126,13 @@ def main() -> None:
     parser.add_argument("--no-push", action="store_true", help="the conditions only, no push search")
     parser.add_argument("--push-only", action="store_true", help="the push search only, no conditions")
     parser.add_argument("--modes", nargs="+", choices=MODES, default=list(MODES), help="the push search's loops")
+    parser.add_argument("--grid", type=float, help="also scan every push on this grid [N s] and count the survived")
+    parser.add_argument("--batch", action="store_true", help="walk the pushes in the batch closed loop")
     args = parser.parse_args()
+    if args.batch:
+        import zmpwalk.walk
+
+        zmpwalk.walk.through_controller = lambda spec: False  # the workers fork after this
     robots = ["hubo", "hubo-soft"] + ([] if args.quick or not TALOS.is_file() else ["talos"])
     conditions = [("latency", 10.0), ("mass", 0.05), ("mass", -0.05), ("tilt-pitch", 2.0), ("tilt-pitch", -2.0),
                   ("tilt-roll", 2.0)]
@@ -139,6 +160,21 @@ def main() -> None:
                 off, on, capture = (found.get((r, d, m)) for m in MODES)
                 cells = [_impulse(off), _impulse(on), _ratio(on, off), _impulse(capture), _ratio(capture, off)]
                 print(f"| {r} | {d[5:]} | {' | '.join(cells)} |", flush=True)
+        if args.grid:
+            print_grid(pool, pushes, args.grid, args.batch)
+
+
+def print_grid(pool: ProcessPoolExecutor, pushes: list[tuple[str, str, str, float]], step: float,
+               batch: bool) -> None:
+    """Every push on the ``step`` grid up to each search's ceiling: the falls and the count survived."""
+    jobs = [(r, d, m, step * k, batch) for r, d, m, high in pushes for k in range(1, int(high / step) + 1)]
+    marks: dict[tuple[str, str, str], list[str]] = {}
+    for name, direction, mode, _, fell in pool.map(grid_job, jobs):
+        marks.setdefault((name, direction, mode), []).append("x" if fell else ".")
+    print(f"\n| robot | push | loop | every push on a {step:g} N s grid (. survived, x fell) | survived |")
+    print("|---|---|---|---|---|")
+    for (name, direction, mode), row in marks.items():
+        print(f"| {name} | {direction[5:]} | {mode} | `{''.join(row)}` | {row.count('.')} / {len(row)} |")
 
 
 if __name__ == "__main__":

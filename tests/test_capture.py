@@ -345,3 +345,15 @@ def test_a_capture_the_walker_cannot_stand_after_holds_its_rest_pose(hubo, walk,
     assert run.result.final_feet_error < 0.02 and run.result.end_max_speed < 0.05  # [m], [m/s]
     held = run.controller.sample  # the capture's last sample: its pelvis point 0.2 mm from where the DCM rests
     np.testing.assert_allclose(held.position_pelvis_in_world[:2], run.controller.captures[-1].rest, atol=1e-3, rtol=0)
+
+
+def test_a_capture_is_wanted_only_beyond_the_trigger_with_the_swinging_sole_unloaded():
+    """The trigger's rule, shared by the controller and the batch loop: the DCM error's length against the trigger
+    (100 mm beyond it, 70 mm not), and never once the swinging sole carries load."""
+    from zmpwalk.capture import capture_wanted
+
+    trigger, threshold = 0.08, 25.0  # [m], [N]
+    assert capture_wanted(np.array([0.06, 0.08]), trigger, 0.0, threshold)  # 100 mm
+    assert not capture_wanted(np.array([0.042, 0.056]), trigger, 0.0, threshold)  # 70 mm
+    assert capture_wanted(np.array([0.0, -0.0801]), trigger, threshold, threshold)  # at the threshold: unloaded
+    assert not capture_wanted(np.array([0.2, 0.0]), trigger, threshold + 0.1, threshold)  # landed

@@ -206,6 +206,7 @@ class Stabilizer:
         self.chains = leg_chains(robot)
         rest, rest_com = rest_mass(robot)
         self._mass = rest + sum(float(c.link_masses.sum()) for c in self.chains)
+        self.load_threshold = LOAD_FRACTION * self._mass * robot.gravity  # [N] a sole carries load above this
         # 8. the outer loop's gain per joint column: G = kappa m g l / k - 1 where the servo is softer
         stiffness = servo_stiffness(robot)
         wanted = self.gains.servo_stiffness * self._mass * robot.gravity * robot.pendulum_length
@@ -217,7 +218,7 @@ class Stabilizer:
             dt=self.dt, omega=self.omega, mass=self._mass, rest_moment=rest * np.asarray(rest_com),
             half_length=robot.foot_length / 2, half_width=robot.foot_width / 2, ankle_height=robot.ankle_height,
             pendulum_length=robot.pendulum_length, sole_center_x=robot.sole_center_x,
-            sole_center_y=robot.sole_center_y, load_threshold=LOAD_FRACTION * self._mass * robot.gravity,
+            sole_center_y=robot.sole_center_y, load_threshold=self.load_threshold,
             ankle_offset=np.concatenate([c.ankle for c in self.chains]), servo_gain=self.servo_gain,
             stiffen=float(self.servo_gain.any()), sole_stiffness=0.0 if sole_law is None else sole_law.stiffness,
             sole_exponent=0.0 if sole_law is None else sole_law.exponent,

@@ -60,6 +60,14 @@ ZMP_TOLERANCE = 1e-9  # [m]
 LEAST_REPLANNED_SWING = 0.08  # [s] a capture step re-planned during its swing lands at least this much later
 
 
+def capture_wanted(dcm_error: Array, trigger: float, swing_force: float, load_threshold: float) -> bool:
+    """Whether the DCM error asks for a capture step in a single support: longer than ``trigger`` [m] while the
+    swinging sole carries no load (its measured normal force ``swing_force`` at most ``load_threshold`` [N]). A
+    swinging sole already loaded has landed: the step is taken, and a plan made then would lift a loaded foot, on
+    a DCM estimate that jumps as the legs' odometry moves its anchor to the landing foot."""
+    return bool(swing_force <= load_threshold and math.hypot(float(dcm_error[0]), float(dcm_error[1])) > trigger)
+
+
 @dataclass(frozen=True)
 class CaptureSettings:
     """When a capture step is taken and how it is shaped.
@@ -319,4 +327,4 @@ def _settled(plan: CaptureState, n: int, landing: Array, settle: float) -> tuple
     return pattern, rest, settle, margin
 
 
-__all__ = ["REACH_MARGIN", "CapturePlan", "CaptureSettings", "capture_step", "quintic_from_rest"]
+__all__ = ["REACH_MARGIN", "CapturePlan", "CaptureSettings", "capture_step", "capture_wanted", "quintic_from_rest"]

@@ -306,13 +306,12 @@ def run_walk(spec: WalkSpec, progress: Progress | None = None, planned: PlannedW
 def through_controller(spec: WalkSpec) -> bool:
     """Whether :func:`run_walk` simulates ``spec`` through the :class:`~zmpwalk.control.WalkingController` (the
     code a robot's loop runs, commands given mid-walk): every walk with the stabilizer on a generator the walker
-    runs online, but those the batch closed loop (:mod:`zmpwalk.sim.closed_loop`) keeps: the paper's example
-    (``paper_steps``), a ZMP-corrected pattern, the preview generator, no feedforward, and capture steps (the
-    controller takes them, :mod:`zmpwalk.control.capture`, but the pushes it survives with them are smaller than
-    the batch loop's: docs/controller.md)."""
+    runs online (capture steps included, :mod:`zmpwalk.control.capture`), but those the batch closed loop
+    (:mod:`zmpwalk.sim.closed_loop`) keeps: the paper's example (``paper_steps``), a ZMP-corrected pattern, the
+    preview generator and no feedforward."""
     from zmpwalk.online_check import ONLINE_GENERATORS
 
-    return (spec.balance and spec.paper_steps is None and not spec.zmp_correction and spec.capture is None
+    return (spec.balance and spec.paper_steps is None and not spec.zmp_correction
             and spec.feedforward is not False and spec.generator_name in ONLINE_GENERATORS)
 
 

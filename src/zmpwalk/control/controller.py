@@ -330,7 +330,7 @@ class WalkingController:
             raise InvalidParameterError("walker.joints", False, "True")
         corrected = self._corrected(sample, angles, measurement)
         if self._capture is not None and corrected is not None and previous is not None:
-            self._capture_step(tick, sample, previous)  # no call per tick without a capture policy
+            self._capture_step(tick, sample, previous, measurement)  # no call per tick without a capture policy
         if self._motion is not None and not self._stranded and self._motion.done(tick):
             self._motion = None
             if self._deferred is not None:
@@ -343,10 +343,11 @@ class WalkingController:
         return JointTargets(sample.time, angles if corrected is None else corrected, velocities, torques, sample,
                             corrected is not None)
 
-    def _capture_step(self, tick: int, sample: WalkingSample, previous: WalkingSample) -> None:
+    def _capture_step(self, tick: int, sample: WalkingSample, previous: WalkingSample,
+                      measurement: BalanceMeasurement) -> None:
         """Plan a capture step from the next tick where one is due (:mod:`zmpwalk.control.capture`)."""
         policy, stabilizer = self._capture, self.stabilizer
-        if policy is None or stabilizer is None or not policy.due(tick, sample, stabilizer):
+        if policy is None or stabilizer is None or not policy.due(tick, sample, stabilizer, measurement):
             return
         try:
             motion = policy.plan(tick, sample, previous, stabilizer, self._motion)

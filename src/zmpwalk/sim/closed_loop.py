@@ -9,7 +9,6 @@ controls are played as planned, with a push applied where :class:`~zmpwalk.sim.d
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -18,9 +17,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk.balance import BalanceMeasurement, BalanceState, Stabilizer
-from zmpwalk.capture import CAPTURE_INTERVAL
+from zmpwalk.capture import CAPTURE_INTERVAL, capture_wanted
 from zmpwalk.errors import InfeasiblePatternError, UnreachableError
 from zmpwalk.patterns.result import WalkingPattern
+from zmpwalk.sides import Support
 from zmpwalk.sim.disturbances import Disturbances, SensorNoise, _MeasurementReader
 from zmpwalk.sim.plant import Plant
 from zmpwalk.sim.references import CONTROL_RATE, tracked_references
@@ -111,7 +111,8 @@ def closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabil
         readings[k] = data.sensordata
         state = stabilizer.state
         _record(log, k, state)
-        if capture is not None and _capture_due(tracks.tracked["support"], k, last_capture, state, capture[0]):
+        if capture is not None and _capture_due(tracks.tracked["support"], k, last_capture, state, capture[0],
+                                                measurement, stabilizer.load_threshold):
             last_capture = k
             try:
                 tail = capture[1](k, stabilizer, int(tracks.tracked["support"][k]))
@@ -154,10 +155,13 @@ def _record(log: dict[str, Array], k: int, state: BalanceState) -> None:
     log["pelvis_turn"][k] = state.pelvis_turn
 
 
-def _capture_due(support: NDArray[np.generic], k: int, last_capture: int, state: BalanceState,
-                 trigger: float) -> bool:
+def _capture_due(support: NDArray[np.generic], k: int, last_capture: int, state: BalanceState, trigger: float,
+                 measurement: BalanceMeasurement, load_threshold: float) -> bool:
     """Whether a capture step is planned at tick ``k``: in a single support that goes on at the next tick, at least
-    :data:`CAPTURE_INTERVAL` after the last one, with the DCM error beyond ``trigger`` [m]."""
-    return bool(k + 1 < len(support) and support[k] != 0 and support[k + 1] == support[k]
-                and k - last_capture >= CAPTURE_INTERVAL * CONTROL_RATE
-                and math.hypot(float(state.dcm_error[0]), float(state.dcm_error[1])) > trigger)
+    :data:`CAPTURE_INTERVAL` after the last one, as :func:`~zmpwalk.capture.capture_wanted` (the DCM error beyond
+    ``trigger`` [m], the swinging sole unloaded)."""
+    if not (k + 1 < len(support) and support[k] != 0 and support[k + 1] == support[k]
+            and k - last_capture >= CAPTURE_INTERVAL * CONTROL_RATE):
+        return False
+    swing = measurement.wrench_right if support[k] == Support.LEFT else measurement.wrench_left
+    return capture_wanted(state.dcm_error, trigger, float(swing[2]), load_threshold)
