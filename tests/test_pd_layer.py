@@ -296,3 +296,28 @@ def test_a_urdf_without_actuators_walks_six_steps(tmp_path: Path, capsys: pytest
     assert summary["final_feet_error"] < 0.02  # [m]
     assert summary["distance"] == pytest.approx(0.30, abs=0.03)  # [m]: six 5 cm steps and the closing one
     assert max(row["impact_torque"] for row in summary["actuators"]) <= EFFORT + 1e-9  # [N m]
+
+
+def test_a_position_servo_s_control_range_does_not_clip_its_feedforward(tmp_path: Path) -> None:
+    """Low-gain position servos whose control range is the joint's (``inheritrange``, as many humanoid models
+    declare them): the plant lifts the range, so an offset that carries a feedforward torque past it is not
+    clipped, while the joint's force range still bounds the torque."""
+    actuators = "".join(f'<position name="{s}_{j}_p" joint="{s}_{j}" kp="20" kv="1" ctrlrange="-0.5 0.5" '
+                        'forcerange="-30 30" forcelimited="true"/>'
+                        for s in ("l", "r") for j in ("hy", "hr", "hp", "kn", "ap", "ar"))
+    actuators += '<position name="shoulder_p" joint="shoulder" kp="20" ctrlrange="-1.3 1.3"/>'
+    robot = load_robot(write(tmp_path, "servo.xml", motor_biped(actuators, knee_limit="")))
+    plant = build_plant(robot)
+    model, data = plant.model, mujoco.MjData(plant.model)
+    assert not model.actuator_ctrllimited.any()  # every position servo's range lifted
+    assert robot.legs is not None
+    angles = np.concatenate([chain.reference[list(chain.role_order)] for chain in robot.legs])
+    set_initial_state(plant, data, np.array([0.0, 0.0, robot.pelvis_height]), 0.0, angles)
+    ankle = int(plant.leg_actuators[4])
+    q = float(data.qpos[plant.leg_qpos[4]])
+    data.ctrl[ankle] = q + 12.0 / 20.0  # a 12 N m feedforward on the angle: 0.6 rad, past the 0.5 rad range
+    mujoco.mj_forward(model, data)
+    assert data.actuator_force[ankle] == pytest.approx(12.0, abs=0.5)  # [N m] (kv q' of the settling pose)
+    data.ctrl[ankle] = q + 2.0  # 40 N m wanted: the force range holds it at 30
+    mujoco.mj_forward(model, data)
+    assert abs(data.actuator_force[ankle]) == pytest.approx(30.0, abs=1e-9)

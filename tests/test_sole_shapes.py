@@ -73,3 +73,19 @@ def test_feet_whose_contacts_are_explicit_pairs(tmp_path: Path) -> None:
     robot = load_robot(path)
     assert robot.foot_length == pytest.approx(0.2, abs=1e-6) and robot.foot_width == pytest.approx(0.08, abs=1e-6)
     assert robot.ankle_height == pytest.approx(0.06, abs=1e-6)
+
+
+def test_a_foot_geom_paired_only_with_the_robot_is_not_its_sole(tmp_path: Path) -> None:
+    """A larger, lower foot box kept for foot-to-foot collisions (paired with the other foot, never with the
+    floor, contype = conaffinity = 0) beside the sole paired with the floor: the sole is the floor's pair."""
+    foot = ('<geom name="{side}_sole" type="box" size="0.1 0.04 0.01" pos="0.03 0 -0.05" mass="0.5" '
+            'contype="0" conaffinity="0"/>'
+            '<geom name="{side}_guard" type="box" size="0.12 0.05 0.005" pos="0.03 0 -0.057" mass="0.01" '
+            'contype="0" conaffinity="0"/>')
+    pairs = ('<contact><pair geom1="l_sole" geom2="floor"/><pair geom1="r_sole" geom2="floor"/>'
+             '<pair geom1="l_guard" geom2="r_guard"/></contact>')
+    path = tmp_path / "guard.xml"
+    path.write_text(biped(foot, pairs), encoding="utf-8")
+    robot = load_robot(path)
+    assert robot.foot_length == pytest.approx(0.2, abs=1e-6) and robot.foot_width == pytest.approx(0.08, abs=1e-6)
+    assert robot.ankle_height == pytest.approx(0.06, abs=1e-6)

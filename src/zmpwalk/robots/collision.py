@@ -72,13 +72,18 @@ def _round_bar_bottom(centre: Array, rotation: Array, size: Array, capsule: bool
 
 
 def colliding_geoms(model: object) -> set[int]:
-    """The geoms that can touch anything: by their contact type and affinity, or named in an explicit contact
-    pair (``<contact><pair>``, whose geoms often have ``contype = conaffinity = 0``)."""
+    """The geoms that can touch the floor: by their contact type and affinity, or paired with a geom of the world
+    body (the floor) in an explicit contact pair (``<contact><pair>``, whose geoms often have ``contype =
+    conaffinity = 0``); a geom paired only with the robot's own geoms (a foot box kept for foot-to-shin
+    collisions) is not."""
     m = model
     geoms = {g for g in range(m.ngeom)  # type: ignore[attr-defined]
              if m.geom_contype[g] != 0 or m.geom_conaffinity[g] != 0}  # type: ignore[attr-defined]
     for pair in range(m.npair):  # type: ignore[attr-defined]
-        geoms.update((int(m.pair_geom1[pair]), int(m.pair_geom2[pair])))  # type: ignore[attr-defined]
+        first, second = int(m.pair_geom1[pair]), int(m.pair_geom2[pair])  # type: ignore[attr-defined]
+        for geom, other in ((first, second), (second, first)):
+            if int(m.geom_bodyid[other]) == 0:  # type: ignore[attr-defined]
+                geoms.add(geom)
     return geoms
 
 

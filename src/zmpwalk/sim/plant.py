@@ -11,6 +11,10 @@ model, unmodified in its meshes, masses, inertias, contacts and actuators, with:
 * a time step of at most :data:`MAX_TIMESTEP` (the 1 kHz servo period of the references);
 * the joint PD layer a humanoid's firmware runs, where the model has torque motors or no actuators
   (:func:`add_pd_layer`);
+* no control range on its position servos (:func:`lift_control_ranges`): the control carries the target angle
+  plus the damping and feedforward torques as angle offsets (``q, dq, tau_ff``, docs/balance.md), which a
+  range copied from the joint's (``inheritrange``) would clip silently, and with them the torque a low-gain servo
+  gives near the end of its range; the joint's range still bounds the motion and its force range the torque;
 * the leg joints' actuators driven by the joint trajectory, every other actuator holding the
   reference pose (the keyframe's controls; the reference angle for a joint of the PD layer).
 
@@ -99,6 +103,7 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
     if not any(g.type == mujoco.mjtGeom.mjGEOM_PLANE for g in spec.worldbody.geoms):
         spec.worldbody.add_geom(name="zmpwalk_floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 0.05])
     add_pd_layer(spec, plant)
+    lift_control_ranges(spec, model)
     qpos = np.array(plant.qpos_reference)
     _add_sites(spec, model, robot, plant, qpos)
     virtual = _virtual_columns(robot)
@@ -202,6 +207,13 @@ def _add_virtual_actuator(spec: mujoco.MjSpec, name: str, ankle_pitch: str, colu
                          ("tau", mujoco.mjtSensor.mjSENS_ACTUATORFRC)):
         sensor = spec.add_sensor(name=f"{column}_{suffix}", type=kind, objname=name)
         sensor.objtype = mujoco.mjtObj.mjOBJ_ACTUATOR
+
+
+def lift_control_ranges(spec: mujoco.MjSpec, model: mujoco.MjModel) -> None:
+    """Drop the control range of every position servo of ``model`` in ``spec`` (the module docstring)."""
+    for actuator, element in zip(range(model.nu), spec.actuators, strict=False):  # the model's, in its order
+        if is_position_servo(model, actuator):
+            element.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
 
 
 def add_pd_layer(spec: mujoco.MjSpec, plant: ModelPlant) -> None:
