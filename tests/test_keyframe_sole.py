@@ -47,10 +47,11 @@ def _leg(side: str, y: float) -> str:
     return inner
 
 
-def pitched_biped(keyframe: bool = True) -> str:
+def pitched_biped(keyframe: bool = True, off_level: float = 0.0) -> str:
     """An 18.6 kg biped without actuators (the joint PD layer drives it) whose foot boxes are pitched 10 degrees at
-    zero angles; its keyframe bends each ankle pitch by -10 degrees, which stands the boxes level."""
-    angles = " ".join(["0"] * 4 + [f"{-PITCH:.15f}", "0"])
+    zero angles; its keyframe bends each ankle pitch by -10 degrees, which stands the boxes level (``off_level``
+    [rad] more: the boxes pitched that much in the keyframe)."""
+    angles = " ".join(["0"] * 4 + [f"{-PITCH - off_level:.15f}", "0"])
     key = f'<keyframe><key name="level" qpos="0 0 0.7 1 0 0 0 {angles} {angles}"/></keyframe>' if keyframe else ""
     return f"""<mujoco model="pitched_feet"><compiler angle="radian"/>
 <default><joint armature="0.01" damping="0.1" actuatorfrcrange="-60 60"/></default>
@@ -93,6 +94,24 @@ def test_the_sole_is_the_keyframe_sole(model_path: Path) -> None:
         rotation = np.array([[math.cos(PITCH), 0, math.sin(PITCH)], [0, 1, 0], [-math.sin(PITCH), 0, math.cos(PITCH)]])
         assert chain.sole_rotation == pytest.approx(rotation, abs=1e-12)  # R_y(10 deg): the sole in the last link
         assert chain.sole_tilt_reference == pytest.approx((0.0, 0.0), abs=1e-9)  # [rad] level in the keyframe
+
+
+def test_a_keyframe_a_little_off_level_gives_the_box_face_as_the_sole(tmp_path: Path) -> None:
+    """Feet 2 degrees off level in the keyframe (a model's standing pose): the lowest 2 mm of the box would be its
+    heel edge; the box's own bottom face is taken instead (within FACE_TILT of level), and the IK keeps that face
+    level: the same sole and sole frame as with a level keyframe."""
+    from zmpwalk.robots.collision import FACE_TILT
+
+    off = math.radians(2.0)
+    assert off < FACE_TILT
+    path = tmp_path / "off_level.xml"
+    path.write_text(pitched_biped(off_level=off), encoding="utf-8")
+    robot = load_robot(path)
+    assert (robot.foot_length, robot.foot_width) == pytest.approx((0.22, 0.14), abs=1e-9)  # [m]
+    assert robot.legs is not None
+    rotation = np.array([[math.cos(PITCH), 0, math.sin(PITCH)], [0, 1, 0], [-math.sin(PITCH), 0, math.cos(PITCH)]])
+    for chain in robot.legs:
+        assert chain.sole_rotation == pytest.approx(rotation, abs=1e-12)  # the box face, not the keyframe's level
 
 
 def test_without_a_level_posture_the_import_names_the_remedy(tmp_path: Path) -> None:

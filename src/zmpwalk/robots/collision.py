@@ -32,6 +32,7 @@ Array = NDArray[np.float64]
 
 SOLE_BAND = 0.002  # [m] collision points this close to the lowest (along the sole's normal) form the sole
 LEVEL = 1e-12  # [rad] a tilt below this is level (the rounding of the model's own rotations)
+FACE_TILT = 0.1  # [rad] a foot box's bottom face this close to level in the reference posture is the sole's plane
 
 
 def rigid_bodies(model: object, body: int) -> list[int]:
@@ -85,6 +86,32 @@ def colliding_geoms(model: object) -> set[int]:
             if int(m.geom_bodyid[other]) == 0:  # type: ignore[attr-defined]
                 geoms.add(geom)
     return geoms
+
+
+def sole_face_up(model: object, data: object, bodies: list[int]) -> Array | None:
+    """The world up of the sole's own plane where the foot's sole is a box: the outward normal of the bottom face of
+    the collision box that reaches lowest (reversed, pointing up), in world, when it is within :data:`FACE_TILT` of
+    the vertical in the posture of ``data``; None where the foot has no such box (its sole is then taken level
+    in that posture). A keyframe whose feet stand 2° off level (a model's standing pose on soft contacts) then
+    still gives the whole box face as the sole, not its lowest edge."""
+    import mujoco
+
+    m, d = model, data
+    colliding = colliding_geoms(m)
+    best: tuple[float, Array] | None = None
+    for g in range(m.ngeom):  # type: ignore[attr-defined]
+        if (int(m.geom_bodyid[g]) not in bodies or g not in colliding  # type: ignore[attr-defined]
+                or int(m.geom_type[g]) != mujoco.mjtGeom.mjGEOM_BOX):  # type: ignore[attr-defined]
+            continue
+        rotation = d.geom_xmat[g].reshape(3, 3)  # type: ignore[attr-defined]
+        axis = int(np.argmax(np.abs(rotation[2, :])))  # the box axis nearest the vertical
+        up = rotation[:, axis] * (1.0 if rotation[2, axis] > 0 else -1.0)
+        lowest = float(d.geom_xpos[g][2] - np.abs(rotation[2, :]) @ m.geom_size[g])  # type: ignore[attr-defined]
+        if best is None or lowest < best[0]:
+            best = (lowest, np.array(up, dtype=np.float64))
+    if best is None or math.acos(min(float(best[1][2]), 1.0)) > FACE_TILT:
+        return None
+    return best[1]
 
 
 def collision_points(model: object, data: object, bodies: list[int]) -> Array:

@@ -58,7 +58,7 @@ from numpy.typing import NDArray
 
 from zmpwalk.errors import FileFormatError
 from zmpwalk.leg_chain import LegChain
-from zmpwalk.robots.collision import Sole, collision_points, rigid_bodies, sole_roll_bound
+from zmpwalk.robots.collision import Sole, collision_points, rigid_bodies, sole_face_up, sole_roll_bound
 from zmpwalk.robots.description import Actuator, LegJoint, ModelPlant
 from zmpwalk.robots.legs import VIRTUAL_PREFIX, FootAtReference, Segments, build_leg, leg_joint_ids, segments
 from zmpwalk.robots.model import RobotModel, schedule_scale
@@ -345,7 +345,9 @@ def _robot_model(*, name: str, description: str, mass: float, height: float, geo
 
 
 def _foot_at_reference(model: object, data: object, foot: int, label: str, source: str) -> FootAtReference:
-    """The foot's collision points and the world's up in its body frame, ``data`` in the reference posture.
+    """The foot's collision points and the up of its sole's plane in its body frame, ``data`` in the reference posture:
+    a box sole's own bottom face where it is nearly level (:func:`~zmpwalk.robots.collision.sole_face_up`), else the
+    world's up.
 
     Raises:
         FileFormatError: The foot body has no collision geom.
@@ -358,7 +360,9 @@ def _foot_at_reference(model: object, data: object, foot: int, label: str, sourc
         raise FileFormatError(source, f"the {label} foot body {foot_name!r} has no collision geom (its sole)")
     rotation = np.array(data.xmat[foot], dtype=np.float64).reshape(3, 3)  # type: ignore[attr-defined]  # copies
     position = np.array(data.xpos[foot], dtype=np.float64)  # type: ignore[attr-defined]
-    return FootAtReference((points - position) @ rotation, rotation[2, :].copy())
+    face = sole_face_up(model, data, rigid_bodies(model, foot))  # a box sole's own plane, else the world's level
+    up = rotation[2, :].copy() if face is None else rotation.T @ face
+    return FootAtReference((points - position) @ rotation, up)
 
 
 def _ready_posture(model: Any, data: Any, chains: list[LegChain], legs: list[list[int]], qpos_reference: Array,
