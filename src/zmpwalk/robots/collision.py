@@ -83,7 +83,7 @@ def colliding_geoms(model: object) -> set[int]:
     for pair in range(m.npair):  # type: ignore[attr-defined]
         first, second = int(m.pair_geom1[pair]), int(m.pair_geom2[pair])  # type: ignore[attr-defined]
         for geom, other in ((first, second), (second, first)):
-            if int(m.geom_bodyid[other]) == 0:  # type: ignore[attr-defined]
+            if int(m.body_weldid[m.geom_bodyid[other]]) == 0:  # type: ignore[attr-defined]  # on the world
                 geoms.add(geom)
     return geoms
 
@@ -91,9 +91,10 @@ def colliding_geoms(model: object) -> set[int]:
 def sole_face_up(model: object, data: object, bodies: list[int]) -> Array | None:
     """The world up of the sole's own plane where the foot's sole is a box: the outward normal of the bottom face of
     the collision box that reaches lowest (reversed, pointing up), in world, when it is within :data:`FACE_TILT` of
-    the vertical in the posture of ``data``; None where the foot has no such box (its sole is then taken level
-    in that posture). A keyframe whose feet stand 2° off level (a model's standing pose on soft contacts) then
-    still gives the whole box face as the sole, not its lowest edge."""
+    the vertical in the posture of ``data`` and reaches within :data:`SOLE_BAND` of the foot's lowest collision
+    point; None where the foot has no such box (its sole is then taken level in that posture). A keyframe whose
+    feet stand 2° off level (a model's standing pose on soft contacts) then still gives the whole box face as the
+    sole, not its lowest edge."""
     import mujoco
 
     m, d = model, data
@@ -110,6 +111,9 @@ def sole_face_up(model: object, data: object, bodies: list[int]) -> Array | None
         if best is None or lowest < best[0]:
             best = (lowest, np.array(up, dtype=np.float64))
     if best is None or math.acos(min(float(best[1][2]), 1.0)) > FACE_TILT:
+        return None
+    lowest_point = float(collision_points(m, d, bodies)[:, 2].min())
+    if best[0] > lowest_point + SOLE_BAND:  # the box is not what the foot stands on (spheres, a mesh below it)
         return None
     return best[1]
 
@@ -213,7 +217,8 @@ def foot_sole(points: Array, up: Array, rotation: Array, position: Array, ankle:
     Args:
         points: The foot's collision points (:func:`collision_points`) in the reference posture, in the foot
             body's frame [m], (m, 3).
-        up: The world's up in the foot body's frame in the reference posture, (3,).
+        up: The up of the sole's plane in the foot body's frame in the reference posture, (3,): the world's, or
+            a box sole's own bottom face (:func:`sole_face_up`).
         rotation, position: The foot body's pose in the pelvis frame at zero joint angles ((3, 3), [m] (3,)).
         ankle: The ankle point in the pelvis frame at zero angles [m], (3,).
     """

@@ -160,8 +160,8 @@ def segments(model: object, data: object, base: int, legs: list[list[int]],
 
 @dataclass(frozen=True)
 class FootAtReference:
-    """A foot in the reference posture: its collision points in the foot body's frame [m], (m, 3), and the world's
-    up in that frame, (3,)."""
+    """A foot in the reference posture: its collision points in the foot body's frame [m], (m, 3), and the up of its
+    sole's plane in that frame, (3,) (the world's, or a box sole's own bottom face)."""
 
     points: Array
     up: Array

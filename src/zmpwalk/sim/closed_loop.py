@@ -74,7 +74,8 @@ def closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabil
                 ) -> tuple[Array, dict[str, Array]]:
     """Step the model tick by tick (the stabilizer in the loop where given, pushes applied); sensor rows
     (n, nsensordata) and the stabilizer's log. With ``capture = (trigger, tail)``: whenever the stabilizer's DCM
-    error passes ``trigger`` [m] in a single support (at most every :data:`CAPTURE_INTERVAL`), ``tail`` re-makes
+    error passes ``trigger`` [m] in a single support while the swinging sole is unloaded
+    (:func:`~zmpwalk.capture.capture_wanted`; at most every :data:`CAPTURE_INTERVAL`), ``tail`` re-makes
     the references from the next tick on (what the stabilizer tracks, the ZMP, the joint references and the
     controls; ``reference``, ``control`` and ``zmp_ref`` are changed in place)."""
     n = len(pattern_time)
