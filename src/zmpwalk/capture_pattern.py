@@ -171,9 +171,8 @@ def _com_path(plan: CaptureState, rest: Array, settle: float, s: Array) -> Array
 
     def particular(tau: Array | float) -> Array:
         tau = np.asarray(tau, dtype=float)
-        derivatives = (tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2), 30.0 * tau**2 * (1.0 - tau) ** 2,
-                       60.0 * tau * (1.0 - 3.0 * tau + 2.0 * tau**2), 60.0 - 360.0 * tau + 360.0 * tau**2,
-                       -360.0 + 720.0 * tau, np.full_like(tau, 720.0))
+        derivatives = (*smoothstep5(tau), 60.0 - 360.0 * tau + 360.0 * tau**2, -360.0 + 720.0 * tau,
+                       np.full_like(tau, 720.0))  # b and its first five derivatives
         series = sum(u**k * d for k, d in enumerate(derivatives))
         return np.asarray(rest + gap * (1.0 - series))
 

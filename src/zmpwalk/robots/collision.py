@@ -88,13 +88,13 @@ def colliding_geoms(model: object) -> set[int]:
     return geoms
 
 
-def sole_face_up(model: object, data: object, bodies: list[int]) -> Array | None:
+def sole_face_up(model: object, data: object, bodies: list[int], lowest: float) -> Array | None:
     """The world up of the sole's own plane where the foot's sole is a box: the outward normal of the bottom face of
     the collision box that reaches lowest (reversed, pointing up), in world, when it is within :data:`FACE_TILT` of
-    the vertical in the posture of ``data`` and reaches within :data:`SOLE_BAND` of the foot's lowest collision
-    point; None where the foot has no such box (its sole is then taken level in that posture). A keyframe whose
-    feet stand 2° off level (a model's standing pose on soft contacts) then still gives the whole box face as the
-    sole, not its lowest edge."""
+    the vertical in the posture of ``data`` and reaches within :data:`SOLE_BAND` of ``lowest``, the height [m] of
+    the foot's lowest collision point there; None where the foot has no such box (its sole is then taken level
+    in that posture). A keyframe whose feet stand 2° off level (a model's standing pose on soft contacts) then
+    still gives the whole box face as the sole, not its lowest edge."""
     import mujoco
 
     m, d = model, data
@@ -112,8 +112,7 @@ def sole_face_up(model: object, data: object, bodies: list[int]) -> Array | None
             best = (lowest, np.array(up, dtype=np.float64))
     if best is None or math.acos(min(float(best[1][2]), 1.0)) > FACE_TILT:
         return None
-    lowest_point = float(collision_points(m, d, bodies)[:, 2].min())
-    if best[0] > lowest_point + SOLE_BAND:  # the box is not what the foot stands on (spheres, a mesh below it)
+    if best[0] > lowest + SOLE_BAND:  # the box is not what the foot stands on (spheres, a mesh below it)
         return None
     return best[1]
 

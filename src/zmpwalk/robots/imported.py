@@ -360,7 +360,7 @@ def _foot_at_reference(model: object, data: object, foot: int, label: str, sourc
         raise FileFormatError(source, f"the {label} foot body {foot_name!r} has no collision geom (its sole)")
     rotation = np.array(data.xmat[foot], dtype=np.float64).reshape(3, 3)  # type: ignore[attr-defined]  # copies
     position = np.array(data.xpos[foot], dtype=np.float64)  # type: ignore[attr-defined]
-    face = sole_face_up(model, data, rigid_bodies(model, foot))  # a box sole's own plane, else the world's level
+    face = sole_face_up(model, data, rigid_bodies(model, foot), float(points[:, 2].min()))  # a box sole's plane
     up = rotation[2, :].copy() if face is None else rotation.T @ face
     return FootAtReference((points - position) @ rotation, up)
 
