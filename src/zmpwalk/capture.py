@@ -43,11 +43,19 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from zmpwalk.capture_pattern import REACH_MARGIN, CaptureState, capture_pattern, quintic_from_rest, turned
+from zmpwalk.capture_pattern import (
+    REACH_MARGIN,
+    CaptureState,
+    capture_pattern_parts,
+    quintic_from_rest,
+    turned,
+    zmp_margin_of_capture,
+)
 from zmpwalk.errors import InfeasiblePatternError, InvalidParameterError, UnreachableError
 from zmpwalk.kinematics import leg_reach_excess
 from zmpwalk.patterns.result import WalkingPattern, check_rate
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.slices import Parts, whole
 
 Array = NDArray[np.float64]
 
@@ -84,6 +92,9 @@ class CaptureSettings:
         landing_inset: The DCM at touchdown lies this far inside the landing sole [m].
         feet_clearance: Least gap between the soles' inner edges across the stance foot [m].
         settle: Double support in which the DCM moves to the midpoint of the soles [s].
+        lead: The walking controller plans a capture step over this long before the step takes over from the walk
+            [s] (:mod:`zmpwalk.control.capture`: a few parts of the plan per tick, from the state predicted at the
+            take-over; whole ticks, at least one: 0 plans it within the triggering tick, as the batch loop does).
     """
 
     trigger: float = 0.08  # [m]
@@ -95,12 +106,15 @@ class CaptureSettings:
     landing_inset: float = 0.03  # [m]
     feet_clearance: float = 0.02  # [m]
     settle: float = 1.0  # [s]
+    lead: float = 0.03  # [s]
 
     def __post_init__(self) -> None:
         for name, value in vars(self).items():
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not (math.isfinite(value)
                                                                                        and value >= 0):
                 raise InvalidParameterError(f"capture.{name}", value, "a finite number >= 0")
+        if self.lead > 0.2:
+            raise InvalidParameterError("capture.lead", self.lead, "at most 0.2 s")
         if not 0.05 <= self.shortest_swing <= self.longest_swing <= 2.0:
             raise InvalidParameterError("capture.shortest_swing", (self.shortest_swing, self.longest_swing),
                                         "0.05 s <= shortest_swing <= longest_swing <= 2 s")
@@ -137,7 +151,7 @@ class CapturePlan:
     reached: bool
 
 
-def capture_step(
+def capture_step_parts(
     robot: RobotModel,
     *,
     time: float,
@@ -152,8 +166,11 @@ def capture_step(
     foot_yaws: tuple[float, float],
     settings: CaptureSettings | None = None,
     touchdown: float | None = None,
-) -> tuple[WalkingPattern, CapturePlan]:
-    """The rest of a walk as one capture step and a stop, from the state at ``time`` (see the module docstring).
+) -> Parts[tuple[WalkingPattern, CapturePlan]]:
+    """The rest of a walk as one capture step and a stop, from the state at ``time`` (see the module docstring),
+    in parts (:mod:`zmpwalk.slices`: the landing search, then the pattern's parts and its reach check for each
+    landing tried; a controller runs them over the ticks before the step takes over); :func:`capture_step` runs it
+    whole.
 
     Args:
         robot: The robot (soles, legs, pendulum length).
@@ -194,10 +211,12 @@ def capture_step(
     st = 0 if stance == "left" else 1
     stance_foot = _StanceFoot(robot, settings, st, float(foot_yaws[st]), ankles, dcm, omega)
     swing_time, dcm_touchdown, landing = stance_foot.swing(time, touchdown)
+    yield
     n = max(math.ceil((max(end, time + swing_time + settings.settle + 1.0 / omega) - time) * rate - 1e-9), 1) + 1
     plan = CaptureState(robot, time, rate, settings.lift, omega, st, com, dcm, stance_foot.p1, swing_time,
                         stance_foot.st_yaw, float(yaw_pelvis_in_world), ankles, velocities, foot_yaws)
-    pattern, rest, settle, margin, landing, reached = _within_reach(plan, n, landing, stance_foot, settings.settle)
+    pattern, rest, settle, margin, landing, reached = yield from _within_reach(plan, n, landing, stance_foot,
+                                                                               settings.settle)
     if margin < -ZMP_TOLERANCE:
         pulled = ", pulled in for the legs' reach," if not reached else ""
         raise InfeasiblePatternError(
@@ -208,6 +227,9 @@ def capture_step(
                                 zmp_stance=stance_foot.p1, dcm_start=dcm, dcm_touchdown=dcm_touchdown,
                                 landing=(float(landing[0]), float(landing[1]), stance_foot.st_yaw), rest=rest,
                                 reached=reached)
+
+
+capture_step = whole(capture_step_parts, "capture_step")
 
 
 def _checked_state(time: float, rate: float, end: float, stance: str, position_com_in_world: Array,
@@ -251,45 +273,52 @@ class _StanceFoot:
         # 2. the landing, for each swing time on the grid
         self.gap_least = 2 * half[1] - 2 * robot.sole_center_y + settings.feet_clearance  # ankle gap across stance
 
-    def off_the_stance(self, landing: Array) -> Array:
-        """``landing`` moved out across the stance foot until the soles' inner edges keep the clearance."""
-        across = turned(landing - self.st_ankle, -self.st_yaw)
-        if self.sw_side * across[1] >= self.gap_least:
-            return landing
-        across[1] = self.sw_side * self.gap_least
-        return self.st_ankle + turned(across, self.st_yaw)
+    def off_the_stance(self, landings: Array) -> Array:
+        """``landings`` (k, 2) [m], each moved out across the stance foot until the soles' inner edges keep the
+        clearance."""
+        c, s = math.cos(self.st_yaw), math.sin(self.st_yaw)
+        rx, ry = landings[:, 0] - self.st_ankle[0], landings[:, 1] - self.st_ankle[1]
+        along, across = c * rx + s * ry, -s * rx + c * ry
+        moved = self.sw_side * across < self.gap_least
+        across = np.where(moved, self.sw_side * self.gap_least, across)
+        out = np.column_stack([self.st_ankle[0] + c * along - s * across, self.st_ankle[1] + s * along + c * across])
+        return np.where(moved[:, None], out, landings)
 
-    def landing_after(self, duration: float) -> tuple[float, Array, Array]:
-        """How far the foot misses the way at the foot speed [m] (<= 0: it makes it), xi(T) and the landing."""
+    def landings_after(self, durations: Array) -> tuple[Array, Array, Array]:
+        """For each swing time of ``durations`` (k,) [s]: how far the foot misses the way at the foot speed [m]
+        (<= 0: it makes it), xi(T) and the landing [m], (k,) and (k, 2) each."""
         p1 = self.p1
-        dcm_touchdown = p1 + (self.dcm - p1) * math.exp(self.omega * duration)
+        dcm_touchdown = p1 + (self.dcm - p1) * np.exp(self.omega * durations)[:, None]
         ahead = dcm_touchdown - p1
-        norm = float(np.linalg.norm(ahead))
-        sole_center = dcm_touchdown + (self.settings.landing_inset * ahead / norm if norm > 0 else 0.0)
-        landing = self.off_the_stance(sole_center - turned(self.sw_center_local, self.st_yaw))
-        miss = float(np.linalg.norm(landing - self.swing_ankle)) - self.settings.foot_speed * duration
+        norm = np.hypot(ahead[:, 0], ahead[:, 1])
+        unit = np.divide(ahead, norm[:, None], out=np.zeros_like(ahead), where=norm[:, None] > 0)
+        landing = self.off_the_stance(dcm_touchdown + self.settings.landing_inset * unit
+                                      - turned(self.sw_center_local, self.st_yaw))
+        way = landing - self.swing_ankle
+        miss = np.hypot(way[:, 0], way[:, 1]) - self.settings.foot_speed * durations
         return miss, dcm_touchdown, landing
 
     def swing(self, time: float, touchdown: float | None) -> tuple[float, Array, Array]:
         """The swing time ``T`` [s], ``xi(T)`` [m] and the landing [m] (the module docstring's step 2), for a capture
-        at ``time`` [s] (``touchdown``: :func:`capture_step`'s)."""
+        at ``time`` [s] (``touchdown``: :func:`capture_step`'s): every swing time of the grid at once."""
         settings = self.settings
         shortest = settings.shortest_swing if touchdown is None else max(touchdown - time, LEAST_REPLANNED_SWING)
         first = round(shortest / SWING_GRID)
-        durations = np.arange(first, max(round(settings.longest_swing / SWING_GRID), first) + 1) * SWING_GRID
-        candidates = [(float(duration), *self.landing_after(float(duration))) for duration in durations]
-        fitting = [c for c in candidates if c[1] <= 0.0]
+        grid = np.arange(first, max(round(settings.longest_swing / SWING_GRID), first) + 1)
+        durations = np.asarray(grid * SWING_GRID, dtype=np.float64)
+        miss, dcm_touchdown, landing = self.landings_after(durations)
+        fitting = np.flatnonzero(miss <= 0.0)
         # the shortest swing that makes its way at the foot speed, else the one that misses it least
-        swing_time, _, dcm_touchdown, landing = fitting[0] if fitting else min(candidates, key=lambda c: c[1])
-        return swing_time, dcm_touchdown, landing
+        best = int(fitting[0]) if len(fitting) else int(np.argmin(miss))
+        return float(durations[best]), dcm_touchdown[best], landing[best]
 
 
 def _within_reach(plan: CaptureState, n: int, landing: Array, stance_foot: _StanceFoot,
-                  settle: float) -> tuple[WalkingPattern, Array, float, float, Array, bool]:
+                  settle: float) -> Parts[tuple[WalkingPattern, Array, float, float, Array, bool]]:
     """:func:`_settled` (from ``settle`` [s]) for ``landing``, pulled towards the stance foot
     (:data:`REACH_SHRINK`, up to :data:`REACH_TRIES` times) until both legs keep :data:`REACH_MARGIN` of their
-    reach: the pattern, the rest point, the settle [s], the least ZMP margin [m], the landing [m] and whether it was
-    not pulled in.
+    reach, in parts: the pattern, the rest point, the settle [s], the least ZMP margin [m], the landing [m] and
+    whether it was not pulled in.
 
     Raises:
         UnreachableError: Still out of reach after the last pull.
@@ -297,7 +326,11 @@ def _within_reach(plan: CaptureState, n: int, landing: Array, stance_foot: _Stan
     robot = plan.robot
     reached = True
     for attempt in range(REACH_TRIES + 1):
-        pattern, rest, settled, margin = _settled(plan, n, landing, settle)
+        settled, margin = _settled(plan, landing, settle)
+        yield
+        samples = max(n, math.ceil((plan.swing_time + settled + 1.0 / plan.omega) * plan.rate) + 1)
+        pattern, rest = yield from capture_pattern_parts(plan, np.arange(samples) / plan.rate, settled, landing)
+        yield
         excess = leg_reach_excess(pattern.position_pelvis_in_world, pattern.yaw_pelvis_in_world,
                                   pattern.position_left_ankle_in_world, pattern.position_right_ankle_in_world, robot)
         worst = int(np.argmax([excess[0].max(), excess[1].max()]))
@@ -309,22 +342,22 @@ def _within_reach(plan: CaptureState, n: int, landing: Array, stance_foot: _Stan
                                    float(excess[worst].max()) + REACH_MARGIN,
                                    f"capture step, after {REACH_TRIES} landings pulled towards the stance foot")
         reached = False
-        landing = stance_foot.off_the_stance(stance_foot.st_ankle + REACH_SHRINK * (landing - stance_foot.st_ankle))
+        pulled = stance_foot.st_ankle + REACH_SHRINK * (landing - stance_foot.st_ankle)
+        landing = stance_foot.off_the_stance(pulled[None, :])[0]
+        yield
     return pattern, rest, settled, margin, landing, reached
 
 
-def _settled(plan: CaptureState, n: int, landing: Array, settle: float) -> tuple[WalkingPattern, Array, float, float]:
-    """:func:`~zmpwalk.capture_pattern.capture_pattern` with the ``settle`` [s] doubled (up to :data:`SETTLE_TRIES`
-    times) until the ZMP stays in the feet: the pattern, the rest point, the settle [s] and the least ZMP margin [m]
-    (< 0: it leaves them)."""
+def _settled(plan: CaptureState, landing: Array, settle: float) -> tuple[float, float]:
+    """The ``settle`` [s] doubled (up to :data:`SETTLE_TRIES` times) until the ZMP stays in the feet, and the least
+    ZMP margin [m] (< 0: it leaves them), in closed form (:func:`~zmpwalk.capture_pattern.zmp_margin_of_capture`:
+    no pattern is sampled)."""
     for tries in range(SETTLE_TRIES + 1):
-        samples = max(n, math.ceil((plan.swing_time + settle + 1.0 / plan.omega) * plan.rate) + 1)
-        pattern, rest = capture_pattern(plan, np.arange(samples) / plan.rate, settle, landing)
-        margin = float(pattern.zmp_margin().min())
+        margin = zmp_margin_of_capture(plan, landing, settle)
         if margin >= -ZMP_TOLERANCE or tries == SETTLE_TRIES:
             break
         settle *= 2.0
-    return pattern, rest, settle, margin
+    return settle, margin
 
 
 __all__ = ["REACH_MARGIN", "CapturePlan", "CaptureSettings", "capture_step", "capture_wanted", "quintic_from_rest"]

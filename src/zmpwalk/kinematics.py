@@ -299,10 +299,11 @@ def _base_under_com(position_com_in_world: Array, yaw_pelvis_in_world: Array, fe
     return base, solutions
 
 
-def pattern_joint_trajectory(pattern: SampledMotion, knee_forward: bool = True,
-                             check_limits: bool = True) -> JointTrajectory:
-    """Joint angles and velocities of a :class:`~zmpwalk.patterns.result.WalkingPattern` (any generator)."""
-    return joint_trajectory(
+def pattern_joint_trajectory_in_parts(pattern: SampledMotion, knee_forward: bool = True,
+                                      check_limits: bool = True) -> Parts[JointTrajectory]:
+    """Joint angles and velocities of a :class:`~zmpwalk.patterns.result.WalkingPattern` (any generator), in parts
+    (:func:`joint_trajectory_in_parts`); :func:`pattern_joint_trajectory` runs it whole."""
+    return joint_trajectory_in_parts(
         pattern.time, pattern.position_pelvis_in_world, pattern.yaw_pelvis_in_world,
         pattern.velocity_pelvis_in_world, pattern.yaw_rate_pelvis,
         ((pattern.position_left_ankle_in_world, pattern.yaw_left_foot_in_world,
@@ -310,6 +311,9 @@ def pattern_joint_trajectory(pattern: SampledMotion, knee_forward: bool = True,
          (pattern.position_right_ankle_in_world, pattern.yaw_right_foot_in_world,
           pattern.velocity_right_ankle_in_world, pattern.yaw_rate_right_foot)),
         pattern.robot, knee_forward, check_limits)
+
+
+pattern_joint_trajectory = whole(pattern_joint_trajectory_in_parts, "pattern_joint_trajectory")
 
 
 _STRAIGHT_CHAINS: dict[int, tuple[weakref.ref[RobotModel], tuple[LegChain, LegChain]]] = {}  # by id(robot)

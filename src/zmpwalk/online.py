@@ -443,12 +443,32 @@ class OnlineWalker:
         if current is None:
             row, (code, pelvis_yaw, left_yaw, right_yaw) = self._standing.copy(), self._standing_scalars
         else:
-            offset = index - current.first_index
-            row, (codes, pelvis_yaws, left_yaws, right_yaws) = current.rows[offset].copy(), current.scalars
-            code, pelvis_yaw, left_yaw, right_yaw = codes[offset], pelvis_yaws[offset], left_yaws[offset], \
-                right_yaws[offset]
+            row, (code, pelvis_yaw, left_yaw, right_yaw) = self._row(current, index)
         if work and self._job is not None:
             self._work()
+        return self._sample(index, row, code, pelvis_yaw, left_yaw, right_yaw)
+
+    def peek(self, ahead: int = 0) -> WalkingSample | None:
+        """The sample :meth:`tick` will return ``ahead`` ticks after the next one (0: the next), where the step under
+        way holds it (None beyond that step's rows, or standing): what the walk plays there unless a command or a
+        stop changes the step after. Bounded: one row copy."""
+        current, index = self._current, self._index + ahead
+        if current is None or not current.first_index <= index < current.first_index + len(current.rows):
+            return None
+        row, (code, pelvis_yaw, left_yaw, right_yaw) = self._row(current, index)
+        return self._sample(index, row, code, pelvis_yaw, left_yaw, right_yaw)
+
+    @staticmethod
+    def _row(plan: CheckedPlan, index: int) -> tuple[Array, tuple[float, float, float, float]]:
+        """A copy of ``plan``'s row at tick ``index`` and its support code and yaws (Python scalars)."""
+        offset = index - plan.first_index
+        codes, pelvis_yaws, left_yaws, right_yaws = plan.scalars
+        row: Array = plan.rows[offset].copy()
+        return row, (codes[offset], pelvis_yaws[offset], left_yaws[offset], right_yaws[offset])
+
+    def _sample(self, index: int, row: Array, code: float, pelvis_yaw: float, left_yaw: float,
+                right_yaw: float) -> WalkingSample:
+        """The sample of tick ``index`` from its row (a copy the sample owns) and scalars."""
         return WalkingSample(
             time=index / self.rate,
             support=_SUPPORT_OF_CODE[code],

@@ -21,19 +21,22 @@ triggers it (4-6 ms of CPU on a 2-core machine): a capture is not yet bounded wo
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk.balance import BalanceMeasurement, Stabilizer
-from zmpwalk.capture import CAPTURE_INTERVAL, CapturePlan, CaptureSettings, capture_step, capture_wanted
+from zmpwalk.capture import CAPTURE_INTERVAL, CapturePlan, CaptureSettings, capture_step_parts, capture_wanted
+from zmpwalk.errors import ZmpwalkError
 from zmpwalk.footsteps import Pose2D, Stance
-from zmpwalk.kinematics import JointTrajectory, pattern_joint_trajectory
+from zmpwalk.kinematics import JointTrajectory, pattern_joint_trajectory_in_parts
 from zmpwalk.online import WalkingSample
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sides import SUPPORT_LABELS
+from zmpwalk.slices import Parts
 
 Array = NDArray[np.float64]
 
@@ -87,6 +90,11 @@ class CaptureMotion:
             joint_velocities=(standing.joint_angles - last.joint_angles) / BLEND if share < 1.0  # type: ignore[operator]
             else np.zeros(12))
 
+    def planned(self, tick: int) -> WalkingSample | None:
+        """The pattern's sample of controller tick ``tick``, where the pattern holds it (None after its end)."""
+        i = tick - self.first
+        return self._row(i) if 0 <= i < len(self.pattern.time) else None
+
     def ended(self, tick: int) -> bool:
         """Whether the pattern has ended by controller tick ``tick`` (the robot at rest on both feet)."""
         return tick - self.first >= len(self.pattern.time) - 1
@@ -117,61 +125,180 @@ class CaptureMotion:
                       Pose2D(float(right[0]), float(right[1]), float(p.yaw_right_foot_in_world[-1])), 0)
 
 
+@dataclass
+class _Planning:
+    """A capture step being planned: its parts, the tick it takes over at, the single support it was planned in."""
+
+    parts: Parts[tuple[WalkingPattern, CapturePlan, JointTrajectory]]
+    first: int  # [ticks]
+    support: str
+    expected: int  # parts it is paced for
+    done: int = 0  # parts run
+    result: tuple[WalkingPattern, CapturePlan, JointTrajectory] | None = None
+
+
 class CapturePolicy:
     """When and how the controller takes a capture step (module docstring).
 
     Args:
         robot: The robot.
         rate: Control rate [Hz].
-        settings: The trigger and the capture step's limits.
+        settings: The trigger, the lead and the capture step's limits.
 
     Attributes:
-        captures: The capture steps planned, in order.
+        captures: The capture steps taken, in order.
+        lead: Ticks from the trigger to the take-over (at least one).
+        parts_per_tick: The most parts of a plan one tick has run so far.
     """
 
     def __init__(self, robot: RobotModel, rate: float, settings: CaptureSettings) -> None:
         self.robot, self.rate, self.settings = robot, float(rate), settings
         self.captures: list[CapturePlan] = []
+        self.lead = max(1, round(settings.lead * self.rate))
+        self.parts_per_tick = 0
         self._last = -math.inf  # [ticks] of the last plan
+        self._planning: _Planning | None = None
+        self._expected = EXPECTED_PARTS
+        self._errors = np.zeros((max(1, round(ERROR_RATE_WINDOW * self.rate)) + 1, 2))  # [m] the last DCM errors
+        self._observed = 0
+
+    @property
+    def planning(self) -> bool:
+        """True while a capture step is being planned."""
+        return self._planning is not None
 
     def due(self, tick: int, sample: WalkingSample, stabilizer: Stabilizer, measurement: BalanceMeasurement) -> bool:
-        """Whether a capture step is planned at ``tick`` (``sample``'s, after the stabilizer's update on
-        ``measurement``): :func:`~zmpwalk.capture.capture_wanted` in a single support."""
-        if sample.support == "double" or tick - self._last < CAPTURE_INTERVAL * self.rate:
+        """Whether a capture step is planned from ``tick`` (``sample``'s, after the stabilizer's update on
+        ``measurement``): none being planned, :func:`~zmpwalk.capture.capture_wanted` in a single support."""
+        if self._planning is not None or sample.support == "double" or tick - self._last < CAPTURE_INTERVAL * self.rate:
             return False
-        swing = measurement.wrench_right if sample.support == "left" else measurement.wrench_left
-        return capture_wanted(stabilizer.state.dcm_error, self.settings.trigger, float(swing[2]),
+        return capture_wanted(stabilizer.state.dcm_error, self.settings.trigger, _swing_force(sample, measurement),
                               stabilizer.load_threshold)
 
-    def plan(self, tick: int, sample: WalkingSample, previous: WalkingSample, stabilizer: Stabilizer,
-             under_way: CaptureMotion | None) -> CaptureMotion:
-        """The capture step from tick ``tick + 1`` on, from ``sample`` (``previous``: the tick before it, for the
-        planned velocities) and the stabilizer's estimate; ``under_way``: the capture being played, if any.
-
-        Raises:
-            UnreachableError, InfeasiblePatternError: No capture step fits (the caller walks on as planned).
-        """
-        self._last = tick  # a plan that fails is tried again only after the interval, as one that succeeds
+    def start(self, tick: int, sample: WalkingSample, previous: WalkingSample, stabilizer: Stabilizer,
+              under_way: CaptureMotion | None, ahead: Callable[[int], WalkingSample | None]) -> bool:
+        """Begin planning the capture step that takes over at tick ``tick + lead``, from the state the walk plays
+        then: its planned samples at the two ticks before (``ahead(i)``: the sample played ``i + 1`` ticks after
+        ``tick``, None where not known yet; ``sample`` and ``previous``, ticks ``tick`` and ``tick - 1``, where the
+        lead is shorter), and the stabilizer's DCM error grown over the lead (:meth:`predicted_dcm_error`);
+        ``under_way``: the capture being played, if any. False where the single support ends within the lead (no
+        plan: the step lands first)."""
+        self._last = tick  # tried again only after the interval, as a plan that fails
+        lead = self.lead
+        before = [sample if lead == 1 else ahead(lead - 2), previous if lead == 1 else
+                  sample if lead == 2 else ahead(lead - 3)]  # ticks first - 1 and first - 2
+        last, second = before
+        if last is None or second is None or last.support != sample.support:
+            return False
         dt = 1.0 / self.rate
         stance, swing = sample.support, "right" if sample.support == "left" else "left"
-        position = sample.position_pelvis_in_world
-        velocity = (position - previous.position_pelvis_in_world) / dt
-        ankles = [sample.position_left_ankle_in_world, sample.position_right_ankle_in_world]
-        rates = [(a - b) / dt for a, b in zip(ankles, (previous.position_left_ankle_in_world,
-                                                        previous.position_right_ankle_in_world), strict=True)]
+        position = last.position_pelvis_in_world
+        velocity = (position - second.position_pelvis_in_world) / dt
+        ankles = [last.position_left_ankle_in_world, last.position_right_ankle_in_world]
+        rates = [(a - b) / dt for a, b in zip(ankles, (second.position_left_ankle_in_world,
+                                                        second.position_right_ankle_in_world), strict=True)]
         ankles = [a + r * dt for a, r in zip(ankles, rates, strict=True)]  # at the capture's first tick
         ankles[0 if swing == "left" else 1][:2] += stabilizer.landing_correction(swing)
         position_next = position + velocity * dt
-        dcm = position_next[:2] + velocity[:2] / stabilizer.omega + stabilizer.state.dcm_error
+        error = self.predicted_dcm_error(lead - 1)
+        dcm = position_next[:2] + velocity[:2] / stabilizer.omega + error
         touchdown = None if under_way is None else under_way.plan.time + under_way.plan.swing_time
-        start = sample.time + dt
-        pattern, plan = capture_step(
-            self.robot, time=start, rate=self.rate, end=start + REST, stance=stance,
-            position_com_in_world=position_next, dcm_in_world=dcm, yaw_pelvis_in_world=sample.yaw_pelvis_in_world,
+        begin = last.time + dt
+        parts = capture_step_parts(
+            self.robot, time=begin, rate=self.rate, end=begin + REST, stance=stance,
+            position_com_in_world=position_next, dcm_in_world=dcm, yaw_pelvis_in_world=last.yaw_pelvis_in_world,
             ankles_in_world=(ankles[0], ankles[1]), ankle_velocities_in_world=(rates[0], rates[1]),
-            foot_yaws=(sample.yaw_left_foot_in_world, sample.yaw_right_foot_in_world), settings=self.settings,
+            foot_yaws=(last.yaw_left_foot_in_world, last.yaw_right_foot_in_world), settings=self.settings,
             touchdown=touchdown)
-        joints = pattern_joint_trajectory(pattern, check_limits=False)  # may raise: before any side effect
-        stabilizer.hand_over_landing(swing)  # the capture's swing starts where the correction aimed it
+        self._planning = _Planning(_with_joints(parts), tick + lead, stance, self._expected)
+        return True
+
+    def observe(self, dcm_error: Array) -> None:
+        """Keep this tick's DCM error of the stabilizer [m], (2,) (called every tick: its rate over the last
+        :data:`ERROR_RATE_WINDOW` predicts it over the lead)."""
+        self._errors[self._observed % len(self._errors)] = dcm_error
+        self._observed += 1
+
+    def predicted_dcm_error(self, ticks: int) -> Array:
+        r"""The stabilizer's DCM error ``ticks`` control periods after the last observed one [m], (2,).
+
+        The pendulum's DCM obeys :math:`\dot\xi = \omega(\xi - p)` for the plan and for the robot, so the error
+        obeys :math:`\dot e = \omega (e - \Delta p)`, ``Delta p`` the ZMP's offset from the plan's that acts on
+        the body: the stabilizer's clamped correction as far as the sole achieves it, and a push still acting. It is
+        taken from the error's own rate over the last :data:`ERROR_RATE_WINDOW` (:math:`\Delta p = e - \dot e /
+        \omega`) and held, which gives :math:`e(t) = e + (\dot e / \omega)(e^{\omega t} - 1)`. (A push 36 N s
+        backward on HUBO: the error grew from 80.4 to 111.8 mm over 20 ms, this predicts 110.7 mm; the stabilizer's
+        desired ZMP alone, ``Delta p = p_d - p_ref``, predicted 78.9 mm.)"""
+        size = len(self._errors)
+        span = min(self._observed - 1, size - 1)
+        error = self._errors[(self._observed - 1) % size]
+        if span <= 0 or ticks <= 0:
+            return np.array(error, dtype=np.float64)
+        rate = (error - self._errors[(self._observed - 1 - span) % size]) * self.rate / span  # [m/s]
+        omega = math.sqrt(self.robot.gravity / self.robot.pendulum_length)
+        return np.asarray(error + rate / omega * math.expm1(omega * ticks / self.rate), dtype=np.float64)
+
+    def work(self, tick: int, sample: WalkingSample, measurement: BalanceMeasurement,
+             stabilizer: Stabilizer) -> None:
+        """Run this tick's share of the plan's parts: the parts left over the ticks left before its take-over, at
+        least one (a count, not a time: the same walk plans the same way on any machine). The plan is dropped where
+        the single support it was planned in has ended or its swinging sole is loaded (the step has landed), or where
+        it fails (no capture step fits: the walk goes on as planned). With a lead of one tick, the whole plan in this
+        tick."""
+        job = self._planning
+        if job is None or job.result is not None:
+            return
+        if sample.support != job.support or _swing_force(sample, measurement) > stabilizer.load_threshold:
+            self._planning = None
+            return
+        ticks_left = max(job.first - tick, 1)
+        quota = max(-(-(max(job.expected - job.done, 1)) // ticks_left), 1) if self.lead > 1 else 1 << 30
+        for count in range(quota):
+            try:
+                next(job.parts)
+            except StopIteration as finished:
+                job.result = finished.value
+                self._expected = job.done + count + 1
+                break
+            except ZmpwalkError:
+                self._planning = None
+                return
+            finally:
+                self.parts_per_tick = max(self.parts_per_tick, count + 1)
+        job.done += quota
+
+    def take_over(self, tick: int, stabilizer: Stabilizer) -> CaptureMotion | None:
+        """The capture step that takes over at ``tick``, where its plan is complete (one not complete by then is
+        dropped: a later trigger plans again from the state then); its swing starts where the stabilizer's landing
+        correction aimed it, which it hands over."""
+        job = self._planning
+        if job is None or tick < job.first:
+            return None
+        self._planning = None
+        if job.result is None:
+            return None
+        self._last = tick  # the next capture at least CAPTURE_INTERVAL after this one takes over
+        pattern, plan, joints = job.result
+        stabilizer.hand_over_landing(plan.swing)
         self.captures.append(plan)
-        return CaptureMotion(plan, pattern, joints, tick + 1, self.rate)
+        return CaptureMotion(plan, pattern, joints, tick, self.rate)
+
+
+ERROR_RATE_WINDOW = 0.005  # [s] the DCM error's rate is taken over this (whole ticks, at least one)
+EXPECTED_PARTS = 40  # the parts a capture plan is paced for before the first one has been counted
+
+
+def _swing_force(sample: WalkingSample, measurement: BalanceMeasurement) -> float:
+    """The measured normal force [N] on the swinging sole of ``sample``'s single support."""
+    swing = measurement.wrench_right if sample.support == "left" else measurement.wrench_left
+    return float(swing[2])
+
+
+def _with_joints(parts: Parts[tuple[WalkingPattern, CapturePlan]]) -> Parts[tuple[WalkingPattern, CapturePlan,
+                                                                                   JointTrajectory]]:
+    """A capture step's parts, then its joint angles' (:func:`~zmpwalk.kinematics.pattern_joint_trajectory_in_parts`,
+    no range check: a capture is taken within reach whatever the joints' soft ranges)."""
+    pattern, plan = yield from parts
+    yield
+    joints = yield from pattern_joint_trajectory_in_parts(pattern, check_limits=False)
+    return pattern, plan, joints

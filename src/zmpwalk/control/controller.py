@@ -320,6 +320,8 @@ class WalkingController:
         begin = online._clock()
         walker, tick, previous = self.walker, self._ticks, self._sample
         sample = walker.tick(work=False)  # ticked during a capture too: its clock runs on, standing
+        if self._capture is not None and self._capture.planning and self.stabilizer is not None:
+            self._take_over(tick)
         if self._motion is not None:
             sample = self._motion.sample(tick, None if self._stranded else sample)
         self._sample = sample
@@ -345,14 +347,33 @@ class WalkingController:
 
     def _capture_step(self, tick: int, sample: WalkingSample, previous: WalkingSample,
                       measurement: BalanceMeasurement) -> None:
-        """Plan a capture step from the next tick where one is due (:mod:`zmpwalk.control.capture`)."""
+        """Begin planning a capture step where one is due, and run this tick's parts of the plan under way
+        (:mod:`zmpwalk.control.capture`)."""
         policy, stabilizer = self._capture, self.stabilizer
-        if policy is None or stabilizer is None or not policy.due(tick, sample, stabilizer, measurement):
+        if policy is None or stabilizer is None:
             return
-        try:
-            motion = policy.plan(tick, sample, previous, stabilizer, self._motion)
-        except ZmpwalkError:
-            return  # no capture step fits: the walk goes on as planned
+        policy.observe(stabilizer.state.dcm_error)
+        if policy.due(tick, sample, stabilizer, measurement):
+            policy.start(tick, sample, previous, stabilizer, self._motion, self._ahead)
+        if policy.planning:
+            policy.work(tick, sample, measurement, stabilizer)
+
+    def _ahead(self, ahead: int) -> WalkingSample | None:
+        """The sample played ``ahead + 1`` ticks after the last one, where known now (the capture's pattern under
+        way, else the walker's step under way)."""
+        if self._motion is not None:
+            return self._motion.planned(self._ticks + ahead)
+        return self.walker.peek(ahead)
+
+    def _take_over(self, tick: int) -> None:
+        """Let the capture step planned for ``tick`` take over (its plan complete), the walker standing where it
+        leaves the feet; a step given before the push or during the capture is walked after it."""
+        policy, stabilizer = self._capture, self.stabilizer
+        if policy is None or stabilizer is None:
+            return
+        motion = policy.take_over(tick, stabilizer)
+        if motion is None:
+            return
         walker = self.walker
         waiting = walker.checking or walker.queued  # a step given before the push: walked after the capture
         if self._deferred is None and waiting is not None and not waiting.stop:
