@@ -106,7 +106,7 @@ class CaptureSettings:
     landing_inset: float = 0.03  # [m]
     feet_clearance: float = 0.02  # [m]
     settle: float = 1.0  # [s]
-    lead: float = 0.03  # [s]
+    lead: float = 0.04  # [s]
 
     def __post_init__(self) -> None:
         for name, value in vars(self).items():
@@ -323,16 +323,13 @@ def _within_reach(plan: CaptureState, n: int, landing: Array, stance_foot: _Stan
     Raises:
         UnreachableError: Still out of reach after the last pull.
     """
-    robot = plan.robot
     reached = True
     for attempt in range(REACH_TRIES + 1):
         settled, margin = _settled(plan, landing, settle)
         yield
         samples = max(n, math.ceil((plan.swing_time + settled + 1.0 / plan.omega) * plan.rate) + 1)
         pattern, rest = yield from capture_pattern_parts(plan, np.arange(samples) / plan.rate, settled, landing)
-        yield
-        excess = leg_reach_excess(pattern.position_pelvis_in_world, pattern.yaw_pelvis_in_world,
-                                  pattern.position_left_ankle_in_world, pattern.position_right_ankle_in_world, robot)
+        excess = yield from _reach_excess(pattern)
         worst = int(np.argmax([excess[0].max(), excess[1].max()]))
         if float(excess[worst].max()) <= -REACH_MARGIN:
             break
@@ -346,6 +343,19 @@ def _within_reach(plan: CaptureState, n: int, landing: Array, stance_foot: _Stan
         landing = stance_foot.off_the_stance(pulled[None, :])[0]
         yield
     return pattern, rest, settled, margin, landing, reached
+
+
+def _reach_excess(pattern: WalkingPattern) -> Parts[tuple[Array, Array]]:
+    """:func:`~zmpwalk.kinematics.leg_reach_excess` of every sample of ``pattern``, left and right [m], in two parts
+    (each half of the samples)."""
+    half = (len(pattern.time) + 1) // 2
+    pieces = []
+    for rows in (slice(0, half), slice(half, None)):
+        yield
+        pieces.append(leg_reach_excess(pattern.position_pelvis_in_world[rows], pattern.yaw_pelvis_in_world[rows],
+                                       pattern.position_left_ankle_in_world[rows],
+                                       pattern.position_right_ankle_in_world[rows], pattern.robot))
+    return np.concatenate([pieces[0][0], pieces[1][0]]), np.concatenate([pieces[0][1], pieces[1][1]])
 
 
 def _settled(plan: CaptureState, landing: Array, settle: float) -> tuple[float, float]:

@@ -102,9 +102,9 @@ def capture_pattern_parts(plan: CaptureState, s: Array, settle: float,
     robot, st, omega = plan.robot, plan.st, plan.omega
     rest = rest_point(plan, landing)
     xi, xi_rate = _dcm_at(plan, rest, settle, s)
-    zmp = xi - xi_rate / omega  # p = xi - xi' / omega
     yield
-    c = _com_path(plan, rest, settle, s)
+    zmp = xi - xi_rate / omega  # p = xi - xi' / omega
+    c = yield from _com_path(plan, rest, settle, s)
     yield
     n = len(s)
     pelvis = np.column_stack([c, np.full(n, plan.com[2])])
@@ -193,7 +193,7 @@ def _dcm_at(plan: CaptureState, rest: Array, settle: float, t: Array) -> tuple[A
     return xi, rate_xi
 
 
-def _com_path(plan: CaptureState, rest: Array, settle: float, s: Array) -> Array:
+def _com_path(plan: CaptureState, rest: Array, settle: float, s: Array) -> Parts[Array]:
     r"""The CoM's horizontal path [m] (n, 2) at ``s``: the solution of ``c' = omega (xi - c)`` from the plan's CoM
     point, in closed form for each phase of :func:`_dcm_at`'s DCM:
 
@@ -205,7 +205,8 @@ def _com_path(plan: CaptureState, rest: Array, settle: float, s: Array) -> Array
       ``u = -1 / (omega settle)``;
     - at rest, ``xi = m``: :math:`c = m + (c_E - m) e^{-\omega (t - T - settle)}`.
 
-    Each is checked against a fine numerical integration in the tests. Bounded work: no loop over the samples.
+    Each is checked against a fine numerical integration in the tests. Bounded work: no loop over the samples; a
+    part per phase.
     """
     omega, swing_time, p1 = plan.omega, plan.swing_time, plan.p1
     c0, a = plan.com[:2], plan.dcm - plan.p1
@@ -238,7 +239,9 @@ def _com_path(plan: CaptureState, rest: Array, settle: float, s: Array) -> Array
     resting = t > end
     settle_mask = ~single_mask & ~resting
     c[single_mask] = single(t[single_mask][:, None])
+    yield
     c[settle_mask] = settling(t[settle_mask][:, None])
+    yield
     c[resting] = rest + (c_end - rest) * np.exp(-omega * (t[resting][:, None] - end))
     return c
 

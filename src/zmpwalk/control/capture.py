@@ -1,21 +1,33 @@
 """Capture steps in the walking controller: a pushed walk becomes one capture step and a stop, tick by tick.
 
 :class:`CapturePolicy` is what :class:`~zmpwalk.control.WalkingController` asks after each stabilizer tick: in a
-single support, at least :data:`~zmpwalk.capture.CAPTURE_INTERVAL` after the last plan, with the
+single support, at least :data:`~zmpwalk.capture.CAPTURE_INTERVAL` after the last capture took over, with the
 stabilizer's DCM error beyond :attr:`CaptureSettings.trigger`, it plans the rest of the walk as one capture step
 and a stop (:func:`zmpwalk.capture.capture_step`, Eqs. of the capture point: the swinging foot lands where the
-measured DCM can come to rest) from the tick's planned state and the measured DCM: ``xi = c + c' / omega +
-dcm_error``, the swinging ankle aimed where the stabilizer's landing correction put it. The
-:class:`CaptureMotion` (that pattern and its joint angles) then replaces the walker's samples from the next tick
-on; a later trigger in the capture's own single support re-plans from it, landing no later than the capture under
-way needs. The walker stands where the capture leaves the feet from the plan on
-(:meth:`~zmpwalk.online.OnlineWalker.stand_at`); the capture's last pose blends into the walker's standing one
-over :data:`BLEND` (the capture's pattern has not quite come to rest); a step given before the push or during the
-capture is given to the walker after it and walks on from there. Where the walker's standing pose cannot reach
-those feet, the controller holds the capture's last pose (:attr:`WalkingController.stranded`).
+measured DCM can come to rest).
 
-As the batch walk's (:class:`zmpwalk.sim.replan.CaptureReplanner`), the plan is made inside the tick that
-triggers it (4-6 ms of CPU on a 2-core machine): a capture is not yet bounded work.
+**Bounded work per tick.** The plan does not run inside the triggering tick: it takes over
+:attr:`CaptureSettings.lead` later (40 ticks at 1 kHz), from the state the walk plays then, and its parts
+(:func:`~zmpwalk.capture.capture_step_parts` and the joints', each at most about 0.2 ms) run over the ticks
+in between, the parts left spread evenly over the ticks left (a count, not a clock: the same walk plans the same
+way on any machine). That state is known at the trigger: the walker's step under way holds its samples
+(:meth:`~zmpwalk.online.OnlineWalker.peek`), a capture under way its pattern; the DCM there is the plan's plus
+the stabilizer's error predicted over the lead from its own rate (:meth:`CapturePolicy.predicted_dcm_error`: the
+pendulum with the ZMP offset held that moves it now, a push still acting included). The swinging ankle starts
+where the stabilizer's landing correction aims it at the trigger. A plan whose single support ends first (the
+foot lands), or that is not complete when its tick comes (more landings tried than it was paced for), is
+dropped and the walk goes on; a later trigger plans again.
+
+The :class:`CaptureMotion` (that pattern and its joint angles) then replaces the walker's samples; a later
+trigger in the capture's own single support re-plans from it, landing no later than the capture under way needs.
+The walker stands where the capture leaves the feet from then on (:meth:`~zmpwalk.online.OnlineWalker.stand_at`);
+the capture's last pose blends into the walker's standing one over :data:`BLEND` (the capture's pattern has not
+quite come to rest); a step given before the push or during the capture is given to the walker after it and walks
+on from there. Where the walker's standing pose cannot reach those feet, the controller holds the capture's last
+pose (:attr:`WalkingController.stranded`).
+
+The batch walk (:class:`zmpwalk.sim.replan.CaptureReplanner`) plans inside the triggering tick, as a lead of 0
+does here.
 """
 
 from __future__ import annotations

@@ -196,6 +196,12 @@ class WalkingController:
         return self._stranded
 
     @property
+    def capture(self) -> CapturePolicy | None:
+        """The capture policy (its lead and pacing: :class:`~zmpwalk.control.capture.CapturePolicy`), or None
+        without ``capture``."""
+        return self._capture
+
+    @property
     def captures(self) -> list[CapturePlan]:
         """The capture steps taken, in order (empty without ``capture``)."""
         return [] if self._capture is None else self._capture.captures

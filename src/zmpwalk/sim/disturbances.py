@@ -126,6 +126,14 @@ class SensorNoise:
         measurement.joint_angles = measurement.joint_angles + rng.normal(0, self.encoder, 12)
 
 
+def _as_slice(index: NDArray[np.intp]) -> NDArray[np.intp] | slice:
+    """``index`` as a slice where it is one run of consecutive columns (a slice reads a row's columns without the
+    copy and the bounds checks of an index array)."""
+    if len(index) and (np.diff(index) == 1).all():
+        return slice(int(index[0]), int(index[-1]) + 1)
+    return index
+
+
 class _MeasurementReader:
     """The stabilizer's inputs from one row of sensor data (:meth:`read`), with the sensors' columns found once.
 
@@ -138,11 +146,11 @@ class _MeasurementReader:
         def columns(*names: str) -> NDArray[np.intp]:
             return np.concatenate([np.arange(sensors.slices[n].start, sensors.slices[n].stop) for n in names])
 
-        self._left = columns("left_force", "left_torque")
-        self._right = columns("right_force", "right_torque")
+        self._left = _as_slice(columns("left_force", "left_torque"))
+        self._right = _as_slice(columns("right_force", "right_torque"))
         self._quaternion = sensors.slices["pelvis_quat"]
         self._gyro = sensors.slices["pelvis_gyro"]
-        self._joints = columns(*(f"{c}_q" for c in JOINT_COLUMNS))
+        self._joints = _as_slice(columns(*(f"{c}_q" for c in JOINT_COLUMNS)))
         self._floor = None if floor is None or np.allclose(floor, np.eye(3)) else floor
 
     def read(self, row: Array) -> BalanceMeasurement:
@@ -156,6 +164,7 @@ class _MeasurementReader:
             level = self._floor @ rotation_from_quaternion(row[None, self._quaternion])[0]
             roll, pitch = math.atan2(level[2, 1], level[2, 2]), math.asin(max(-1.0, min(1.0, -level[2, 0])))
             yaw = math.atan2(level[1, 0], level[0, 0])
+        joints = row[self._joints]
         return BalanceMeasurement(wrench_left=-row[self._left], wrench_right=-row[self._right],
                                   attitude=np.array([roll, pitch]), rate=row[self._gyro].copy(), yaw=yaw,
-                                  joint_angles=row[self._joints])
+                                  joint_angles=joints.copy() if isinstance(self._joints, slice) else joints)

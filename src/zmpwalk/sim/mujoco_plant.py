@@ -108,44 +108,61 @@ class ModelFeedforward:
         self._reaction, self._force, self._point = np.zeros(model.nv), np.zeros(3), np.zeros(3)
         self._no_torque = np.zeros(3)
         self.servo_torques = np.zeros(model.nu)
+        self.rate = float(rate)
+        # per-tick work on views found once: MjData's attributes build a new view at every read
+        self._data_qpos, self._data_qvel, self._data_qacc = self._data.qpos, self._data.qvel, self._data.qacc
+        self._subtree_com = self._data.subtree_com
+        columns, addresses = plant.leg_columns, plant.leg_qpos
+        contiguous = len(columns) == 12 and (np.diff(addresses) == 1).all() and (columns == np.arange(12)).all()
+        self._leg_slice = slice(int(addresses[0]), int(addresses[0]) + 12) if contiguous else None
 
     def torques(self, sample: WalkingSample) -> Array:
         """The leg joints' torques [N m], (12,), in the walker's column order, for this tick's ``sample``."""
         plant, model, data = self.plant, self.plant.model, self._data
         angles = sample.joint_angles if sample.joint_angles is not None else _held_angles(plant)
         qpos = self._qpos
-        qpos[0:3] = _base_position(plant, self._scratch, sample, angles, self._sites)
-        _upright(qpos, sample.yaw_pelvis_in_world)
-        qpos[plant.leg_qpos] = angles[plant.leg_columns]
-        self._previous_qvel[:] = self._qvel
+        if plant.imported:
+            qpos[0:3] = _base_position(plant, self._scratch, sample, angles, self._sites)
+        else:  # the box model's base is the pelvis point
+            qpos[0:3] = sample.position_pelvis_in_world
+        yaw = sample.yaw_pelvis_in_world
+        qpos[3], qpos[6] = math.cos(yaw / 2), math.sin(yaw / 2)  # upright: qpos[4:6] stay 0
+        if self._leg_slice is not None:
+            qpos[self._leg_slice] = angles
+        else:
+            qpos[plant.leg_qpos] = angles[plant.leg_columns]
+        qvel, previous_qvel = self._qvel, self._previous_qvel
+        previous_qvel[:] = qvel
         if self._previous_qpos is None:
             self._previous_qpos = qpos.copy()
-        mujoco.mj_differentiatePos(model, self._qvel, self.dt, self._previous_qpos, qpos)
+        mujoco.mj_differentiatePos(model, qvel, self.dt, self._previous_qpos, qpos)
         if sample.joint_velocities is not None:
-            self._qvel[self._leg_dofs] = sample.joint_velocities
+            qvel[self._leg_dofs] = sample.joint_velocities
         self._previous_qpos[:] = qpos
-        data.qpos[:] = qpos
-        data.qvel[:] = self._qvel
-        data.qacc[:] = (self._qvel - self._previous_qvel) / self.dt
+        self._data_qpos[:] = qpos
+        self._data_qvel[:] = qvel
+        np.subtract(qvel, previous_qvel, out=self._data_qacc)
+        self._data_qacc *= self.rate
         mujoco.mj_kinematics(model, data)
         mujoco.mj_comPos(model, data)
         mujoco.mj_comVel(model, data)
         mujoco.mj_rne(model, data, 1, self._tau)
         self._subtract_reaction(sample)
         self.servo_torques[self._servos] = self._tau[self._dofs]
-        return np.array(self.servo_torques[plant.leg_actuators], dtype=np.float64)
+        leg: Array = self.servo_torques[self.plant.leg_actuators]  # a new array
+        return leg
 
     def _subtract_reaction(self, sample: WalkingSample) -> None:
         """Take the planned ground wrench's share of each sole off the torques: ``tau -= J_p^T f``, the share's force
         ``f`` at its CoP ``p`` on the floor (MuJoCo's ``mj_applyFT``; scalar arithmetic: numpy's cross product of two
         3-vectors costs 30 us)."""
         data, gravity = self._data, self._gravity
-        zx, zy = float(sample.zmp_in_world[0]), float(sample.zmp_in_world[1])
-        cx, cy, cz = data.subtree_com[0].tolist()
+        zx, zy = sample.zmp_in_world[:2].tolist()
+        cx, cy, cz = self._subtree_com[0].tolist()
         scale = self._mass * gravity / max(cz, 1e-6)  # cart-table: m c'' = m (g / z)(c - p)
         fx, fy, fz = scale * (cx - zx), scale * (cy - zy), self._mass * gravity
-        (lx, ly), (rx, ry) = sample.position_left_ankle_in_world[:2].tolist(), \
-            sample.position_right_ankle_in_world[:2].tolist()
+        lx, ly = sample.position_left_ankle_in_world[:2].tolist()
+        rx, ry = sample.position_right_ankle_in_world[:2].tolist()
         if sample.support == "left":
             ratio = 0.0
         elif sample.support == "right":
@@ -155,12 +172,12 @@ class ModelFeedforward:
             ratio = min(max(((zx - lx) * sx + (zy - ly) * sy) / max(sx * sx + sy * sy, 1e-12), 0.0), 1.0)
         bx, by = lx + (rx - lx) * ratio, ly + (ry - ly) * ratio  # the ZMP's foot of the line between the ankles
         reaction, force, point = self._reaction, self._force, self._point
-        reaction[:] = 0.0
-        for body, share, (ax, ay) in ((self._feet[0], 1.0 - ratio, (lx, ly)), (self._feet[1], ratio, (rx, ry))):
+        reaction.fill(0.0)
+        for body, share, ax, ay in ((self._feet[0], 1.0 - ratio, lx, ly), (self._feet[1], ratio, rx, ry)):
             if share == 0.0:
                 continue
-            force[:] = (share * fx, share * fy, share * fz)
-            point[:] = (ax + zx - bx, ay + zy - by, 0.0)  # this sole's CoP, keeping the total at the ZMP
+            force[0], force[1], force[2] = share * fx, share * fy, share * fz
+            point[0], point[1] = ax + zx - bx, ay + zy - by  # this sole's CoP, keeping the total at the ZMP
             mujoco.mj_applyFT(self.plant.model, data, force, self._no_torque, point, body, reaction)
         self._tau -= reaction
 
