@@ -407,7 +407,7 @@ class WalkingController:
         except ZmpwalkError as error:
             self._fault(error)
             return None
-        if not math.isfinite(float(targets.sum())):
+        if not math.isfinite(sum(targets.tolist())):  # a sum of Python floats: no numpy reduction per tick
             self._fault(InvalidParameterError("measurement", "values that make the stabilizer's targets non-finite",
                                               "finite wrenches, attitude, rates and encoders"))
             return None

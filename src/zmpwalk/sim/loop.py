@@ -122,7 +122,7 @@ class _Log:
 
     def record(self, k: int, plant: MujocoPlant, controller: WalkingController, targets: JointTargets) -> None:
         sample = targets.sample
-        self.readings[k] = plant.data.sensordata
+        self.readings[k] = plant.sensordata
         self.zmp[k] = sample.zmp_in_world
         self.ankles[k, 0] = sample.position_left_ankle_in_world
         self.ankles[k, 1] = sample.position_right_ankle_in_world

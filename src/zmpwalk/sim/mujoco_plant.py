@@ -34,6 +34,8 @@ from zmpwalk.sim.soles import SensorSlices
 
 Array = NDArray[np.float64]
 
+_STEPS_IN_ONE_CALL = "nstep" in (mujoco.mj_step.__doc__ or "")  # mj_step(m, d, nstep): the steps of a tick in one call
+
 
 def _upright(qpos: Array, yaw: float) -> None:
     """Set the free base's orientation in ``qpos`` to upright at ``yaw`` [rad]."""
@@ -253,6 +255,10 @@ class MujocoPlant:
         self._past = np.empty((self._delay + 1, model.nsensordata))  # ring of the last readings, oldest first read
         self._noise = noise
         self._rng = np.random.default_rng(noise.seed) if noise is not None else None
+        # views found once (MjData's attributes build a new view at every read) and a buffer for apply()
+        self.sensordata = self.data.sensordata  # [various] the sensors' row, updated by every step
+        self._qpos, self._data_ctrl = self.data.qpos, self.data.ctrl
+        self._leg = np.zeros(len(plant.leg_actuators))
 
     @property
     def time(self) -> float:
@@ -290,7 +296,7 @@ class MujocoPlant:
         """The sensors (``latency`` ago; now without one): each sole's wrench (the ground's, at the ankle, foot
         frame), the IMU, the encoders; with ``noise`` added."""
         if self._delay == 0:
-            measurement = self._reader.read(self.data.sensordata)
+            measurement = self._reader.read(self.sensordata)
         else:
             measurement = self._reader.read(self._past[(self._ticks + 1) % (self._delay + 1)])  # after tick t - delay
         if self._noise is not None and self._rng is not None:
@@ -299,29 +305,34 @@ class MujocoPlant:
 
     def apply(self, targets: JointTargets) -> None:
         """Drive the leg servos with the targets (the control of the class docstring)."""
-        leg = targets.angles + self._damping_ratio * targets.velocities
+        leg = self._leg
+        np.multiply(self._damping_ratio, targets.velocities, out=leg)
+        leg += targets.angles
         if targets.torques is not None:
-            leg = leg + targets.torques * self._compliance
+            leg += targets.torques * self._compliance
         self._ctrl[self.plant.leg_actuators] = leg
-        self.data.ctrl[:] = self._ctrl
+        self._data_ctrl[:] = self._ctrl
 
     def step(self) -> None:
         """Integrate one control period (a push acting where :attr:`disturbances` has one)."""
         if self.disturbances is not None:
             self.data.xfrc_applied[self._push_body, :3] = self.disturbances.force_at(self.time)
-        for _ in range(self.steps_per_tick):
-            mujoco.mj_step(self.model, self.data)
+        if _STEPS_IN_ONE_CALL:
+            mujoco.mj_step(self.model, self.data, self.steps_per_tick)
+        else:  # pragma: no cover - MuJoCo before nstep
+            for _ in range(self.steps_per_tick):
+                mujoco.mj_step(self.model, self.data)
         self._ticks += 1
         if self._delay:
-            self._past[self._ticks % (self._delay + 1)] = self.data.sensordata
+            self._past[self._ticks % (self._delay + 1)] = self.sensordata
 
     def fallen(self) -> bool:
         """The fall criterion of :mod:`zmpwalk.sim.run` now (the torso touching the floor, tilted over
         :data:`~zmpwalk.sim.run.FALL_TILT` or sunk below :data:`~zmpwalk.sim.run.FALL_HEIGHT_FRACTION` of the pelvis
         height), or a state that is no longer finite (scalar reads: this runs every tick)."""
-        row = self.data.sensordata
+        row = self.sensordata
         x, y = float(row[self._quaternion.start + 1]), float(row[self._quaternion.start + 2])
         upright = 1.0 - 2.0 * (x * x + y * y)  # cos(tilt): the torso's z axis against the vertical
         touched = self._touch is not None and row[self._touch.start] > 0
         return bool(touched or upright < self._upright_least or row[self._pelvis.start + 2] < self._least_height
-                    or not math.isfinite(float(self.data.qpos.sum())))
+                    or not math.isfinite(sum(self._qpos.tolist())))  # a sum of Python floats: no numpy reduction

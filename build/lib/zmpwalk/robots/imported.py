@@ -1,0 +1,419 @@
+"""A robot from its own model: MJCF (``.xml``) or URDF (``.urdf``), read with MuJoCo's compiler.
+
+:func:`import_robot` finds the two legs and derives from the model everything
+zmpwalk needs (the builder's model is the single source of truth):
+
+* **Floating base**: the body with the free joint (a URDF gets one at its root
+  link). Its frame is the **pelvis frame** of zmpwalk (x forward, y left, z up).
+* **Feet**: with no mapping, the two bodies whose collision geoms reach lowest in
+  the reference pose (the model's keyframe, or its zero pose), one each side of
+  the base (``y > 0`` left). Two candidates within
+  :data:`~zmpwalk.robots.tree.FOOT_TIE` of each other on one side make the tree
+  ambiguous: give ``feet = (left, right)`` body names (:mod:`zmpwalk.robots.tree`).
+* **Legs** (:mod:`zmpwalk.robots.legs`): the hinge joints on the path from the
+  point where the two feet's paths part down to each foot; six per leg, or five
+  without the ankle roll (a virtual ankle roll completes its chain). Joints above
+  that point (a waist) and every other joint (arms, head) are held at the
+  reference pose. Each leg joint gets its role (hip yaw, hip roll, hip pitch,
+  knee, ankle pitch, ankle roll) from its axis at the zero pose (the axis's
+  largest component: z yaw, x roll, y pitch) and its place in the chain, and its
+  sign from the direction of that component. The knee's zero offset is the bend
+  of the model's zero pose (thigh and shank directions about the knee axis).
+* **Geometry** in the pelvis frame at the zero pose: hip centre (the point
+  nearest the three hip axes, with their largest distance from it), knee and
+  ankle points, link lengths. The hip spacing is the hip centres' (a five-joint
+  leg's: its ankles', the plane in which its sole stays flat under an upright
+  pelvis).
+* **Sole** (:func:`zmpwalk.robots.collision.foot_sole`), taken in the
+  **reference posture**, where the foot stands level: the foot's collision geoms
+  within :data:`~zmpwalk.robots.collision.SOLE_BAND` of the lowest, projected on
+  the floor (polygon), the ankle height above them, and the sole frame's rotation
+  in the pelvis frame at zero angles, which the leg chain's inverse kinematics
+  keeps level.
+* **Ready posture**: the hips above the ankles at the keyframe's
+  hip-to-ankle distance, at most :data:`READY_STRETCH` of the straight leg (a
+  bent knee for walking). The pattern moves the centre of mass: the CoM's
+  offset from the base origin in that posture, ``com_offset``, is found by
+  fixed-point iteration (the posture moves the CoM, the CoM moves the
+  posture) and every pattern point is shifted by it. The pendulum length is the
+  CoM's height.
+* **Limits, actuators, mass**: joint ranges per joint and side; each leg joint's
+  actuator (type, ``kp``, ``kv``, force range); total mass.
+* **Joint PD layer**: a torque motor (``<motor>``), a leg joint without an actuator, and every joint of a
+  model without actuators (a URDF) is driven as a humanoid's firmware drives it, by a joint PD loop
+  ``tau = kp (q_ref - q) - kv q'`` clipped at the joint's torque limit (:func:`pd_gains`'s rule, or the
+  robot file's ``[pd]``); the simulation runs it as a position servo (:mod:`zmpwalk.sim.plant`).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zmpwalk.errors import FileFormatError
+from zmpwalk.leg_chain import LegChain
+from zmpwalk.robots.collision import Sole, collision_points, rigid_bodies, sole_face_up, sole_roll_bound
+from zmpwalk.robots.description import Actuator, LegJoint, ModelPlant
+from zmpwalk.robots.legs import VIRTUAL_PREFIX, FootAtReference, Segments, build_leg, leg_joint_ids, segments
+from zmpwalk.robots.model import RobotModel, schedule_scale
+from zmpwalk.robots.pd import element_name, pd_layer
+from zmpwalk.robots.tree import find_feet, floating_base, keyframe_index
+
+Array = NDArray[np.float64]
+
+READY_STRETCH = 0.92  # [-] hip-to-ankle distance of the ready posture, at most this fraction of the straight leg
+
+
+def load_model(path: Path, package_paths: tuple[Path, ...] = ()) -> Any:
+    """The compiled :class:`mujoco.MjModel` of an MJCF or URDF file (see :func:`load_model_spec`)."""
+    return load_model_spec(path, package_paths).compile()
+
+
+def load_model_spec(path: Path, package_paths: tuple[Path, ...] = ()) -> Any:
+    """A :class:`mujoco.MjSpec` of an MJCF or URDF file; a URDF gets a free joint at its root link.
+
+    Raises:
+        FileFormatError: No such file, an unresolved ``package://`` path, or MuJoCo cannot compile it
+            (the message is MuJoCo's, e.g. the missing mesh).
+    """
+    import mujoco
+
+    if not path.is_file():
+        raise FileFormatError(str(path), "no such file")
+    try:
+        if path.suffix.lower() == ".urdf":
+            text = _resolve_packages(path, package_paths)
+            spec = mujoco.MjSpec.from_string(text)
+            spec.meshdir = str(path.parent)
+            spec.strippath = False
+            root = spec.worldbody.first_body()
+            if root is None:
+                raise FileFormatError(str(path), "the URDF has no links")
+            if not root.joints:
+                root.add_freejoint()
+        else:
+            spec = mujoco.MjSpec.from_file(str(path))
+        spec.compile()  # checks it (missing meshes, bad references) once, here
+    except FileFormatError:
+        raise
+    except (ValueError, RuntimeError, UnicodeDecodeError) as error:
+        message = " ".join(str(error).split())
+        raise FileFormatError(str(path), f"MuJoCo cannot compile the model: {message}") from None
+    return spec
+
+
+def _resolve_packages(path: Path, package_paths: tuple[Path, ...]) -> str:
+    """The URDF text with ``package://NAME/REST`` replaced by absolute paths (searched in ``package_paths``
+    and the file's own folder and its parents), and relative mesh paths made absolute."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as error:
+        raise FileFormatError(str(path), f"cannot read the URDF: {error}") from None
+    roots = [*package_paths, path.parent, *path.parent.parents]
+
+    def package(match: re.Match[str]) -> str:
+        name, rest = match.group(1), match.group(2)
+        for root in roots:
+            for candidate in (root / name / rest, root / rest if root.name == name else None):
+                if candidate is not None and candidate.is_file():
+                    return str(candidate.resolve())
+        searched = ", ".join(str(r) for r in roots[:4])
+        raise FileFormatError(str(path), f"cannot resolve package://{name}/{rest} (searched {searched}; "
+                              "give the folder that holds the package with --package-path)")
+
+    text = re.sub(r"package://([^/\"']+)/([^\"']+)", package, text)
+
+    def relative(match: re.Match[str]) -> str:
+        filename = match.group(2)
+        if Path(filename).is_absolute():
+            return match.group(0)
+        return f"{match.group(1)}{(path.parent / filename).resolve()}{match.group(3)}"
+
+    return re.sub(r"(filename=[\"'])([^\"']+)([\"'])", relative, text)
+
+
+def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyframe: str | None = None,
+                 package_paths: tuple[Path, ...] = (), name: str | None = None,
+                 overrides: dict[str, float] | None = None,
+                 pd_gains: dict[str, tuple[float, float | None]] | None = None) -> RobotModel:
+    """The :class:`~zmpwalk.robots.model.RobotModel` of an MJCF or URDF model (see the module docstring).
+
+    Args:
+        path: The model file (a Menagerie ``scene*.xml`` with its floor, a robot ``.xml``, or a ``.urdf``).
+        feet: Foot body names (left, right), where the tree is ambiguous.
+        keyframe: The keyframe of the reference pose (default: the model's first, else its zero pose).
+        package_paths: Folders holding the packages of a URDF's ``package://`` paths.
+        name: Short name (default: the model's).
+        overrides: Robot-file values replacing derived ones (``pelvis_height``, ``dsp_time``, ...).
+        pd_gains: The PD layer's gains of some joints (model joint name -> (kp [N m/rad], kv [N m s/rad] or
+            None: critical damping)) replacing :func:`pd_gains`'s (a robot file's ``[pd]``).
+
+    Raises:
+        FileFormatError: What the model lacks for walking, named (no floating base, no legs, a leg of
+            other than five or six hinge joints, ambiguous feet, a sole that does not stand flat in the
+            reference posture, ...).
+        InvalidParameterError: ``pd_gains`` names a joint the PD layer does not drive.
+    """
+    import mujoco
+
+    path = Path(path)
+    source = str(path)
+    model = load_model(path, package_paths)
+    data = mujoco.MjData(model)
+    base = floating_base(model, source)
+    key_id = keyframe_index(model, keyframe, source)
+    qpos_reference = model.key_qpos[key_id].copy() if key_id >= 0 else model.qpos0.copy()
+    data.qpos[:] = qpos_reference
+    mujoco.mj_kinematics(model, data)
+    foot_ids = find_feet(model, data, base, feet, source)
+    feet_at_reference = [_foot_at_reference(model, data, foot, label, source)
+                         for foot, label in zip(foot_ids, ("left", "right"), strict=True)]
+    legs = leg_joint_ids(model, base, foot_ids, source)
+    leg_joint_set = {j for leg in legs for j in leg}
+    base_joint = int(model.body_jntadr[base])
+    adr = int(model.jnt_qposadr[base_joint])
+    base_rotation, base_origin = _zero_pose(model, data, qpos_reference, leg_joint_set, base, adr)
+
+    def in_pelvis(point: Array) -> Array:
+        return np.asarray(base_rotation.T @ (point - base_origin), dtype=np.float64)
+
+    masses = segments(model, data, base, legs, in_pelvis)
+    built = [build_leg(model, data, side, foot, leg, qpos_reference, masses, at_reference, in_pelvis, base_rotation,
+                       source) for side, foot, leg, at_reference in zip((1, -1), foot_ids, legs, feet_at_reference,
+                                                                        strict=True)]
+    chains = [chain for chain, _, _ in built]
+    leg_joints = [joint for _, joints, _ in built for joint in joints]
+    geometry = _geometry(chains, (built[0][2], built[1][2]), source)
+    polygon, ankle_height, left_hip = built[0][2].polygon, geometry.ankle_height, chains[0].hip
+    hip_x, hip_spacing, hip_drop = geometry.hip_x, geometry.hip_spacing, geometry.hip_drop
+    thigh, shank = geometry.thigh, geometry.shank
+    mass = float(np.sum(model.body_mass))
+    values = dict(overrides or {})
+    distance, height_scale = _reference_reach(model, data, qpos_reference, base, left_hip, foot_ids[0],
+                                              ankle_height, thigh + shank)
+    model_name = model.names[:model.names.find(b"\0")].decode()
+    robot_name = name or re.sub(r"[^A-Za-z0-9_.-]+", "-", model_name).strip("-") or path.stem
+    plant = _model_plant(model, path, base, foot_ids, key_id, leg_joint_set | {base_joint}, masses, polygon,
+                         package_paths)
+    ready = _ready_posture(model, data, chains, legs, qpos_reference, adr, distance, hip_x, hip_spacing, hip_drop,
+                           ankle_height, values.get("pelvis_height"), source)
+    pelvis_height, pendulum, com_offset, chains_ready, qpos = ready
+    # The joint PD layer: gains from the ready posture's inertia; a leg joint holds the robot, m g l.
+    pd_joints = pd_layer(model, data, qpos, leg_joint_set, mass * float(np.linalg.norm(model.opt.gravity)) * pendulum,
+                          pd_gains or {})
+    leg_joints = _driven_joints(leg_joints, dict(pd_joints), geometry)
+    plant = replace(plant, joints=tuple(leg_joints), pd_joints=pd_joints)
+    return _robot_model(
+        name=robot_name, description=f"imported from {path.name} ({mass:.1f} kg)", mass=mass, height=height_scale,
+        geometry=geometry, pelvis_height=pelvis_height, pendulum=pendulum, gravity=float(-model.opt.gravity[2]),
+        overrides=values, leg_joints=leg_joints, com_offset=com_offset, legs=(chains_ready[0], chains_ready[1]),
+        plant=plant)
+
+
+def _zero_pose(model: Any, data: Any, qpos_reference: Array, leg_joints: set[int], base: int,
+               adr: int) -> tuple[Array, Array]:
+    """Put ``data`` at the zero pose of the legs, the base at the origin (the rest of the body at the reference):
+    joint axes and anchors are then in the pelvis frame. Returns the base's rotation and origin there."""
+    import mujoco
+
+    zero = qpos_reference.copy()
+    for j in leg_joints:
+        zero[model.jnt_qposadr[j]] = 0.0
+    zero[adr:adr + 7] = (0, 0, 0, 1, 0, 0, 0)
+    data.qpos[:] = zero
+    mujoco.mj_kinematics(model, data)
+    return data.xmat[base].reshape(3, 3).copy(), data.xpos[base].copy()
+
+
+def _reference_reach(model: Any, data: Any, qpos_reference: Array, base: int, hip: Array, foot: int,
+                     ankle_height: float, straight: float) -> tuple[float, float]:
+    """The ready posture's hip-to-ankle distance [m], the keyframe's, at most :data:`READY_STRETCH` of the
+    ``straight`` leg, and the robot's height above its sole in the reference posture [m] (``data`` left there)."""
+    import mujoco
+
+    data.qpos[:] = qpos_reference
+    mujoco.mj_kinematics(model, data)
+    key_hip = data.xpos[base] + data.xmat[base].reshape(3, 3) @ hip
+    key_foot_bottom = min(float(p[2]) for p in collision_points(model, data, rigid_bodies(model, foot)))
+    key_distance = float(key_hip[2] - key_foot_bottom - ankle_height)
+    distance = min(key_distance if key_distance > 0 else straight, READY_STRETCH * straight)
+    return distance, float(np.max(data.geom_xpos[:, 2]) - key_foot_bottom)
+
+
+def _driven_joints(joints: list[LegJoint], driven: dict[str, Actuator], geometry: _Geometry) -> list[LegJoint]:
+    """The leg joints with the PD layer's actuators where it drives them, and a five-joint leg's virtual ankle roll
+    with its range, the sole roll it may leave (:func:`zmpwalk.robots.collision.sole_roll_bound`)."""
+    bound = sole_roll_bound(geometry.sole_box[3] - geometry.sole_box[1])
+    joints = [replace(joint, actuator=driven.get(joint.name, joint.actuator)) for joint in joints]
+    return [replace(joint, limits=(-bound, bound)) if joint.name.startswith(VIRTUAL_PREFIX) else joint
+            for joint in joints]
+
+
+def _model_plant(model: Any, path: Path, base: int, feet: list[int], key_id: int, leg_joints: set[int],
+                 masses: Segments, polygon: Array, package_paths: tuple[Path, ...]) -> ModelPlant:
+    """What the simulation needs of the model (its leg joints and PD layer are filled in later): every joint but
+    ``leg_joints`` (the legs' and the base's) is held at the reference pose."""
+    import mujoco
+
+    def name(kind: Any, index: int) -> str:
+        return element_name(model, kind, index)
+
+    qpos = model.key_qpos[key_id] if key_id >= 0 else model.qpos0
+    ctrl = model.key_ctrl[key_id] if key_id >= 0 and model.nu else np.zeros(model.nu)
+    rest_com = masses.rest_com
+    return ModelPlant(
+        path=path.resolve(), base_body=name(mujoco.mjtObj.mjOBJ_BODY, base),
+        feet=(name(mujoco.mjtObj.mjOBJ_BODY, feet[0]), name(mujoco.mjtObj.mjOBJ_BODY, feet[1])), joints=(),
+        qpos_reference=tuple(float(v) for v in qpos), ctrl_reference=tuple(float(v) for v in ctrl),
+        package_paths=package_paths, sole_polygon=tuple((float(x), float(y)) for x, y in polygon),
+        held_joints=tuple(name(mujoco.mjtObj.mjOBJ_JOINT, j) for j in range(model.njnt) if j not in leg_joints),
+        keyframe=name(mujoco.mjtObj.mjOBJ_KEY, key_id) if key_id >= 0 else None, rest_mass=masses.rest_mass,
+        rest_com=(float(rest_com[0]), float(rest_com[1]), float(rest_com[2])))
+
+
+@dataclass(frozen=True)
+class _Geometry:
+    """The leg geometry and the sole that the robot model keeps (lengths [m]): the hips' mean x, spacing and
+    drop below the base origin, the left thigh and shank, the ankle height and the left sole's bounding
+    rectangle (x_min, y_min, x_max, y_max) in the sole frame."""
+
+    hip_x: float
+    hip_spacing: float
+    hip_drop: float
+    thigh: float
+    shank: float
+    ankle_height: float
+    sole_box: tuple[float, float, float, float]
+
+
+def _geometry(chains: list[LegChain], soles: tuple[Sole, Sole], source: str) -> _Geometry:
+    """:class:`_Geometry` of the two legs.
+
+    Raises:
+        FileFormatError: The two soles differ by more than 10 mm in length or width.
+    """
+    # A five-joint leg keeps its sole flat under an upright pelvis only in its own plane: the feet stand there.
+    lateral = [chain.ankle[1] if chain.virtual is not None else chain.hip[1] for chain in chains]
+    left_hip, right_hip = chains[0].hip, chains[1].hip
+    x_min, y_min = soles[0].polygon.min(axis=0)
+    x_max, y_max = soles[0].polygon.max(axis=0)
+    right_width = soles[1].polygon.max(axis=0) - soles[1].polygon.min(axis=0)
+    if abs(right_width[0] - (x_max - x_min)) > 0.01 or abs(right_width[1] - (y_max - y_min)) > 0.01:
+        raise FileFormatError(source, "the two soles differ by more than 10 mm in size; zmpwalk mirrors the "
+                              "left sole for the right foot")
+    return _Geometry(
+        hip_x=float((left_hip[0] + right_hip[0]) / 2), hip_spacing=float(lateral[0] - lateral[1]),
+        hip_drop=float(-(left_hip[2] + right_hip[2]) / 2), thigh=float(np.linalg.norm(chains[0].knee_point - left_hip)),
+        shank=float(np.linalg.norm(chains[0].ankle - chains[0].knee_point)), ankle_height=soles[0].ankle_height,
+        sole_box=(float(x_min), float(y_min), float(x_max), float(y_max)))
+
+
+def _robot_model(*, name: str, description: str, mass: float, height: float, geometry: _Geometry,
+                 pelvis_height: float, pendulum: float, gravity: float, overrides: dict[str, float],
+                 leg_joints: list[LegJoint], com_offset: Array, legs: tuple[LegChain, LegChain],
+                 plant: ModelPlant) -> RobotModel:
+    """The robot model: derived values (the robot file's ``overrides`` replacing them), the joint ranges by column,
+    and the HUBO tables scaled to this robot (docs/robot-import.md): times with sqrt(l/g), strides and foot lift
+    with the leg length, sway and V_y with the hip spacing."""
+    g = geometry
+    x_min, y_min, x_max, y_max = g.sole_box
+    time_scale, length_scale, lateral_scale = schedule_scale(pendulum, g.thigh + g.shank, g.hip_spacing)
+    limits = {f"{'left' if i < 6 else 'right'}_{joint.role}": joint.limits for i, joint in enumerate(leg_joints)}
+    fields_: dict[str, Any] = {
+        "name": name, "description": description, "mass": mass, "height": height, "hip_spacing": g.hip_spacing,
+        "hip_drop": g.hip_drop, "thigh_length": g.thigh, "shank_length": g.shank, "ankle_height": g.ankle_height,
+        "foot_length": x_max - x_min, "foot_width": y_max - y_min, "sole_center_x": (x_max + x_min) / 2,
+        "sole_center_y": (y_max + y_min) / 2, "pelvis_height": pelvis_height, "pendulum_length": pendulum,
+        "min_knee": 0.05, "dsp_time": 0.1 * time_scale, "foot_lift": 0.04 * length_scale,
+        "lateral_velocity": 0.1 * lateral_scale, "gravity": gravity,
+    }
+    for key, value in overrides.items():
+        if key in fields_:
+            fields_[key] = value
+    return RobotModel(
+        **fields_, joint_limits=limits, hip_x=g.hip_x, com_offset=(float(com_offset[0]), float(com_offset[1])),
+        legs=legs, plant=plant, schedule_scale=(time_scale, length_scale, lateral_scale),
+        foot_speed_limit=overrides.get("foot_speed_limit"),
+        foot_acceleration_limit=overrides.get("foot_acceleration_limit"),
+    )
+
+
+def _foot_at_reference(model: object, data: object, foot: int, label: str, source: str) -> FootAtReference:
+    """The foot's collision points and the up of its sole's plane in its body frame, ``data`` in the reference posture:
+    a box sole's own bottom face where it is nearly level (:func:`~zmpwalk.robots.collision.sole_face_up`), else the
+    world's up.
+
+    Raises:
+        FileFormatError: The foot body has no collision geom.
+    """
+    import mujoco
+
+    points = collision_points(model, data, rigid_bodies(model, foot))
+    if len(points) == 0:
+        foot_name = element_name(model, mujoco.mjtObj.mjOBJ_BODY, foot)
+        raise FileFormatError(source, f"the {label} foot body {foot_name!r} has no collision geom (its sole)")
+    rotation = np.array(data.xmat[foot], dtype=np.float64).reshape(3, 3)  # type: ignore[attr-defined]  # copies
+    position = np.array(data.xpos[foot], dtype=np.float64)  # type: ignore[attr-defined]
+    face = sole_face_up(model, data, rigid_bodies(model, foot), float(points[:, 2].min()))  # a box sole's plane
+    up = rotation[2, :].copy() if face is None else rotation.T @ face
+    return FootAtReference((points - position) @ rotation, up)
+
+
+def _ready_posture(model: Any, data: Any, chains: list[LegChain], legs: list[list[int]], qpos_reference: Array,
+                   adr: int, distance: float, hip_x: float, hip_spacing: float, hip_drop: float, ankle_height: float,
+                   pelvis_height_override: float | None, source: str
+                   ) -> tuple[float, float, Array, list[LegChain], Array]:
+    """The ready posture: the ankles ``hip_spacing`` apart below the pattern's point with the soles level, the
+    hip-to-ankle distance ``distance`` [m]. The pattern moves the CoM: its offset from the base origin moves the
+    posture, which moves the CoM, to a fixed point (within 1e-7 m).
+
+    Returns:
+        The pelvis height [m], the pendulum length (the CoM's height) [m], the CoM offset from the base origin
+        [m] (2,), the chains with the ready posture as their reference angles, and the posture's ``qpos``.
+
+    Raises:
+        FileFormatError: A leg cannot reach the ready posture.
+    """
+    import mujoco
+
+    com_offset = np.zeros(2)
+    pelvis_height = pendulum = 0.0
+    chains_ready = chains
+    qpos = qpos_reference.copy()
+    for _ in range(8):  # fixed point: posture -> CoM offset -> posture
+        dx = hip_x - com_offset[0]
+        vertical = math.sqrt(max(distance * distance - dx * dx, 1e-12))
+        pelvis_height = float(ankle_height + hip_drop + vertical if pelvis_height_override is None
+                              else pelvis_height_override)
+        chains_ready = []
+        qpos = qpos_reference.copy()
+        qpos[adr:adr + 7] = (0, 0, pelvis_height, 1, 0, 0, 0)
+        for chain, side, leg in zip(chains, (1, -1), legs, strict=True):
+            # the ankle below the pattern point, which is the CoM offset from the base origin; the sole level
+            target = np.array([[com_offset[0], side * hip_spacing / 2 + com_offset[1], ankle_height - pelvis_height]])
+            angles, excess = chain.solve(target, np.eye(3)[None])
+            if excess[0] > 0:
+                raise FileFormatError(source, f"the {chain.label} leg cannot reach the ready posture "
+                                      f"(pelvis height {pelvis_height:.3f} m)")
+            chains_ready.append(replace(chain, reference=angles[0]))
+            for j, angle in zip(leg, angles[0], strict=False):  # a five-joint leg's virtual roll has no qpos
+                qpos[model.jnt_qposadr[j]] = angle
+        data.qpos[:] = qpos
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_comPos(model, data)
+        com = data.subtree_com[0]
+        new_offset = np.array([com[0], com[1]])
+        pendulum = float(com[2])
+        converged = np.max(np.abs(new_offset - com_offset)) < 1e-7
+        com_offset = new_offset
+        if converged:
+            break
+    return pelvis_height, pendulum, com_offset, chains_ready, qpos
+
+

@@ -1,0 +1,215 @@
+"""What zmpwalk derived from a robot, for a builder to check against the CAD: ``zmpwalk robot PATH``."""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from zmpwalk.joint_limits import JOINT_COLUMNS
+from zmpwalk.robots.collision import tilt_of
+from zmpwalk.robots.description import PD_BANDWIDTH, PD_DAMPING_RATIO, PD_LOAD_STIFFNESS, Actuator
+from zmpwalk.robots.model import RobotModel
+
+if TYPE_CHECKING:
+    from zmpwalk.sim.statics import StaticTorques
+
+
+def robot_summary(robot: RobotModel, statics: StaticTorques | None = None) -> dict[str, Any]:
+    """The derived values as plain data (SI units: m, kg, rad, N m).
+
+    Args:
+        statics: The static torques of the ready posture (:func:`zmpwalk.sim.statics.static_torques`), listed
+            per joint when given.
+    """
+    summary: dict[str, Any] = {
+        "name": robot.name, "description": robot.description, "mass": robot.mass, "height": robot.height,
+        "hips": {side: list(robot.hip_in_pelvis(s)) for side, s in (("left", 1), ("right", -1))},
+        "hip_x": robot.hip_x, "hip_spacing": robot.hip_spacing, "hip_drop": robot.hip_drop,
+        "thigh_length": robot.thigh_length, "shank_length": robot.shank_length, "ankle_height": robot.ankle_height,
+        "sole": {"length": robot.foot_length, "width": robot.foot_width, "center_x": robot.sole_center_x,
+                 "center_y": robot.sole_center_y},
+        "pelvis_height": robot.pelvis_height, "pendulum_length": robot.pendulum_length,
+        "com_offset": list(robot.com_offset), "schedule_scale": list(robot.schedule_scale),
+        "walking": {"dsp_time": robot.dsp_time, "foot_lift": robot.foot_lift,
+                    "lateral_velocity": robot.lateral_velocity},
+        "limits": {column: list(robot.limits_of(column)) for column in JOINT_COLUMNS},
+    }
+    # The hips in the base frame (the pattern's point is com_offset ahead of the base origin).
+    summary["hips"] = {side: [robot.hip_x, s * robot.hip_spacing / 2, -robot.hip_drop]
+                       for side, s in (("left", 1), ("right", -1))}
+    if robot.plant is not None and robot.legs is not None:
+        plant = robot.plant
+        summary["model"] = str(plant.path)
+        summary["base_body"] = plant.base_body
+        summary["feet"] = list(plant.feet)
+        summary["keyframe"] = plant.keyframe
+        summary["held_joints"] = list(plant.held_joints)
+        summary["sole_polygon"] = [list(p) for p in plant.sole_polygon]
+        summary["ik"] = {chain.label: ("closed form" if chain.closed_form else "numeric") for chain in robot.legs}
+        summary["sole_tilt"] = {chain.label: {"zero": list(tilt_of(chain.sole_rotation[:, 2])),
+                                              "reference": list(chain.sole_tilt_reference)} for chain in robot.legs}
+        summary["five_joint"] = {chain.label: chain.virtual is not None for chain in robot.legs}
+        summary["hip_axes_offset"] = {chain.label: chain.hip_axes_offset for chain in robot.legs}
+        summary["ankle_axes_offset"] = {chain.label: chain.ankle_axes_offset for chain in robot.legs}
+        summary["joints"] = [
+            {"column": column, "name": joint.name, "axis": list(joint.axis), "sign": joint.sign,
+             "zero_offset": joint.zero_offset, "limits": list(joint.limits),
+             "actuator": None if joint.actuator is None else _actuator_summary(joint.actuator)}
+            for column, joint in zip(JOINT_COLUMNS, plant.joints, strict=True)]
+        legs = {joint.name for joint in plant.joints}
+        summary["pd_joints"] = {name: _actuator_summary(actuator) for name, actuator in plant.pd_joints
+                                if name not in legs}
+        if statics is not None:
+            for i, joint in enumerate(summary["joints"]):
+                joint["static_torque"] = {"both_feet": float(statics.both_feet[i]),
+                                          "on_left": float(statics.on_left[i]), "on_right": float(statics.on_right[i])}
+            summary["static_torque_over_limit"] = statics.over_limit
+    return summary
+
+
+def _ankle_words(summary: dict[str, Any], leg: str) -> str:
+    """How far apart a leg's ankle axes are, or that it has none to roll (a five-joint leg, with the bound on
+    the sole roll it may leave)."""
+    if not summary["five_joint"][leg]:
+        return f"ankle {summary['ankle_axes_offset'][leg] * 1e3:.1f} mm"
+    column = next(joint for joint in summary["joints"] if joint["column"] == f"{leg}_ankle_roll")
+    return f"5 joints: no ankle roll, the sole roll the IK leaves within {column['limits'][1]:.4f} rad"
+
+
+def _tilt_line(summary: dict[str, Any]) -> str:
+    """The soles' tilt (roll, pitch) [rad] at zero joint angles and in the reference posture."""
+    tilts = summary["sole_tilt"]
+
+    def pair(values: list[float]) -> str:
+        return "(" + ", ".join(f"{round(v, 4) + 0.0:+.4f}" for v in values) + ")"  # no "-0.0000"
+
+    return ("sole tilt (roll, pitch) [rad]: at zero angles " + ", ".join(f"{leg} {pair(t['zero'])}" for leg, t in
+                                                                       tilts.items())
+            + f"; in the reference posture ({summary['keyframe'] or 'zero pose'}) "
+            + ", ".join(f"{leg} {pair(t['reference'])}" for leg, t in tilts.items())
+            + " (the IK keeps the sole frame level)")
+
+
+def _actuator_summary(actuator: Actuator) -> dict[str, Any]:
+    """One actuator as plain data: ``kind`` the model's (position, motor, general, none), ``drive`` in words
+    (position servo, torque motor + PD, PD (no actuator)), ``pd_layer``, gains [N m/rad, N m s/rad], the torque
+    limit [N m] and, for the PD layer, the reflected inertia its gains come from [kg m^2]."""
+    return {"name": actuator.name, "kind": actuator.kind, "drive": actuator.label, "pd_layer": actuator.pd_layer,
+            "kp": actuator.kp, "kv": actuator.kv, "force_limit": actuator.force_limit, "inertia": actuator.inertia}
+
+
+def _mm(value: float) -> str:
+    return f"{value * 1e3:+.1f}"
+
+
+def robot_table(robot: RobotModel, statics: StaticTorques | None = None) -> str:
+    """The derived values as a table (lengths in mm for reading; the files and JSON are in SI), with the static
+    torques of the ready posture where ``statics`` is given."""
+    s = robot_summary(robot, statics)
+    lines = [f"{robot.name}: {robot.description}"]
+    if "model" in s:
+        lines.append(f"model {s['model']}; base {s['base_body']!r}; feet {s['feet'][0]!r}, {s['feet'][1]!r}; "
+                     f"reference pose: {s['keyframe'] or 'zero pose'}")
+    lines += [
+        f"mass {robot.mass:.3f} kg, height {robot.height:.3f} m",
+        "hips in the base frame [mm]: left (" + ", ".join(_mm(v) for v in s["hips"]["left"]) + "), right ("
+        + ", ".join(_mm(v) for v in s["hips"]["right"]) + ")",
+        f"thigh {robot.thigh_length * 1e3:.1f} mm, shank {robot.shank_length * 1e3:.1f} mm, "
+        f"ankle above the sole {robot.ankle_height * 1e3:.1f} mm",
+        f"sole {robot.foot_length * 1e3:.1f} x {robot.foot_width * 1e3:.1f} mm, centre "
+        f"({_mm(robot.sole_center_x)}, {_mm(robot.sole_center_y)}) mm from the ankle",
+        f"ready posture: base {robot.pelvis_height:.4f} m above the ground, centre of mass "
+        f"{robot.pendulum_length:.4f} m high and ({_mm(robot.com_offset[0])}, {_mm(robot.com_offset[1])}) mm "
+        "from the base origin",
+        "HUBO tables scaled by: time x{:.3f}, stride x{:.3f}, lateral x{:.3f}".format(*robot.schedule_scale),
+    ]
+    if "joints" in s:
+        lines.append("IK: " + ", ".join(f"{k} {v} (hip axes {s['hip_axes_offset'][k] * 1e3:.1f} mm apart, "
+                                        + _ankle_words(s, k) + ")" for k, v in s["ik"].items()))
+        lines.append(_tilt_line(s))
+        lines.append("")
+        lines += _joint_lines(s["joints"], statics)
+        if any(joint["actuator"] and joint["actuator"]["pd_layer"] for joint in s["joints"]) or s["pd_joints"]:
+            lines.append(f"PD layer (the firmware's joint loop, run at the physics step, clipped at 'max'): kp = "
+                         f"max(I w^2, {PD_LOAD_STIFFNESS:g} W) with w = 2 pi x {PD_BANDWIDTH / (2 * math.pi):g} Hz, "
+                         f"W = m g l = {robot.mass * robot.gravity * robot.pendulum_length:.1f} N m for a leg joint; "
+                         f"kv = 2 x {PD_DAMPING_RATIO:g} sqrt(kp I); I [kg m^2] its reflected inertia "
+                         "(docs/robot-import.md), or the robot file's [pd]")
+        if s["pd_joints"]:
+            lines.append("held by the PD layer (kp [N m/rad], kv [N m s/rad], max [N m]): " + ", ".join(
+                f"{name} {a['kp']:.1f}/{a['kv']:.2f}/{a['force_limit']:.3g}" for name, a in s["pd_joints"].items()))
+        if statics is not None:
+            lines.append("2 feet, 1 foot: static torque [N m] holding the ready posture on both feet, and on one foot "
+                         "with the centre of mass over its sole (the larger of the two feet)")
+            over = statics.over_limit
+            lines.append("over the actuator's limit standing still: " + (", ".join(over) if over else "none"))
+        if s["held_joints"]:
+            lines.append(f"held at the reference pose: {', '.join(s['held_joints'])}")
+    return "\n".join(lines)
+
+
+def _joint_lines(joints: list[dict[str, Any]], statics: StaticTorques | None) -> list[str]:
+    """The leg joints' table: column, model joint, axis, sign, zero, range, what drives it and its gains, the
+    torque limit, and the static torques where given."""
+    header = (f"{'column':<18} {'model joint':<22} {'axis':<16} {'sign':>4} {'zero':>7} {'range [rad]':>17} "
+              f"{'actuator':<17} {'kp':>8} {'kv':>7} {'I':>7} {'max [N m]':>9}"
+              + (f" {'2 feet':>7} {'1 foot':>7}" if statics is not None else ""))
+    lines = [header, "-" * len(header)]
+    for index, joint in enumerate(joints):
+        actuator = joint["actuator"] or {"drive": "none", "kp": math.nan, "kv": math.nan, "force_limit": math.nan,
+                                         "inertia": math.nan}
+        axis = "(" + ", ".join(f"{v:+.2f}" for v in joint["axis"]) + ")"
+        inertia = "-" if math.isnan(actuator["inertia"]) else f"{actuator['inertia']:.4f}"
+        lines.append(f"{joint['column']:<18} {joint['name']:<22} {axis:<16} {joint['sign']:>+4d} "
+                     f"{joint['zero_offset']:>+7.3f} [{joint['limits'][0]:>+7.3f}, {joint['limits'][1]:>+7.3f}] "
+                     f"{actuator['drive']:<17} {actuator['kp']:>8.1f} {actuator['kv']:>7.2f} {inertia:>7} "
+                     f"{actuator['force_limit']:>9.1f}"
+                     + (f" {abs(statics.both_feet[index]):>7.1f} {statics.one_foot[index]:>7.1f}"
+                        if statics is not None else ""))
+    return lines
+
+
+def robot_toml(robot: RobotModel, folder: Path) -> str:
+    """A robot file that loads the robot's own model (``[model]``), with the values a builder may change
+    (``[posture]``, ``[walking]``) and the derived geometry as comments to check against the CAD.
+
+    Args:
+        folder: Where the file will be written (the model path is written relative to it).
+    """
+    lines = [f"# zmpwalk robot file of {robot.name}, derived from its model by 'zmpwalk robot'.",
+             "# Units: SI (m, kg, rad, s). Values under [posture] and [walking] replace the derived ones."]
+    if robot.plant is not None:
+        plant = robot.plant
+        try:
+            model_path = os.path.relpath(plant.path, folder.resolve())
+        except ValueError:  # another drive
+            model_path = str(plant.path)
+        lines += ["", "[model]", f"file = {_quote(model_path)}",
+                  f"feet = [{_quote(plant.feet[0])}, {_quote(plant.feet[1])}]"]
+        if plant.keyframe:
+            lines.append(f"keyframe = {_quote(plant.keyframe)}")
+        if plant.package_paths:
+            lines.append("package_paths = [" + ", ".join(_quote(str(p)) for p in plant.package_paths) + "]")
+        lines.append(f"name = {_quote(robot.name)}")
+    lines += ["", "[posture]",
+              f"pelvis_height = {robot.pelvis_height:.6g}   # [m] base origin above the ground, ready posture",
+              "", "[walking]",
+              f"dsp_time = {robot.dsp_time:.6g}   # [s] double-support time d (HUBO's 0.1 s, time-scaled)",
+              f"foot_lift = {robot.foot_lift:.6g}   # [m] swing apex height (HUBO's 0.04 m, length-scaled)",
+              f"lateral_velocity = {robot.lateral_velocity:.6g}   # [m] V_y of Eq. 20 (HUBO's 0.1 m, lateral-scaled)"]
+    if robot.plant is not None and robot.plant.pd_joints:
+        lines += ["", "[pd]",
+                  "# The joint PD layer (the firmware's joint loop) of each torque motor or unactuated joint:",
+                  "# kp [N m/rad], kv [N m s/rad] (kv may be left out: critical damping). Derived by zmpwalk's rule",
+                  "# (docs/robot-import.md); put your firmware's gains here."]
+        lines += [f"{_quote(name)} = {{kp = {actuator.kp:.6g}, kv = {actuator.kv:.6g}}}"
+                  for name, actuator in robot.plant.pd_joints]
+    lines += ["", "# Derived from the model (for checking; edit the model, not these lines):"]
+    lines += [f"#   {line}" if line else "#" for line in robot_table(robot).splitlines()]
+    return "\n".join(lines) + "\n"
+
+
+def _quote(text: str) -> str:
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'

@@ -1,0 +1,184 @@
+"""Each joint's actuator read from a robot's own model, and the joint PD layer (a humanoid's firmware loop) for
+torque motors and unactuated joints: :func:`pd_gains`'s rule from the joint's reflected inertia and the weight it
+holds."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zmpwalk.errors import InvalidParameterError
+from zmpwalk.robots.description import (
+    PD_BANDWIDTH,
+    PD_DAMPING_RATIO,
+    PD_LOAD_STIFFNESS,
+    PD_PREFIX,
+    PD_STEP_LIMIT,
+    PHYSICS_STEP,
+    Actuator,
+)
+
+Array = NDArray[np.float64]
+
+
+def element_name(model: object, kind: object, index: int) -> str:
+    """The name of a model's element (a joint, a body, an actuator: ``kind``), or ``#index`` where it has none."""
+    import mujoco
+
+    return str(mujoco.mj_id2name(model, kind, index) or f"#{index}")
+
+
+def is_position_servo(model: Any, actuator: int) -> bool:
+    """Whether an actuator is a position servo on a joint: ``gain (u - q) - kv q'`` (MuJoCo ``<position>``
+    or an equivalent ``<general>``)."""
+    import mujoco
+
+    gain, bias = model.actuator_gainprm[actuator], model.actuator_biasprm[actuator]
+    return bool(model.actuator_trntype[actuator] == mujoco.mjtTrn.mjTRN_JOINT and gain[0] > 0
+                and model.actuator_biastype[actuator] == mujoco.mjtBias.mjBIAS_AFFINE
+                and abs(bias[1] + gain[0]) < 1e-9 * max(1.0, gain[0]))
+
+
+def joint_actuator(model: object, joint: int) -> Actuator | None:
+    """The model's actuator of ``joint`` (the first with a joint transmission to it), or None; its ``kp``, ``kv``
+    are the model's (0 for a motor: see :func:`pd_layer`)."""
+    import mujoco
+
+    m = model
+    for a in range(m.nu):  # type: ignore[attr-defined]
+        if m.actuator_trntype[a] != mujoco.mjtTrn.mjTRN_JOINT or int(m.actuator_trnid[a][0]) != joint:  # type: ignore[attr-defined]
+            continue
+        gear = float(m.actuator_gear[a][0])  # type: ignore[attr-defined]
+        gain, bias = m.actuator_gainprm[a], m.actuator_biasprm[a]  # type: ignore[attr-defined]
+        if is_position_servo(m, a):
+            kind, kp, kv = "position", float(gain[0]) * gear, float(-bias[2]) * gear
+        elif _is_motor(m, a):
+            kind, kp, kv = "motor", 0.0, 0.0
+        else:
+            kind, kp, kv = "general", float(gain[0]), float(-bias[2])
+        limit = _joint_torque_limit(m, joint)
+        if m.actuator_forcelimited[a]:  # type: ignore[attr-defined]
+            limit = min(limit, float(np.max(np.abs(m.actuator_forcerange[a]))) * abs(gear))  # type: ignore[attr-defined]
+        if kind == "motor" and m.actuator_ctrllimited[a]:  # type: ignore[attr-defined]
+            limit = min(limit, float(np.max(np.abs(m.actuator_ctrlrange[a]))) * abs(float(gain[0]) * gear))  # type: ignore[attr-defined]
+        return Actuator(element_name(m, mujoco.mjtObj.mjOBJ_ACTUATOR, a), kind, kp, kv, limit)
+    return None
+
+
+def _is_motor(model: Any, actuator: int) -> bool:
+    """Whether an actuator is a torque motor on a joint: ``gain ctrl`` (MuJoCo ``<motor>``: fixed gain, no bias,
+    no activation dynamics)."""
+    import mujoco
+
+    return bool(model.actuator_trntype[actuator] == mujoco.mjtTrn.mjTRN_JOINT
+                and model.actuator_biastype[actuator] == mujoco.mjtBias.mjBIAS_NONE
+                and model.actuator_gaintype[actuator] == mujoco.mjtGain.mjGAIN_FIXED
+                and model.actuator_dyntype[actuator] == mujoco.mjtDyn.mjDYN_NONE)
+
+
+def _joint_torque_limit(model: Any, joint: int) -> float:
+    """The joint's own limit on its actuators' total torque, ``actuatorfrcrange`` (a URDF's ``<limit effort>``)
+    [N m]; inf where it has none."""
+    if not model.jnt_actfrclimited[joint]:
+        return math.inf
+    return float(np.max(np.abs(model.jnt_actfrcrange[joint])))
+
+
+def pd_gains(inertia: float, moment: float, timestep: float = PHYSICS_STEP) -> tuple[float, float]:
+    r"""The joint PD layer's gains of one joint: stiffness ``kp`` [N m/rad] and damping ``kv`` [N m s/rad].
+
+    .. math::
+
+        k_p = \min\left(\max(I \omega^2,\ \kappa W),\ I (\beta / \Delta t)^2\right), \qquad
+        k_v = 2 \zeta \sqrt{k_p I}
+
+    with :data:`PD_BANDWIDTH` ``omega`` (the joint swings on its own inertia at least this fast),
+    :data:`PD_LOAD_STIFFNESS` ``kappa`` times the weight moment ``W`` it holds (a leg joint holds the robot on
+    one foot, ``W = m g l``, whose toppling moment grows by ``m g l`` per radian of lean: at ``kappa = 2`` the
+    joint's net stiffness against it is still ``m g l``, above the 1.7 ``m g l`` below which the stabilizer
+    stiffens servos with its encoder loop), the discrete bound :data:`PD_STEP_LIMIT` ``beta``
+    (``sqrt(kp / I) dt <= beta``, and so ``kv dt / I <= 2 zeta beta``: stable at the physics step even where the
+    damping is integrated explicitly, the bound being 2) and :data:`PD_DAMPING_RATIO` ``zeta`` (critical damping
+    of the joint swinging on its own inertia).
+
+    Args:
+        inertia: ``I``, the joint's reflected inertia: the diagonal of the joint-space mass matrix at the ready
+            posture, the rotor's armature included [kg m^2].
+        moment: ``W``, the weight moment the joint holds [N m] (0: the bandwidth alone).
+        timestep: ``dt``, the period of the PD loop, the physics step [s].
+
+    Raises:
+        InvalidParameterError: A non-positive inertia or time step, or a negative moment.
+    """
+    if not inertia > 0 or not math.isfinite(inertia):
+        raise InvalidParameterError("inertia", inertia, "a finite reflected inertia > 0 kg m^2")
+    if not timestep > 0:
+        raise InvalidParameterError("timestep", timestep, "a physics step > 0 s")
+    if not moment >= 0:
+        raise InvalidParameterError("moment", moment, "a weight moment >= 0 N m")
+    kp = max(inertia * PD_BANDWIDTH ** 2, PD_LOAD_STIFFNESS * moment)
+    kp = min(kp, inertia * (PD_STEP_LIMIT / timestep) ** 2)
+    return kp, 2.0 * PD_DAMPING_RATIO * math.sqrt(kp * inertia)
+
+
+def _weight_moment(model: Any, data: Any, joint: int) -> float:
+    """The largest moment of the weight of the bodies a hinge moves about its axis [N m]: their mass times g
+    times their centre of mass's distance from the axis line."""
+    body = int(model.jnt_bodyid[joint])
+    axis = data.xaxis[joint]
+    lever = data.subtree_com[body] - data.xanchor[joint]
+    distance = float(np.linalg.norm(lever - axis * float(axis @ lever)))
+    return float(model.body_subtreemass[body]) * float(np.linalg.norm(model.opt.gravity)) * distance
+
+
+def pd_layer(model: Any, data: Any, qpos: Array, leg_joints: set[int], leg_moment: float,
+              given: dict[str, tuple[float, float | None]]) -> tuple[tuple[str, Actuator], ...]:
+    """The joints the PD layer drives, with their actuators (gains from :func:`pd_gains` at the posture ``qpos``,
+    or ``given``: joint name -> (kp, kv or None for critical damping)): every torque motor on a hinge or slide,
+    every leg joint without an actuator, and every joint of a model without actuators (a URDF). A leg joint holds
+    ``leg_moment`` [N m]; another hinge the weight of what it moves (:func:`_weight_moment`); a slide nothing.
+
+    Raises:
+        InvalidParameterError: ``given`` names a joint the layer does not drive, or a leg joint's torque
+            limit is 0.
+    """
+    import mujoco
+
+    data.qpos[:] = qpos
+    mujoco.mj_forward(model, data)
+    inertia = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, inertia)
+    timestep = min(float(model.opt.timestep), PHYSICS_STEP)
+    layer = []
+    for j in range(model.njnt):
+        hinge = int(model.jnt_type[j]) == mujoco.mjtJoint.mjJNT_HINGE  # a numpy integer is never `in` enums
+        if not hinge and int(model.jnt_type[j]) != mujoco.mjtJoint.mjJNT_SLIDE:
+            continue
+        name = element_name(model, mujoco.mjtObj.mjOBJ_JOINT, j)
+        existing = joint_actuator(model, j)
+        if existing is None and (j in leg_joints or model.nu == 0):
+            existing = Actuator(PD_PREFIX + name, "none", 0.0, 0.0, _joint_torque_limit(model, j))
+        if existing is None or existing.kind not in ("motor", "none"):
+            continue
+        if existing.force_limit == 0.0:
+            if j in leg_joints:
+                raise InvalidParameterError(f"{name} torque limit", 0.0, "a leg joint's torque limit > 0 N m "
+                                            "(actuatorfrcrange, a URDF's <limit effort>, the motor's ctrlrange)")
+            continue  # the model holds it passive
+        dof = int(model.jnt_dofadr[j])
+        moment = leg_moment if j in leg_joints else _weight_moment(model, data, j) if hinge else 0.0
+        reflected = float(inertia[dof, dof])
+        kp, kv = pd_gains(reflected, moment, timestep)
+        if name in given:
+            kp, wanted = given[name]
+            kv = 2.0 * PD_DAMPING_RATIO * math.sqrt(kp * reflected) if wanted is None else wanted
+        layer.append((name, replace(existing, kp=kp, kv=kv, pd_layer=True, inertia=reflected)))
+    unknown = sorted(set(given) - {name for name, _ in layer})
+    if unknown:
+        raise InvalidParameterError("pd joint", unknown[0], "a joint the PD layer drives (a torque motor's or an "
+                                    "unactuated leg joint): " + ", ".join(name for name, _ in layer))
+    return tuple(layer)
