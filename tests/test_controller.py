@@ -361,3 +361,30 @@ def test_the_walk_s_clock_and_settle(hubo):
         WalkingController(hubo, RATE, capture=True)  # type: ignore[arg-type]
     with pytest.raises(InvalidParameterError, match="noise"):
         MujocoPlant(hubo, RATE, noise=0.1)  # type: ignore[arg-type]
+
+
+@pytest.mark.slow
+def test_a_simulated_walk_is_the_same_on_a_busy_machine(hubo, monkeypatch):
+    """The simulator's walker counts the parts of a command's check (sim.loop.simulated_clock) instead of timing
+    them: on a machine 20 times slower (every reading of the machine's clock 1 ms on) turn45 walks to the same
+    metre, its commands given at the same ticks. (The machine's own clock there gives the commands 1.563 s later
+    and another walk.)"""
+    from zmpwalk import online
+    from zmpwalk.scenarios import load_scenario
+
+    commands = load_scenario("turn45")
+    quiet = simulate_controller(hubo, commands)
+    now = [0.0]
+
+    def busy() -> float:
+        now[0] += 1e-3
+        return now[0]
+
+    monkeypatch.setattr(online, "_clock", busy)
+    loaded = simulate_controller(hubo, commands)
+    assert loaded.given == quiet.given
+    assert loaded.result.distance == quiet.result.distance  # [m] bitwise
+    plant = MujocoPlant(hubo, RATE)
+    machine = simulate_controller(hubo, commands, plant=plant,
+                                  controller=WalkingController(hubo, RATE, feedforward=plant.feedforward()))
+    assert machine.given[1] > quiet.given[1] + 1.0  # [s] the premise: the machine's clock is the difference

@@ -181,3 +181,21 @@ def test_the_closing_stop_is_named_after_the_step_it_follows(hubo):
     assert [walk.label(n) for n in (1, 3, 4)] == ["step 1", "step 3", "the closing stop after step 3"]
     walk.labels = ["walk.toml [[steps]] 1", "walk.toml [[steps]] 1", "walk.toml [[steps]] 2"]
     assert walk.label(4) == "the closing stop after walk.toml [[steps]] 2"
+
+
+def test_a_step_in_place_the_legs_cannot_follow_names_the_foot_lift_it_was_given(hubo):
+    """A robot whose ankle pitch stops 15 mrad past its standing angle (-0.5054 rad) cannot step in place at the
+    schedule's lift: the error names the foot lift (the schedule's: the command sets none), says what helps, and
+    gives the joint that leaves its range; 5 mm of lift fits."""
+    import dataclasses
+
+    robot = dataclasses.replace(hubo, joint_limits={"ankle_pitch": (-0.52, 1.0)})
+    walker = OnlineWalker(robot, rate=RATE, joints=True)
+    with pytest.raises(InfeasibleCommandError) as refused:
+        walker.command(StepCommand(0.8), wait=True)
+    error = refused.value
+    assert error.parameter == "foot_lift" and error.value == "the schedule's" and not error.largest
+    assert "a step in place the legs can follow from here: a lower foot lift or another step time" in str(error)
+    assert "ankle_pitch" in str(error) and "None" not in str(error)
+    walker.command(StepCommand(0.8, foot_lift=0.005), wait=True)
+    assert walker.queued is not None or walker.walking

@@ -56,7 +56,8 @@ class InfeasibleCommandError(InvalidParameterError):
 
     Attributes:
         parameter, value, allowed: As :class:`InvalidParameterError`; ``parameter`` is the command's
-            largest stride field (``forward``, ``side`` or ``turn``), or ``foot_lift`` for a step in place.
+            largest stride field (``forward``, ``side`` or ``turn``), or ``foot_lift`` for a step in place (its value
+            the command's, or "the schedule's" where the command does not set it).
         largest: The largest stride that fits in the same direction, as ``{field: value}`` (signed, SI), or
             empty when no stride in that direction fits (the cause is then another field).
         cause: The reach, joint-range or ZMP error behind it.
@@ -78,6 +79,8 @@ class InfeasibleCommandError(InvalidParameterError):
         if largest:
             at = f" at a step time of {step_time:.3f} s" if step_time is not None else ""
             allowed = f"a stride {fitting} {where}, at most {self.stride_text(largest)}{at}; {cause}"
+        elif parameter == "foot_lift":  # a step in place: no stride to shorten
+            allowed = f"a step in place {fitting} {where}: a lower foot lift or another step time; {cause}"
         else:
             allowed = f"a step {fitting} {where}; no stride in this direction fits, whatever its length; {cause}"
         super().__init__(parameter, value, allowed)

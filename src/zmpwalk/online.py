@@ -66,6 +66,7 @@ from __future__ import annotations
 import math
 import numbers
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -192,6 +193,8 @@ class OnlineWalker:
             :func:`work_budget`: 50 us, or 1 % of the control period where that is longer, at most 500 us).
             Smaller: shorter ticks, and checks that take more ticks, so that more commands come too late for the
             step they were given in (and walk a step later: module docstring).
+        clock: The budget's clock [s] (default ``time.perf_counter``, the machine's); a simulation gives one that
+            counts parts (:class:`~zmpwalk.slices.CountingClock`), so that its walk is the same under any load.
 
     Raises:
         InvalidParameterError: An unknown ``pelvis`` or ``generator``, ``pelvis="quintic"`` with the
@@ -201,9 +204,12 @@ class OnlineWalker:
 
     def __init__(self, robot: RobotModel, rate: float = 100.0, schedule: Schedule | None = None,
                  joints: bool = False, pelvis: str = "cubic", generator: str | None = None,
-                 budget: float | None = None) -> None:
+                 budget: float | None = None, clock: Callable[[], float] | None = None) -> None:
         check_rate(rate)
         self._budget = work_budget(rate) if budget is None else _checked_budget(budget, rate)
+        if clock is not None and not callable(clock):
+            raise InvalidParameterError("clock", clock, "a callable returning seconds, or None (the machine's)")
+        self._own_clock = clock
         self._pelvis = online_pelvis(pelvis, robot.default_generator if generator is None else generator)
         self.robot, self.rate, self.joints = robot, float(rate), bool(joints)
         self._width = ROW_WIDTH_WITH_JOINTS if self.joints else ROW_WIDTH
@@ -343,6 +349,11 @@ class OnlineWalker:
             rejection.named = True
         return rejection.error
 
+    def now(self) -> float:
+        """The budget's clock [s] (the constructor's ``clock``): what a loop times its own work in the tick with, for
+        :meth:`work`'s ``spent``."""
+        return (self._own_clock or _clock)()
+
     def work(self, spent: float = 0.0) -> None:
         """The parts of a command's check that :meth:`tick` runs, where it was called with ``work=False``: within
         the tick's budget less ``spent`` [s] (the loop's own work in the tick: the stabilizer's) but at least
@@ -372,7 +383,8 @@ class OnlineWalker:
         quota = -(-(expected - job.parts) // ticks_left)  # its share of the parts left
         plan: object
         try:
-            plan, parts = run_for(job.planning, max(self._budget - spent, WORK_SHARE * self._budget), quota, _clock)
+            plan, parts = run_for(job.planning, max(self._budget - spent, WORK_SHARE * self._budget), quota,
+                                  self._own_clock or _clock)
             job.parts += parts
         except ZmpwalkError as error:
             self._drop_job()

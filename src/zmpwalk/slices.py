@@ -62,6 +62,24 @@ def run_for(parts: Parts[T], budget: float, quota: int = 1,
             return UNFINISHED, count
 
 
+class CountingClock:
+    """A clock that advances ``step`` [s] at every reading: a time budget read with it counts parts (:func:`run_for`
+    reads it once before the first part and once after each), the same on every machine and under any load. For
+    simulations, whose results must not depend on how busy the machine running them is.
+
+    Args:
+        step: [s] per reading.
+    """
+
+    def __init__(self, step: float) -> None:
+        self.step = float(step)
+        self.now = 0.0  # [s]
+
+    def __call__(self) -> float:
+        self.now += self.step
+        return self.now
+
+
 def whole(parts: Callable[P, Parts[T]], name: str) -> Callable[P, T]:
     """The function ``name`` that runs a sliced computation to its end, with the same arguments and docstring."""
     @functools.wraps(parts)

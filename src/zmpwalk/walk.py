@@ -323,7 +323,7 @@ def _controller_walk(spec: WalkSpec, progress: Callable[[float], None] | None) -
         ZmpwalkError: The walker refused a command (the first refusal, in ``spec.source``'s words).
     """
     from zmpwalk.control import WalkingController
-    from zmpwalk.sim.loop import simulate_controller, walk_start
+    from zmpwalk.sim.loop import simulate_controller, simulated_clock, walk_start
     from zmpwalk.sim.mujoco_plant import MujocoPlant
     from zmpwalk.sim.references import CONTROL_RATE
 
@@ -332,7 +332,7 @@ def _controller_walk(spec: WalkSpec, progress: Callable[[float], None] | None) -
                         time_origin=walk_start(spec.settle, CONTROL_RATE))  # a push at the walk's time
     controller = WalkingController(spec.robot, CONTROL_RATE, schedule=spec.schedule,
                                    generator=spec.generator_name, pelvis=spec.pelvis, feedforward=plant.feedforward(),
-                                   capture=spec.capture)
+                                   capture=spec.capture, clock=simulated_clock(CONTROL_RATE))
     run = simulate_controller(spec.robot, spec.commands, controller=controller, plant=plant, hold=spec.hold,
                               settle=spec.settle, progress=progress)
     if run.rejections:

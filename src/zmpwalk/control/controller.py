@@ -25,12 +25,12 @@ from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Callable
 from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
-from zmpwalk import online
 from zmpwalk.balance import BalanceMeasurement, Stabilizer
 from zmpwalk.capture import CapturePlan, CaptureSettings
 from zmpwalk.commands import StepCommand
@@ -141,6 +141,8 @@ class WalkingController:
         capture: Take capture steps (:mod:`zmpwalk.control.capture`: when the stabilizer's DCM error passes the
             trigger in a single support, the rest of the walk becomes one capture step and a stop; the walker
             then stands where it left the feet); None: none.
+        clock: The walker's budget clock (:class:`~zmpwalk.online.OnlineWalker`): None, the machine's; the
+            simulator gives one that counts parts (:func:`zmpwalk.sim.loop.simulated_clock`).
 
     Raises:
         InvalidParameterError: As :class:`~zmpwalk.online.OnlineWalker` and :class:`~zmpwalk.balance.Stabilizer`
@@ -158,7 +160,7 @@ class WalkingController:
     def __init__(self, robot: RobotModel, rate: float = 1000.0, *, schedule: Schedule | None = None,
                  generator: str | None = None, pelvis: str = "cubic", balance: bool = True,
                  gains: StabilizerGains | None = None, feedforward: Feedforward | None = None,
-                 capture: CaptureSettings | None = None) -> None:
+                 capture: CaptureSettings | None = None, clock: Callable[[], float] | None = None) -> None:
         if capture is not None and not isinstance(capture, CaptureSettings):
             raise InvalidParameterError("capture", capture, "a CaptureSettings, or None")
         if capture is not None and not balance:
@@ -166,7 +168,8 @@ class WalkingController:
                                         "estimate triggers the capture step")
         self.robot = robot
         self.schedule = schedule or Schedule.hubo()
-        self.walker = OnlineWalker(robot, rate, self.schedule, joints=True, pelvis=pelvis, generator=generator)
+        self.walker = OnlineWalker(robot, rate, self.schedule, joints=True, pelvis=pelvis, generator=generator,
+                                   clock=clock)
         self.rate = self.walker.rate
         self.stabilizer = Stabilizer(robot, rate, gains) if balance else None
         self.feedforward = feedforward
@@ -323,7 +326,7 @@ class WalkingController:
         """
         if not isinstance(measurement, BalanceMeasurement):
             raise InvalidParameterError("measurement", type(measurement).__name__, "a BalanceMeasurement")
-        begin = online._clock()
+        begin = self.walker.now()
         walker, tick, previous = self.walker, self._ticks, self._sample
         sample = walker.tick(work=False)  # ticked during a capture too: its clock runs on, standing
         if self._capture is not None and self._capture.planning and self.stabilizer is not None:
@@ -346,7 +349,7 @@ class WalkingController:
                 self._deferred = None
         torques = None if self.feedforward is None else self.feedforward.torques(sample)
         if walker.checking is not None:  # the check's parts, in the budget the tick has left
-            walker.work(online._clock() - begin)
+            walker.work(walker.now() - begin)
         self._give_velocity_step()
         return JointTargets(sample.time, angles if corrected is None else corrected, velocities, torques, sample,
                             corrected is not None)

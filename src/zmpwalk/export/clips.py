@@ -35,7 +35,7 @@ from zmpwalk.errors import InvalidParameterError
 from zmpwalk.online import START_DELAY
 from zmpwalk.robots.collision import collision_points, rigid_bodies
 from zmpwalk.robots.model import RobotModel
-from zmpwalk.sim.loop import ControllerRun, simulate_controller
+from zmpwalk.sim.loop import ControllerRun, simulate_controller, simulated_clock
 from zmpwalk.sim.mujoco_plant import MujocoPlant, _ankle_sites, _base_position, _upright
 
 Array = NDArray[np.float64]
@@ -137,7 +137,7 @@ def walk_clips(robot: RobotModel, command: StepCommand, count: int, fps: float,
     every = CONTROL_RATE / fps
     plant = _RecordingPlant(robot, CONTROL_RATE, every)
     controller = WalkingController(robot, CONTROL_RATE, generator=generator or robot.default_generator,
-                                   feedforward=plant.feedforward())
+                                   feedforward=plant.feedforward(), clock=simulated_clock(CONTROL_RATE))
     run = simulate_controller(robot, [command] * count, rate=CONTROL_RATE, plant=plant, controller=controller)
     states = np.asarray(plant.states)
     frames = np.arange(math.floor((len(states) - 1) / every) + 1)

@@ -96,7 +96,8 @@ def infeasible_command(command: StepCommand, cause: ZmpwalkError, feasible: Call
 
     moving = [name for name in STRIDE_FIELDS if getattr(command, name) != 0.0]
     if not moving:
-        return InfeasibleCommandError("foot_lift", command.foot_lift, {}, cause)
+        lift = command.foot_lift if command.foot_lift is not None else "the schedule's"
+        return InfeasibleCommandError("foot_lift", lift, {}, cause)
     # the field that is largest against its own limit names the error
     limits = {"forward": MAX_STRIDE, "side": MAX_STRIDE, "turn": MAX_TURN}
     name = max(moving, key=lambda n: abs(getattr(command, n)) / limits[n])

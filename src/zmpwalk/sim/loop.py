@@ -35,7 +35,7 @@ from zmpwalk.control import JointTargets, WalkingController
 from zmpwalk.errors import InvalidParameterError, ZmpwalkError
 from zmpwalk.footsteps import sole_corners
 from zmpwalk.kinematics import JOINT_COLUMNS
-from zmpwalk.online import START_DELAY, OnlineWalker
+from zmpwalk.online import START_DELAY, OnlineWalker, work_budget
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sides import SUPPORT_OF_LABEL
 from zmpwalk.sim.disturbances import Disturbances, SensorNoise
@@ -45,6 +45,7 @@ from zmpwalk.sim.ranges import check_range
 from zmpwalk.sim.result import SimulationResult
 from zmpwalk.sim.soles import SoleMeasurements, foot_slip, rpy_from_quaternion, sole_measurements
 from zmpwalk.sim.verdict import HOLD
+from zmpwalk.slices import CountingClock
 from zmpwalk.stabilizer.layout import LOG_SIZE, L
 from zmpwalk.zmp import batch_hull_margin, edge_margin
 
@@ -146,6 +147,18 @@ class _Log:
                 "pelvis_turn": rows[:, L.pelvis_turn:L.pelvis_turn + 2].copy()}
 
 
+SIMULATED_PART = 0.2  # [-] of the walker's work budget: what each part of a command's check costs in a simulation
+
+
+def simulated_clock(rate: float) -> CountingClock:
+    """The walker's budget clock in a simulated loop at ``rate`` [Hz]: each reading advances
+    :data:`SIMULATED_PART` of the budget (:func:`~zmpwalk.online.work_budget`), so a tick runs the parts of a
+    command's check that fit the budget at that cost (about four; this machine's parts take 5-20 us of 50), the
+    same on every machine and under any load: a simulated walk, its commands' checks included, does not depend on
+    how busy the machine running it is."""
+    return CountingClock(SIMULATED_PART * work_budget(rate))
+
+
 def walk_start(settle: float, rate: float) -> float:
     """When a walk given ``settle`` [s] begins [s] after the robot is stood (:func:`simulate_controller`): its
     first command ``settle - START_DELAY`` after (at once where that is negative), the walk START_DELAY later."""
@@ -190,8 +203,9 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
         commands: The steps, given one by one during the walk (a steps file's, :func:`zmpwalk.scenarios.load_scenario`).
         rate: Control rate [Hz].
         controller: The controller (default: a :class:`~zmpwalk.control.WalkingController` with the stabilizer
-            where ``balance``, capture steps with ``capture`` and the plant's
-            :class:`~zmpwalk.sim.mujoco_plant.ModelFeedforward` where ``feedforward``).
+            where ``balance``, capture steps with ``capture``, the plant's
+            :class:`~zmpwalk.sim.mujoco_plant.ModelFeedforward` where ``feedforward``, and the walker's budget on
+            :func:`simulated_clock`).
         plant: The plant (default: a :class:`~zmpwalk.sim.mujoco_plant.MujocoPlant` with ``mass_scale``,
             ``disturbances``, ``latency`` [s] and ``noise``: the controller measures the sensors ``latency`` late,
             with that noise).
@@ -222,7 +236,8 @@ def simulate_controller(robot: RobotModel, commands: Sequence[StepCommand] = (),
     plant = plant or MujocoPlant(robot, rate, mass_scale=mass_scale, disturbances=disturbances, latency=latency,
                                  noise=noise, time_origin=start)
     controller = controller or WalkingController(robot, plant.rate, balance=balance, capture=capture,
-                                                 feedforward=plant.feedforward() if feedforward else None)
+                                                 feedforward=plant.feedforward() if feedforward else None,
+                                                 clock=simulated_clock(plant.rate))
     if controller.rate != plant.rate:
         raise InvalidParameterError("controller.rate", controller.rate, f"the plant's rate, {plant.rate:g} Hz")
     plant.stand(OnlineWalker(robot, plant.rate, controller.schedule, joints=True).tick())
