@@ -1,10 +1,11 @@
 """The walking controller's ticks in pushed walks with capture steps: per-tick CPU time of ``update()``.
 
 Each case walks a robot through the walking controller in MuJoCo (:func:`zmpwalk.sim.loop.simulate_controller`,
-1 kHz, the stabilizer, the feedforward, ``CaptureSettings()``) with a push in the middle of the fifth step's single
-support, and times every ``WalkingController.update`` with ``time.thread_time_ns()`` (this thread's CPU time: other
-processes on a shared machine do not count). Printed per case: the captures taken, the ticks' median, p99 and max,
-the count over 200 us and over 1 ms, and the largest tick within 0.1 s of a capture's trigger (where its plan runs).
+1 kHz, the stabilizer, the plant's feedforward, ``CaptureSettings()``, as ``simulate --capture`` runs it) with a
+push in the middle of the fifth step's single support, and times every ``WalkingController.update`` with
+``time.thread_time_ns()`` (this thread's CPU time: other processes on a shared machine do not count). Printed per
+case: the captures taken, the ticks' median, p99 and max, the count over 200 us and over 1 ms, and the largest tick
+within 0.1 s of a capture's trigger (where its plan runs).
 
 ``--before DIR`` runs every case also against another source tree (``DIR/src`` on ``PYTHONPATH``), in the same
 run, side by side. TALOS needs ../shared/robots (skipped when absent).
@@ -45,6 +46,7 @@ def run_case(name: str) -> dict[str, object]:
     from zmpwalk.scenarios import load_scenario
     from zmpwalk.sim.disturbances import Disturbances
     from zmpwalk.sim.loop import simulate_controller
+    from zmpwalk.sim.mujoco_plant import MujocoPlant
 
     robot_name, (px, py) = CASES[name]
     if robot_name == "talos":
@@ -67,7 +69,14 @@ def run_case(name: str) -> dict[str, object]:
             ticks.append(time.thread_time_ns() - begin)
             return targets
 
-    controller = Timed(robot, 1000.0, capture=CaptureSettings())
+    plant = MujocoPlant(robot, 1000.0, disturbances=push)
+    try:  # the simulator's own controller: the plant's feedforward, the walker's budget counted in parts
+        from zmpwalk.sim.loop import simulated_clock
+
+        controller = Timed(robot, 1000.0, capture=CaptureSettings(), feedforward=plant.feedforward(),
+                           clock=simulated_clock(1000.0))
+    except ImportError:  # a tree from before the counted budget
+        controller = Timed(robot, 1000.0, capture=CaptureSettings(), feedforward=plant.feedforward())
     if controller._capture is not None:  # the trigger ticks, in either version of the policy
         policy = controller._capture
         for method in ("start", "plan"):
@@ -81,7 +90,7 @@ def run_case(name: str) -> dict[str, object]:
                 setattr(policy, method, traced)
     gc.collect()
     gc.freeze()
-    run = simulate_controller(robot, commands, controller=controller, disturbances=push)
+    run = simulate_controller(robot, commands, controller=controller, plant=plant)
     us = np.array(ticks) / 1e3
     near = [us[max(t - 5, 0):t + 100].max() for t in triggers]
     return {"captures": len(run.result.captures), "fell": run.result.fell, "ticks": len(us),

@@ -402,7 +402,8 @@ def test_the_predicted_dcm_error_follows_the_pendulum(hubo):
 
 def test_the_controller_plans_a_capture_over_its_lead_a_few_parts_a_tick(hubo, monkeypatch):
     """A capture forced 200 ticks into a single support (the trigger replaced) on the mock plant: it takes over
-    exactly ``lead`` ticks after its trigger, with no tick running more than one of its parts (1 kHz, 0.04 s), and
+    exactly ``lead`` ticks after its trigger, with no tick running more than two of its parts (1 kHz, 0.04 s: paced
+    for the parts of the last plan and of one more landing tried), and
     the references stay continuous there (the pelvis point moves at most 1 mm and each joint at most twice its
     largest move per tick over the 100 ticks before)."""
     import zmpwalk.control.capture as policy_module
@@ -427,9 +428,57 @@ def test_the_controller_plans_a_capture_over_its_lead_a_few_parts_a_tick(hubo, m
     first = starts[0] + policy.lead
     assert policy.lead == 40 and controller.captures[0].time == pytest.approx(log[first].sample.time, abs=1e-12)
     assert log[first].sample.support == log[first - 1].sample.support  # taken over within the single support
-    assert policy.parts_per_tick == 1
+    assert 1 <= policy.parts_per_tick <= 2
     pelvis = np.array([t.sample.position_pelvis_in_world for t in log[first - 100:first + 1]])
     angles = np.array([t.sample.joint_angles for t in log[first - 100:first + 1]])
     assert np.linalg.norm(pelvis[-1] - pelvis[-2]) < 1e-3  # [m]
     steps = np.abs(np.diff(angles, axis=0))
     assert (steps[-1] <= 2.0 * steps[:-1].max(axis=0) + 1e-9).all()
+
+
+@pytest.mark.slow
+def test_the_corrected_targets_do_not_jump_where_a_capture_takes_over(hubo):
+    """HUBO walking at 0.15 m/s, pushed 36 N s backward at 3.2 s: the stabilizer's landing correction of the
+    swinging foot grows during the 40 ms lead (-4.6 mm at the trigger, -19.2 mm at the take-over); the capture
+    starts from the first and the stabilizer keeps the rest, so no corrected joint target moves more at the take-over
+    than the most it moved per tick over the 100 ticks before (taking all of it at the take-over moved two joints
+    33.5 and 26.3 mrad, against 1.5 and 0.4 mrad)."""
+    from zmpwalk.control import WalkingController
+    from zmpwalk.sim.disturbances import Disturbances
+    from zmpwalk.sim.loop import simulate_controller, simulated_clock
+    from zmpwalk.sim.mujoco_plant import MujocoPlant
+
+    log = []
+
+    class Logged(WalkingController):
+        def update(self, measurement):
+            targets = super().update(measurement)
+            log.append((targets.angles.copy(), len(self.captures)))
+            return targets
+
+    plant = MujocoPlant(hubo, RATE, disturbances=Disturbances(push_time=3.2, push_impulse=(-36.0, 0.0, 0.0)))
+    controller = Logged(hubo, RATE, feedforward=plant.feedforward(), capture=CaptureSettings(),
+                        clock=simulated_clock(RATE))
+    run = simulate_controller(hubo, operator=lambda c, k: c.set_velocity(0.15, 0.0, 0.0) if k == 0 else None,
+                              duration=5.0, controller=controller, plant=plant)
+    assert not run.result.fell
+    first = [count for _, count in log].index(1)  # the take-over tick
+    steps = np.abs(np.diff(np.array([angles for angles, _ in log]), axis=0))
+    assert (steps[first - 1] <= steps[first - 101:first - 1].max(axis=0) + 1e-4).all()  # [rad]
+
+
+def test_a_landing_correction_handed_over_keeps_what_the_plan_did_not_take(hubo):
+    """Stabilizer.hand_over_landing(foot, taken): the correction keeps its part beyond ``taken``; None takes it all;
+    a malformed ``taken`` is refused by name, the correction unchanged."""
+    from zmpwalk.balance import Stabilizer
+
+    stabilizer = Stabilizer(hubo, RATE)
+    stabilizer._landing[1] = (0.010, -0.020)  # [m] the right foot's, as a swing would leave it
+    taken = stabilizer.hand_over_landing("right", np.array([0.004, -0.005]))
+    np.testing.assert_allclose(taken, [0.004, -0.005], atol=1e-15)
+    np.testing.assert_allclose(stabilizer.landing_correction("right"), [0.006, -0.015], atol=1e-15)
+    with pytest.raises(InvalidParameterError, match="taken"):
+        stabilizer.hand_over_landing("right", np.array([math.nan, 0.0]))
+    np.testing.assert_allclose(stabilizer.landing_correction("right"), [0.006, -0.015], atol=1e-15)
+    np.testing.assert_allclose(stabilizer.hand_over_landing("right"), [0.006, -0.015], atol=1e-15)
+    np.testing.assert_allclose(stabilizer.landing_correction("right"), [0.0, 0.0], atol=0)

@@ -276,17 +276,23 @@ class Stabilizer:
             raise InvalidParameterError("foot", foot, '"left" or "right"')
         return np.array(self._landing[0 if foot == "left" else 1], dtype=np.float64)
 
-    def hand_over_landing(self, foot: str) -> Array:
-        """Clear the landing correction of ``foot`` and return it (:meth:`landing_correction`): a new plan
-        whose swing starts from the planned place plus it takes it over (a capture step,
-        :func:`zmpwalk.capture.capture_step`), so the foot's target does not jump.
+    def hand_over_landing(self, foot: str, taken: Array | None = None) -> Array:
+        """Hand the landing correction of ``foot`` to a new plan whose swing starts from the planned place plus
+        ``taken`` [m] (world, (2,); None: the whole correction now, :meth:`landing_correction`): a capture step,
+        :func:`zmpwalk.capture.capture_step`. The correction keeps what the plan did not take (it may have moved
+        since the plan read it), so the foot's target does not jump. Returns the part taken.
 
         Raises:
-            InvalidParameterError: ``foot`` is not ``"left"`` or ``"right"``.
+            InvalidParameterError: ``foot`` is not ``"left"`` or ``"right"``, or ``taken`` is not two finite values.
         """
         correction = self.landing_correction(foot)
-        self._landing[0 if foot == "left" else 1] = 0.0
-        return correction
+        if taken is None:
+            taken = correction
+        taken = np.asarray(taken, dtype=np.float64)
+        if taken.shape != (2,) or not np.isfinite(taken).all():
+            raise InvalidParameterError("taken", taken.tolist(), "two finite values [m], or None")
+        self._landing[0 if foot == "left" else 1] = correction - taken
+        return np.array(taken, dtype=np.float64)
 
     def reset(self) -> None:
         """Forget the filters and offsets (the next update starts from the reference)."""

@@ -164,7 +164,7 @@ def zmp_margin_of_capture(plan: CaptureState, landing: Array, settle: float) -> 
     dcm_touchdown = plan.p1 + (plan.dcm - plan.p1) * math.exp(plan.omega * plan.swing_time)
     k = 1.0 / (plan.omega * settle)
     half_sum = (1.0 + 4.0 * k) / 2.0
-    root = half_sum - math.sqrt(half_sum**2 - 2.0 * k)  # the root in [0, 1] (the other is > 1 for k > 0)
+    root = 2.0 * k / (half_sum + math.sqrt(half_sum**2 - 2.0 * k))  # the root in (0, 1) (the other is > 1)
     taus = [0.0, 1.0] + ([root] if 0.0 < root < 1.0 else [])
     single, double = (phase.polygon(plan.robot).tolist() for phase in _record(plan, landing, settle, Support.LEFT)[1])
     margin = point_margin(float(plan.p1[0]), float(plan.p1[1]), single)

@@ -65,7 +65,8 @@ def run_for(parts: Parts[T], budget: float, quota: int = 1,
 class CountingClock:
     """A clock that advances ``step`` [s] at every reading: a time budget read with it counts parts (:func:`run_for`
     reads it once before the first part and once after each), the same on every machine and under any load. For
-    simulations, whose results must not depend on how busy the machine running them is.
+    simulations, whose results must not depend on how busy the machine running them is. It counts its readings
+    in an integer, so its time is the count times ``step`` however long it has run.
 
     Args:
         step: [s] per reading.
@@ -73,11 +74,11 @@ class CountingClock:
 
     def __init__(self, step: float) -> None:
         self.step = float(step)
-        self.now = 0.0  # [s]
+        self.readings = 0
 
     def __call__(self) -> float:
-        self.now += self.step
-        return self.now
+        self.readings += 1
+        return self.readings * self.step
 
 
 def whole(parts: Callable[P, Parts[T]], name: str) -> Callable[P, T]:

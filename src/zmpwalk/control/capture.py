@@ -1,20 +1,24 @@
 """Capture steps in the walking controller: a pushed walk becomes one capture step and a stop, tick by tick.
 
 :class:`CapturePolicy` is what :class:`~zmpwalk.control.WalkingController` asks after each stabilizer tick: in a
-single support, at least :data:`~zmpwalk.capture.CAPTURE_INTERVAL` after the last capture took over, with the
+single support, at least :data:`~zmpwalk.capture.CAPTURE_INTERVAL` after the last trigger and the last take-over,
+with the
 stabilizer's DCM error beyond :attr:`CaptureSettings.trigger`, it plans the rest of the walk as one capture step
 and a stop (:func:`zmpwalk.capture.capture_step`, Eqs. of the capture point: the swinging foot lands where the
 measured DCM can come to rest).
 
 **Bounded work per tick.** The plan does not run inside the triggering tick: it takes over
 :attr:`CaptureSettings.lead` later (40 ticks at 1 kHz), from the state the walk plays then, and its parts
-(:func:`~zmpwalk.capture.capture_step_parts` and the joints', each at most about 0.2 ms) run over the ticks
-in between, the parts left spread evenly over the ticks left (a count, not a clock: the same walk plans the same
-way on any machine). That state is known at the trigger: the walker's step under way holds its samples
+(:func:`~zmpwalk.capture.capture_step_parts` and the joints', each at most about 0.2 ms on HUBO; an imported
+robot's IK is one long part) run over the ticks in between, the parts left (those of the last plan and of one
+more landing tried, :data:`PULL_PARTS`) spread evenly over the ticks left (a count, not a clock: the same walk
+plans the same way on any machine). That state is known at the trigger: the walker's step under way holds its samples
 (:meth:`~zmpwalk.online.OnlineWalker.peek`), a capture under way its pattern; the DCM there is the plan's plus
 the stabilizer's error predicted over the lead from its own rate (:meth:`CapturePolicy.predicted_dcm_error`: the
 pendulum with the ZMP offset held that moves it now, a push still acting included). The swinging ankle starts
-where the stabilizer's landing correction aims it at the trigger. A plan whose single support ends first (the
+where the stabilizer's landing correction aims it at the trigger; what that correction moves during the lead
+stays the stabilizer's (:meth:`~zmpwalk.balance.Stabilizer.hand_over_landing`), so the foot's target does not
+jump at the take-over. A plan whose single support ends first (the
 foot lands), or that is not complete when its tick comes (more landings tried than it was paced for), is
 dropped and the walk goes on; a later trigger plans again.
 
@@ -145,6 +149,7 @@ class _Planning:
     first: int  # [ticks]
     support: str
     expected: int  # parts it is paced for
+    aim: Array  # [m] (2,) the swinging foot's landing correction the plan starts from
     done: int = 0  # parts run
     result: tuple[WalkingPattern, CapturePlan, JointTrajectory] | None = None
 
@@ -168,7 +173,7 @@ class CapturePolicy:
         self.captures: list[CapturePlan] = []
         self.lead = max(1, round(settings.lead * self.rate))
         self.parts_per_tick = 0
-        self._last = -math.inf  # [ticks] of the last plan
+        self._last = -math.inf  # [ticks] of the last trigger or take-over
         self._planning: _Planning | None = None
         self._expected = EXPECTED_PARTS
         self._errors = np.zeros((max(1, round(ERROR_RATE_WINDOW * self.rate)) + 1, 2))  # [m] the last DCM errors
@@ -210,9 +215,10 @@ class CapturePolicy:
         rates = [(a - b) / dt for a, b in zip(ankles, (second.position_left_ankle_in_world,
                                                         second.position_right_ankle_in_world), strict=True)]
         ankles = [a + r * dt for a, r in zip(ankles, rates, strict=True)]  # at the capture's first tick
-        ankles[0 if swing == "left" else 1][:2] += stabilizer.landing_correction(swing)
+        aim = stabilizer.landing_correction(swing)
+        ankles[0 if swing == "left" else 1][:2] += aim
         position_next = position + velocity * dt
-        error = self.predicted_dcm_error(lead - 1)
+        error = self.predicted_dcm_error(lead)
         dcm = position_next[:2] + velocity[:2] / stabilizer.omega + error
         touchdown = None if under_way is None else under_way.plan.time + under_way.plan.swing_time
         begin = last.time + dt
@@ -222,7 +228,7 @@ class CapturePolicy:
             ankles_in_world=(ankles[0], ankles[1]), ankle_velocities_in_world=(rates[0], rates[1]),
             foot_yaws=(last.yaw_left_foot_in_world, last.yaw_right_foot_in_world), settings=self.settings,
             touchdown=touchdown)
-        self._planning = _Planning(_with_joints(parts), tick + lead, stance, self._expected)
+        self._planning = _Planning(_with_joints(parts), tick + lead, stance, self._expected + PULL_PARTS, aim)
         return True
 
     def observe(self, dcm_error: Array) -> None:
@@ -230,6 +236,10 @@ class CapturePolicy:
         :data:`ERROR_RATE_WINDOW` predicts it over the lead)."""
         self._errors[self._observed % len(self._errors)] = dcm_error
         self._observed += 1
+
+    def forget(self) -> None:
+        """Forget the DCM errors kept (the stabilizer restarted: its error starts again from zero)."""
+        self._observed = 0
 
     def predicted_dcm_error(self, ticks: int) -> Array:
         r"""The stabilizer's DCM error ``ticks`` control periods after the last observed one [m], (2,).
@@ -287,16 +297,18 @@ class CapturePolicy:
         if job is None or tick < job.first:
             return None
         self._planning = None
-        if job.result is None:
+        if job.result is None:  # more landings tried than paced for: the next plan gets the parts this one ran
+            self._expected = max(self._expected, job.done)
             return None
         self._last = tick  # the next capture at least CAPTURE_INTERVAL after this one takes over
         pattern, plan, joints = job.result
-        stabilizer.hand_over_landing(plan.swing)
+        stabilizer.hand_over_landing(plan.swing, job.aim)  # the correction's moves since the trigger stay its own
         self.captures.append(plan)
         return CaptureMotion(plan, pattern, joints, tick, self.rate)
 
 
 ERROR_RATE_WINDOW = 0.005  # [s] the DCM error's rate is taken over this (whole ticks, at least one)
+PULL_PARTS = 16  # a plan is paced for this many parts more than the last one took: one more landing tried
 EXPECTED_PARTS = 40  # the parts a capture plan is paced for before the first one has been counted
 
 

@@ -421,3 +421,5 @@ class WalkingController:
         self.faults += 1
         if self.stabilizer is not None:
             self.stabilizer.reset()
+        if self._capture is not None:
+            self._capture.forget()

@@ -147,13 +147,14 @@ class _Log:
                 "pelvis_turn": rows[:, L.pelvis_turn:L.pelvis_turn + 2].copy()}
 
 
-SIMULATED_PART = 0.2  # [-] of the walker's work budget: what each part of a command's check costs in a simulation
+SIMULATED_PART = 0.19  # [-] of the walker's budget that each part of a check costs in a simulation (not a divisor of
+# the budget, so that run_for's comparisons of a part's cost against what is left are never exact ties)
 
 
 def simulated_clock(rate: float) -> CountingClock:
     """The walker's budget clock in a simulated loop at ``rate`` [Hz]: each reading advances
     :data:`SIMULATED_PART` of the budget (:func:`~zmpwalk.online.work_budget`), so a tick runs the parts of a
-    command's check that fit the budget at that cost (about four; this machine's parts take 5-20 us of 50), the
+    command's check that fit the budget at that cost (three to four; this machine's parts take 5-20 us of 50), the
     same on every machine and under any load: a simulated walk, its commands' checks included, does not depend on
     how busy the machine running it is."""
     return CountingClock(SIMULATED_PART * work_budget(rate))

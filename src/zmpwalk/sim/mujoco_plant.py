@@ -103,6 +103,7 @@ class ModelFeedforward:
         self._mass = float(np.sum(model.body_mass))
         self._gravity = -float(model.opt.gravity[2])
         self._qpos = plant.qpos_hold.copy()
+        self._qpos[4:6] = 0.0  # the base upright: torques() writes only the quaternion's w and z
         self._previous_qpos: Array | None = None
         self._qvel, self._previous_qvel = np.zeros(model.nv), np.zeros(model.nv)
         self._tau = np.zeros(model.nv)
