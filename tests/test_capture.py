@@ -482,3 +482,12 @@ def test_a_landing_correction_handed_over_keeps_what_the_plan_did_not_take(hubo)
     np.testing.assert_allclose(stabilizer.landing_correction("right"), [0.006, -0.015], atol=1e-15)
     np.testing.assert_allclose(stabilizer.hand_over_landing("right"), [0.006, -0.015], atol=1e-15)
     np.testing.assert_allclose(stabilizer.landing_correction("right"), [0.0, 0.0], atol=0)
+
+
+def test_a_slow_loop_plans_its_capture_within_the_triggering_tick(hubo):
+    """The lead in ticks: 40 at 1 kHz, 8 at 200 Hz; one (the whole plan in the triggering tick) at 125 Hz and below,
+    whose period holds the plan's 40 nominal parts of 0.1 ms twice over."""
+    from zmpwalk.control.capture import CapturePolicy
+
+    leads = {rate: CapturePolicy(hubo, rate, CaptureSettings()).lead for rate in (1000.0, 200.0, 125.0, 100.0, 50.0)}
+    assert leads == {1000.0: 40, 200.0: 8, 125.0: 1, 100.0: 1, 50.0: 1}

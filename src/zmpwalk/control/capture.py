@@ -31,7 +31,8 @@ on from there. Where the walker's standing pose cannot reach those feet, the con
 pose (:attr:`WalkingController.stranded`).
 
 The batch walk (:class:`zmpwalk.sim.replan.CaptureReplanner`) plans inside the triggering tick, as a lead of 0
-does here.
+does here, and as a slow loop does (125 Hz and below, :attr:`CapturePolicy.lead`), whose period holds the whole
+plan.
 """
 
 from __future__ import annotations
@@ -164,14 +165,19 @@ class CapturePolicy:
 
     Attributes:
         captures: The capture steps taken, in order.
-        lead: Ticks from the trigger to the take-over (at least one).
+        lead: Ticks from the trigger to the take-over: ``settings.lead`` in whole ticks, at least one; one (the plan
+            within the triggering tick) where the control period holds the whole plan twice over at
+            :data:`NOMINAL_PART` a part (125 Hz and below: at 100 Hz a 40 ms lead, 4 ticks of 14 parts, took
+            1.0-2.4 ms a tick against 1.3 ms in one, and lost two pushes of three that the plan in one tick
+            survived).
         parts_per_tick: The most parts of a plan one tick has run so far.
     """
 
     def __init__(self, robot: RobotModel, rate: float, settings: CaptureSettings) -> None:
         self.robot, self.rate, self.settings = robot, float(rate), settings
         self.captures: list[CapturePlan] = []
-        self.lead = max(1, round(settings.lead * self.rate))
+        in_one_tick = IN_TICK_SHARE / self.rate >= EXPECTED_PARTS * NOMINAL_PART  # a slow loop's period holds it
+        self.lead = 1 if in_one_tick else max(1, round(settings.lead * self.rate))
         self.parts_per_tick = 0
         self._last = -math.inf  # [ticks] of the last trigger or take-over
         self._planning: _Planning | None = None
@@ -309,6 +315,8 @@ class CapturePolicy:
 
 ERROR_RATE_WINDOW = 0.005  # [s] the DCM error's rate is taken over this (whole ticks, at least one)
 PULL_PARTS = 16  # a plan is paced for this many parts more than the last one took: one more landing tried
+NOMINAL_PART = 1e-4  # [s] a part's cost, nominal (HUBO: 10-130 us alone, up to about 0.35 ms inside the loop)
+IN_TICK_SHARE = 0.5  # [-] a whole plan taking this share of the control period or less, nominally, is made in one tick
 EXPECTED_PARTS = 40  # the parts a capture plan is paced for before the first one has been counted
 
 
