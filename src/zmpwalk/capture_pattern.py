@@ -1,7 +1,7 @@
 r"""The capture step's pattern for one landing: the DCM, the CoM and the feet of the three phases.
 
-:func:`capture_pattern` builds the pattern :func:`zmpwalk.capture.capture_step` chose a landing for (its module
-docstring's three phases): the DCM runs away from the stance ZMP until touchdown, moves to the midpoint of the soles
+:func:`capture_pattern_parts` builds the pattern :func:`zmpwalk.capture.capture_step` chose a landing for (its
+module docstring's three phases): the DCM runs away from the stance ZMP until touchdown, moves to the midpoint of the soles
 along a quintic over the settle and rests there; the CoM follows it (``c' = omega (xi - c)``, in closed form); the
 swinging foot moves along quintics to the landing, lifted on the way, turning to the stance foot's yaw; the CoM
 point is lowered where a leg would otherwise be out of reach.
@@ -27,7 +27,7 @@ from zmpwalk.patterns.result import (
 )
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sides import Support
-from zmpwalk.slices import Parts, whole
+from zmpwalk.slices import Parts
 from zmpwalk.zmp import point_margin
 
 Array = NDArray[np.float64]
@@ -98,7 +98,7 @@ def capture_pattern_parts(plan: CaptureState, s: Array, settle: float,
                           landing: Array) -> Parts[tuple[WalkingPattern, Array]]:
     """The capture pattern for one landing (the module docstring's three phases) at times ``s`` [s] after the
     capture, and the rest point [m], in parts (:mod:`zmpwalk.slices`: a few vectorised operations over every
-    sample each, about 0.1 ms for 2 000 samples); :func:`capture_pattern` runs it whole."""
+    sample each, about 0.1 ms for 2 000 samples)."""
     robot, st, omega = plan.robot, plan.st, plan.omega
     rest = rest_point(plan, landing)
     xi, xi_rate = _dcm_at(plan, rest, settle, s)
@@ -130,8 +130,6 @@ def capture_pattern_parts(plan: CaptureState, s: Array, settle: float,
         zmp_in_world=zmp, steps=steps, support_phases=phases)
     return pattern, rest
 
-
-capture_pattern = whole(capture_pattern_parts, "capture_pattern")
 
 
 def rest_point(plan: CaptureState, landing: Array) -> Array:
