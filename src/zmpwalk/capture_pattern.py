@@ -1,10 +1,10 @@
 r"""The capture step's pattern for one landing: the DCM, the CoM and the feet of the three phases.
 
 :func:`capture_pattern_parts` builds the pattern :func:`zmpwalk.capture.capture_step` chose a landing for (its
-module docstring's three phases): the DCM runs away from the stance ZMP until touchdown, moves to the midpoint of the soles
-along a quintic over the settle and rests there; the CoM follows it (``c' = omega (xi - c)``, in closed form); the
-swinging foot moves along quintics to the landing, lifted on the way, turning to the stance foot's yaw; the CoM
-point is lowered where a leg would otherwise be out of reach.
+module docstring's three phases): the DCM runs away from the stance ZMP until touchdown, moves to the midpoint of
+the soles along a quintic over the settle and rests there; the CoM follows it (``c' = omega (xi - c)``, in closed
+form); the swinging foot moves along quintics to the landing, lifted on the way, turning to the stance foot's yaw;
+the CoM point is lowered where a leg would otherwise be out of reach.
 
 Axes: world, x forward at the walk's start, y left, z up (docs/frames-and-units.md).
 """
