@@ -454,8 +454,11 @@ class OnlineWalker:
         # one copy per tick: the caller's arrays never alias the walker's buffers
         if current is None:
             row, (code, pelvis_yaw, left_yaw, right_yaw) = self._standing.copy(), self._standing_scalars
-        else:
-            row, (code, pelvis_yaw, left_yaw, right_yaw) = self._row(current, index)
+        else:  # the row's copy and scalars inline (as _row gives them to peek): no call more per tick
+            offset = index - current.first_index
+            row, (codes, pelvis_yaws, left_yaws, right_yaws) = current.rows[offset].copy(), current.scalars
+            code, pelvis_yaw, left_yaw, right_yaw = codes[offset], pelvis_yaws[offset], left_yaws[offset], \
+                right_yaws[offset]
         if work and self._job is not None:
             self._work()
         return self._sample(index, row, code, pelvis_yaw, left_yaw, right_yaw)
