@@ -218,6 +218,10 @@ def test_bad_input_is_rejected(hubo, walk):
         CaptureSettings(trigger=-0.1)
     with pytest.raises(InvalidParameterError, match="foot_speed"):
         CaptureSettings(foot_speed=0.0)
+    with pytest.raises(InvalidParameterError, match=r"capture\.lead = 0\.5 .*at most 0\.2 s"):
+        CaptureSettings(lead=0.5)
+    with pytest.raises(InvalidParameterError, match=r"capture\.lead"):
+        CaptureSettings(lead=-0.01)
 
 
 @pytest.mark.slow

@@ -388,3 +388,13 @@ def test_a_simulated_walk_is_the_same_on_a_busy_machine(hubo, monkeypatch):
     machine = simulate_controller(hubo, commands, plant=plant,
                                   controller=WalkingController(hubo, RATE, feedforward=plant.feedforward()))
     assert machine.given[1] > quiet.given[1] + 1.0  # [s] the premise: the machine's clock is the difference
+
+
+def test_a_budget_clock_that_is_not_callable_is_refused(hubo):
+    """OnlineWalker / WalkingController ``clock``: a callable returning seconds, or None."""
+    from zmpwalk import OnlineWalker
+
+    with pytest.raises(InvalidParameterError, match=r"clock = 0\.001 .*a callable returning seconds"):
+        OnlineWalker(hubo, RATE, clock=0.001)  # type: ignore[arg-type]
+    with pytest.raises(InvalidParameterError, match="clock"):
+        WalkingController(hubo, RATE, clock="perf_counter")  # type: ignore[arg-type]

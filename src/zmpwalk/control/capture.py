@@ -2,9 +2,8 @@
 
 :class:`CapturePolicy` is what :class:`~zmpwalk.control.WalkingController` asks after each stabilizer tick: in a
 single support, at least :data:`~zmpwalk.capture.CAPTURE_INTERVAL` after the last trigger and the last take-over,
-with the
-stabilizer's DCM error beyond :attr:`CaptureSettings.trigger`, it plans the rest of the walk as one capture step
-and a stop (:func:`zmpwalk.capture.capture_step`, Eqs. of the capture point: the swinging foot lands where the
+with the stabilizer's DCM error beyond :attr:`CaptureSettings.trigger`, it plans the rest of the walk as one capture
+step and a stop (:func:`zmpwalk.capture.capture_step`, Eqs. of the capture point: the swinging foot lands where the
 measured DCM can come to rest).
 
 **Bounded work per tick.** The plan does not run inside the triggering tick: it takes over
@@ -184,6 +183,7 @@ class CapturePolicy:
         self._expected = EXPECTED_PARTS
         self._errors = np.zeros((max(1, round(ERROR_RATE_WINDOW * self.rate)) + 1, 2))  # [m] the last DCM errors
         self._observed = 0
+        self._omega = math.sqrt(robot.gravity / robot.pendulum_length)  # [1/s] the pendulum's
 
     @property
     def planning(self) -> bool:
@@ -208,9 +208,8 @@ class CapturePolicy:
         plan: the step lands first)."""
         self._last = tick  # tried again only after the interval, as a plan that fails
         lead = self.lead
-        before = [sample if lead == 1 else ahead(lead - 2), previous if lead == 1 else
-                  sample if lead == 2 else ahead(lead - 3)]  # ticks first - 1 and first - 2
-        last, second = before
+        last = sample if lead == 1 else ahead(lead - 2)  # tick first - 1
+        second = previous if lead == 1 else sample if lead == 2 else ahead(lead - 3)  # tick first - 2
         if last is None or second is None or last.support != sample.support:
             return False
         dt = 1.0 / self.rate
@@ -263,7 +262,7 @@ class CapturePolicy:
         if span <= 0 or ticks <= 0:
             return np.array(error, dtype=np.float64)
         rate = (error - self._errors[(self._observed - 1 - span) % size]) * self.rate / span  # [m/s]
-        omega = math.sqrt(self.robot.gravity / self.robot.pendulum_length)
+        omega = self._omega
         return np.asarray(error + rate / omega * math.expm1(omega * ticks / self.rate), dtype=np.float64)
 
     def work(self, tick: int, sample: WalkingSample, measurement: BalanceMeasurement,
@@ -281,19 +280,18 @@ class CapturePolicy:
             return
         ticks_left = max(job.first - tick, 1)
         quota = max(-(-(max(job.expected - job.done, 1)) // ticks_left), 1) if self.lead > 1 else 1 << 30
-        for count in range(quota):
-            try:
+        ran = 0
+        try:
+            while ran < quota:
+                ran += 1
                 next(job.parts)
-            except StopIteration as finished:
-                job.result = finished.value
-                self._expected = job.done + count + 1
-                break
-            except ZmpwalkError:
-                self._planning = None
-                return
-            finally:
-                self.parts_per_tick = max(self.parts_per_tick, count + 1)
-        job.done += quota
+        except StopIteration as finished:
+            job.result = finished.value
+            self._expected = job.done + ran
+        except ZmpwalkError:
+            self._planning = None
+        job.done += ran
+        self.parts_per_tick = max(self.parts_per_tick, ran)
 
     def take_over(self, tick: int, stabilizer: Stabilizer) -> CaptureMotion | None:
         """The capture step that takes over at ``tick``, where its plan is complete (one not complete by then is
