@@ -21,12 +21,13 @@ from zmpwalk.errors import (
 )
 from zmpwalk.kinematics import JointLimitError, JointTrajectory, pattern_joint_trajectory
 from zmpwalk.leg_chain import LegChain
-from zmpwalk.online import OnlineWalker, WalkingSample
+from zmpwalk.online import OnlineWalker
 from zmpwalk.patterns.lipm import generate_hyperbolic
 from zmpwalk.patterns.polynomial import generate
 from zmpwalk.patterns.preview import generate_preview
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots import RobotModel, list_robots, load_robot
+from zmpwalk.sample import WalkingSample
 from zmpwalk.schedule import Schedule, ShapeParameters
 from zmpwalk.walk import WalkOutcome, WalkSpec, run_walk
 

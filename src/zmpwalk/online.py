@@ -67,7 +67,6 @@ import math
 import numbers
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -100,6 +99,7 @@ from zmpwalk.patterns.polynomial import first_sample_at
 from zmpwalk.patterns.result import check_rate
 from zmpwalk.patterns.stages import Boundary
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.sample import WalkingSample as WalkingSample  # re-exported: where a loop has always found it
 from zmpwalk.schedule import Schedule
 from zmpwalk.sides import SUPPORT_LABELS
 from zmpwalk.slices import UNFINISHED, run_for, run_to_end
@@ -112,38 +112,6 @@ START_DELAY = 0.6  # [s] a walk commanded from standstill starts this much later
 def start_delay_ticks(rate: float) -> int:
     """:data:`START_DELAY` in whole ticks at ``rate`` [Hz] (rounded up)."""
     return math.ceil(START_DELAY * rate - 1e-9)
-
-
-@dataclass(slots=True)  # not frozen: a frozen dataclass's __init__ costs 1 us more, a third of a tick
-class WalkingSample:
-    """The pattern at one control tick, in world (SI).
-
-    A new object every tick, its arrays copies of the walker's row: changing it changes nothing in the walker.
-
-    Attributes:
-        time: [s].
-        support: ``"double"``, ``"left"`` or ``"right"``.
-        position_pelvis_in_world: Pelvis centre [m], shape (3,).
-        yaw_pelvis_in_world: [rad].
-        position_left_ankle_in_world, position_right_ankle_in_world: [m], shape (3,).
-        yaw_left_foot_in_world, yaw_right_foot_in_world: [rad].
-        zmp_in_world: Cart-table ZMP [m], shape (2,).
-        joint_angles: The 12 leg joint angles [rad] in the order of
-            :data:`zmpwalk.kinematics.JOINT_COLUMNS`, or None unless the walker was made with ``joints=True``.
-        joint_velocities: Their rates [rad/s], or None.
-    """
-
-    time: float
-    support: str
-    position_pelvis_in_world: Array
-    yaw_pelvis_in_world: float
-    position_left_ankle_in_world: Array
-    yaw_left_foot_in_world: float
-    position_right_ankle_in_world: Array
-    yaw_right_foot_in_world: float
-    zmp_in_world: Array
-    joint_angles: Array | None = None
-    joint_velocities: Array | None = None
 
 
 _SUPPORT_OF_CODE = {float(code): name for code, name in enumerate(SUPPORT_LABELS)}
@@ -454,7 +422,7 @@ class OnlineWalker:
         # one copy per tick: the caller's arrays never alias the walker's buffers
         if current is None:
             row, (code, pelvis_yaw, left_yaw, right_yaw) = self._standing.copy(), self._standing_scalars
-        else:  # the row's copy and scalars inline (as _row gives them to peek): no call more per tick
+        else:
             offset = index - current.first_index
             row, (codes, pelvis_yaws, left_yaws, right_yaws) = current.rows[offset].copy(), current.scalars
             code, pelvis_yaw, left_yaw, right_yaw = codes[offset], pelvis_yaws[offset], left_yaws[offset], \
@@ -470,16 +438,10 @@ class OnlineWalker:
         current, index = self._current, self._index + ahead
         if current is None or not current.first_index <= index < current.first_index + len(current.rows):
             return None
-        row, (code, pelvis_yaw, left_yaw, right_yaw) = self._row(current, index)
-        return self._sample(index, row, code, pelvis_yaw, left_yaw, right_yaw)
-
-    @staticmethod
-    def _row(plan: CheckedPlan, index: int) -> tuple[Array, tuple[float, float, float, float]]:
-        """A copy of ``plan``'s row at tick ``index`` and its support code and yaws (Python scalars)."""
-        offset = index - plan.first_index
-        codes, pelvis_yaws, left_yaws, right_yaws = plan.scalars
-        row: Array = plan.rows[offset].copy()
-        return row, (codes[offset], pelvis_yaws[offset], left_yaws[offset], right_yaws[offset])
+        offset = index - current.first_index
+        codes, pelvis_yaws, left_yaws, right_yaws = current.scalars
+        return self._sample(index, current.rows[offset].copy(), codes[offset], pelvis_yaws[offset], left_yaws[offset],
+                            right_yaws[offset])
 
     def _sample(self, index: int, row: Array, code: float, pelvis_yaw: float, left_yaw: float,
                 right_yaw: float) -> WalkingSample:

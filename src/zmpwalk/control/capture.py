@@ -48,9 +48,9 @@ from zmpwalk.capture import CAPTURE_INTERVAL, CapturePlan, CaptureSettings, capt
 from zmpwalk.errors import ZmpwalkError
 from zmpwalk.footsteps import Pose2D, Stance
 from zmpwalk.kinematics import JointTrajectory, pattern_joint_trajectory_in_parts
-from zmpwalk.online import WalkingSample
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.sample import WalkingSample
 from zmpwalk.sides import SUPPORT_LABELS
 from zmpwalk.slices import Parts
 

@@ -37,8 +37,9 @@ from zmpwalk.commands import StepCommand
 from zmpwalk.control.capture import CaptureMotion, CapturePolicy
 from zmpwalk.control.plant import JointTargets
 from zmpwalk.errors import InvalidParameterError, ZmpwalkError
-from zmpwalk.online import OnlineWalker, WalkingSample
+from zmpwalk.online import OnlineWalker
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.sample import WalkingSample
 from zmpwalk.schedule import Schedule
 from zmpwalk.sides import SUPPORT_OF_LABEL
 from zmpwalk.stabilizer_gains import StabilizerGains

@@ -24,8 +24,9 @@ from numpy.typing import NDArray
 from zmpwalk.balance import BalanceMeasurement
 from zmpwalk.control.plant import JointTargets
 from zmpwalk.errors import InvalidParameterError
-from zmpwalk.online import OnlineWalker, WalkingSample
+from zmpwalk.online import OnlineWalker
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.sample import WalkingSample
 
 Array = NDArray[np.float64]
 

@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk.balance import BalanceMeasurement
-from zmpwalk.online import WalkingSample
+from zmpwalk.sample import WalkingSample
 
 Array = NDArray[np.float64]
 

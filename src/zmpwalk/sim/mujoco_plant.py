@@ -21,9 +21,9 @@ from numpy.typing import NDArray
 from zmpwalk.balance import BalanceMeasurement
 from zmpwalk.control.plant import JointTargets
 from zmpwalk.errors import InvalidParameterError
-from zmpwalk.online import WalkingSample
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.robots.pd import is_position_servo
+from zmpwalk.sample import WalkingSample
 from zmpwalk.sim.disturbances import NOSLIP_ITERATIONS, SensorNoise
 from zmpwalk.sim.mjcf import contact_mapping
 from zmpwalk.sim.plant import Plant as SimPlant
