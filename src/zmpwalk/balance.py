@@ -90,7 +90,6 @@ stabilizer: a tick costs about 3 µs from Python and allocates nothing.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -98,9 +97,8 @@ from numpy.typing import NDArray
 
 from zmpwalk.errors import InvalidParameterError
 from zmpwalk.kinematics import leg_chains, rest_mass
-from zmpwalk.leg_chain import LegChain
 from zmpwalk.robots.model import RobotModel
-from zmpwalk.stabilizer.layout import LOG_SIZE, STATE_SIZE, L, S, initial_state, pack_parameters
+from zmpwalk.stabilizer.layout import LOG_SIZE, STATE_SIZE, L, S, chain_table, initial_state, pack_parameters
 from zmpwalk.stabilizer_gains import StabilizerGains
 
 Array = NDArray[np.float64]
@@ -369,20 +367,6 @@ class Stabilizer:
                  m.joint_angles)[status - 1]
         raise InvalidParameterError(INPUT_NAMES[status - 1], f"{np.size(given)} values",
                                     f"{kernel.INPUT_SIZES[status - 1]} values")
-
-
-def chain_table(chains: Sequence[LegChain]) -> Array:
-    """The compiled leg's table (2, 6, 11) of both leg chains (:mod:`zmpwalk.stabilizer.leg`): per leg and chain
-    joint its axis and a point on it in the base frame at zero angles [m], its link's CoM [m] and mass [kg], and
-    its role-ordered column."""
-    chain = np.empty((2, 6, 11))
-    for leg, leg_chain in enumerate(chains):
-        chain[leg, :, 0:3] = leg_chain.axes
-        chain[leg, :, 3:6] = leg_chain.points
-        chain[leg, :, 6:9] = leg_chain.link_coms
-        chain[leg, :, 9] = leg_chain.link_masses
-        chain[leg, :, 10] = np.argsort(np.asarray(leg_chain.role_order))  # chain joint -> role column
-    return chain
 
 
 def balance_state(log: Array) -> BalanceState:

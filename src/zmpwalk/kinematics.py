@@ -17,7 +17,7 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from zmpwalk.errors import InvalidParameterError, UnreachableError
+from zmpwalk.errors import UnreachableError
 from zmpwalk.joint_limits import (  # re-exported (__all__): the columns and their checks live there
     JOINT_COLUMNS,
     LEG_JOINTS,
@@ -32,6 +32,7 @@ from zmpwalk.leg_chain.rotations import rot_x, rot_y, rot_z  # re-exported (__al
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sides import Side
 from zmpwalk.slices import Parts, whole
+from zmpwalk.whole_body import COM_ITERATIONS, COM_TOLERANCE, imported_legs_in_parts
 
 Array = NDArray[np.float64]
 
@@ -151,9 +152,10 @@ def joint_trajectory_in_parts(
     knee_forward: bool = True,
     check_limits: bool = True,
 ) -> Parts[JointTrajectory]:
-    """Joint angles (closed-form IK) and velocities (Jacobian) of both legs with an upright pelvis, in parts
-    (:mod:`zmpwalk.slices`: with closed-form legs, each leg's angles and rates, then the joint ranges; an
-    imported robot's legs in one part). :func:`joint_trajectory` runs it whole.
+    """Joint angles and velocities (Jacobian) of both legs with an upright pelvis, in parts (:mod:`zmpwalk.slices`:
+    a robot file's legs in closed form, each leg's angles and rates; an imported robot's base under the CoM and its
+    legs, compiled, :data:`~zmpwalk.whole_body.IK_CHUNK` samples a part (:mod:`zmpwalk.whole_body`); then the joint
+    ranges). :func:`joint_trajectory` runs it whole.
 
     Args:
         time: [s], (n,).
@@ -170,38 +172,19 @@ def joint_trajectory_in_parts(
         JointLimitError: First joint to leave its range (when ``check_limits``).
     """
     n = len(time)
-    c, s = np.cos(yaw_pelvis_in_world), np.sin(yaw_pelvis_in_world)
     angles, velocities = np.empty((n, 12)), np.empty((n, 12))
     base: Array | None = None
-    solutions: list[tuple[Array, Array]] = []
-    if robot.legs is not None:
-        # An imported robot: the pattern moves the whole-body centre of mass; find the base that puts it there.
-        base, solutions = _base_under_com(position_pelvis_in_world, yaw_pelvis_in_world,
-                                          [(f[0], f[1]) for f in feet], robot)
-        if n > 1:
-            velocity_pelvis_in_world = velocity_pelvis_in_world + np.gradient(base - position_pelvis_in_world,
-                                                                              time, axis=0)
-        position_pelvis_in_world = base
     if robot.legs is None:  # closed form, written row by row into (12, n) and returned transposed
+        heading = (np.cos(yaw_pelvis_in_world), np.sin(yaw_pelvis_in_world))
         angles, velocities = yield from _closed_form_legs_in_parts(
-            time, position_pelvis_in_world, (c, s), yaw_pelvis_in_world, velocity_pelvis_in_world, yaw_rate_pelvis,
+            time, position_pelvis_in_world, heading, yaw_pelvis_in_world, velocity_pelvis_in_world, yaw_rate_pelvis,
             feet, robot, knee_forward)
-    else:  # an imported robot's legs: angles from _base_under_com, rates from J q' = twist
-        for index, (side, (position, _, velocity, yaw_rate)) in enumerate(zip(Side, feet, strict=True)):
-            rel = position - position_pelvis_in_world
-            v = velocity - velocity_pelvis_in_world  # relative velocity in the (rotating) pelvis frame
-            v[:, 0] += yaw_rate_pelvis * rel[:, 1]
-            v[:, 1] -= yaw_rate_pelvis * rel[:, 0]
-            twist = np.column_stack([c * v[:, 0] + s * v[:, 1], -s * v[:, 0] + c * v[:, 1], v[:, 2],
-                                     np.zeros(n), np.zeros(n), yaw_rate - yaw_rate_pelvis])
-            chain = robot.legs[index]
-            leg_angles, excess = solutions[index]
-            _check_reach(excess, time, side.label,
-                         "inverse kinematics, " + ("closed form" if chain.closed_form else "numeric"))
-            rates = chain.joint_rates(leg_angles, twist)
-            order = list(chain.role_order)
-            angles[:, 6 * index:6 * index + 6] = leg_angles[:, order]
-            velocities[:, 6 * index:6 * index + 6] = rates[:, order]
+    else:  # an imported robot: the pattern moves the whole-body CoM; the base that puts it there, and the legs
+        base, angles, velocities, excess = yield from imported_legs_in_parts(
+            time, position_pelvis_in_world, yaw_pelvis_in_world, velocity_pelvis_in_world, yaw_rate_pelvis, feet,
+            robot)
+        for index, side in enumerate(Side):
+            _check_reach(excess[index], time, side.label, "inverse kinematics")
     if check_limits:  # the joint ranges: parts of their own, each half of the samples (the first sample out
         half = (n + 1) // 2  # of range is the first of the first half that has one, else of the second)
         yield
@@ -249,54 +232,6 @@ def _check_reach(excess: Array, time: Array, label: str, detail: str) -> None:
     if np.any(excess > 0):
         first = int(np.argmax(excess > 0))
         raise UnreachableError(label, float(time[first]), float(excess.max()), detail)
-
-
-COM_TOLERANCE = 1e-6  # [m] the base is placed until the whole-body CoM is this close to the pattern's
-COM_ITERATIONS = 12
-
-
-def _base_under_com(position_com_in_world: Array, yaw_pelvis_in_world: Array, feet: list[tuple[Array, Array]],
-                    robot: RobotModel) -> tuple[Array, list[tuple[Array, Array]]]:
-    r"""Base positions (n, 3) [m] that put the whole-body CoM of an imported robot on the pattern's point, and
-    the leg solutions there.
-
-    The pattern (Eqs. 1-2 of Park et al.) moves one mass; a real robot's legs carry part of it (TALOS: 17 %
-    each), so a swinging leg moves the CoM away from where the pattern put it. With the feet fixed in world,
-    the base is moved horizontally by the remaining CoM error until it is below :data:`COM_TOLERANCE`:
-
-    .. math:: p_{base}^{k+1} = p_{base}^k + (c_{pattern} - c(p_{base}^k, q^k))_{xy}
-
-    (a contraction: moving the base by ``d`` moves the CoM by about ``d (1 - m_{feet} / M)``).
-    The CoM height stays the pattern's (its vertical motion is what the pattern neglects too).
-    """
-    legs, plant = robot.legs, robot.plant
-    if legs is None or plant is None:
-        raise InvalidParameterError("robot", robot.name, "an imported robot (leg chains and masses)")
-    n = len(yaw_pelvis_in_world)
-    c, s = np.cos(yaw_pelvis_in_world), np.sin(yaw_pelvis_in_world)
-    rotation = rot_z(yaw_pelvis_in_world)
-    offset = np.array([robot.com_offset[0], robot.com_offset[1], 0.0])
-    base = position_com_in_world - np.einsum("nij,j->ni", rotation, offset)
-    total = plant.rest_mass + sum(float(leg.link_masses.sum()) for leg in legs)
-    starts: list[Array | None] = [None, None]
-    solutions: list[tuple[Array, Array]] = []
-    for _ in range(COM_ITERATIONS):
-        solutions = []
-        com_in_base = plant.rest_mass * np.asarray(plant.rest_com)
-        com_in_base = np.broadcast_to(com_in_base, (n, 3)).copy()
-        for index, (chain, (position, yaw)) in enumerate(zip(legs, feet, strict=True)):
-            rel = position - base
-            ankle_in_base = np.column_stack([c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1], rel[:, 2]])
-            solution = chain.solve(ankle_in_base, rot_z(yaw - yaw_pelvis_in_world), start=starts[index])
-            solutions.append(solution)
-            starts[index] = solution[0]
-            com_in_base += np.einsum("k,nki->ni", chain.link_masses, chain.link_com_positions(solution[0]))
-        com = base + np.einsum("nij,nj->ni", rotation, com_in_base / total)
-        error = position_com_in_world[:, :2] - com[:, :2]
-        base[:, :2] += error
-        if np.max(np.abs(error)) < COM_TOLERANCE:
-            break
-    return base, solutions
 
 
 def pattern_joint_trajectory_in_parts(pattern: SampledMotion, knee_forward: bool = True,

@@ -103,6 +103,7 @@ from zmpwalk.sample import WalkingSample as WalkingSample  # re-exported: where 
 from zmpwalk.schedule import Schedule
 from zmpwalk.sides import SUPPORT_LABELS
 from zmpwalk.slices import UNFINISHED, run_for, run_to_end
+from zmpwalk.whole_body import leg_parts
 
 Array = NDArray[np.float64]
 
@@ -120,7 +121,8 @@ WORK_BUDGET = 50e-6  # [s] a tick runs parts of a check while the next one is ex
 WORK_FRACTION = 0.01  # [-] ... or within this fraction of the control period, where that is longer (below 200 Hz)
 WORK_LIMIT = 500e-6  # [s] ... but never over this (below 20 Hz): a tick's work stays well under a millisecond
 WORK_SHARE = 0.5  # [-] of the budget a check's parts get however long the loop's own work in the tick took
-PARTS_PER_BLOCK = 45  # parts of a block of SLICE_ROWS samples (a first guess of a check's length, before one has run)
+PARTS_PER_BLOCK = 45  # parts of a block of SLICE_ROWS samples (a first guess of a check's length; an imported robot's
+# legs add theirs, zmpwalk.whole_body.leg_parts)
 FINISH_EARLY = 0.95  # [-] a check is paced to end within this fraction of the ticks before its step begins
 
 
@@ -190,6 +192,7 @@ class OnlineWalker:
         self._job: CheckJob | None = None
         self._rejection: Rejection | None = None
         self._check_parts = 0  # parts the last completed check took
+        self._block_parts = PARTS_PER_BLOCK + (leg_parts(robot, SLICE_ROWS) if self.joints else 0)  # a first guess
         self._buffers = RowBuffers(self._width, READY_BUFFERS, math.ceil(READY_SECONDS * self.rate))
         self._check = CommandCheck(robot, self._schedule, self._pelvis, self.joints, self._buffers)
         self._set_standing(self._check.standing_row(self._stance))
@@ -258,7 +261,7 @@ class OnlineWalker:
         # parts to expect: as many as the last check took, at least a guess from the samples (the step, its
         # stop and the settle, and from standstill the start stage; blocks of SLICE_ROWS), more than a late one ran
         blocks = math.ceil((3.0 if self._current is not None else 4.0) * command.duration * self.rate / SLICE_ROWS)
-        expected = max(self._check_parts, PARTS_PER_BLOCK * blocks, retry + retry // 8 + 1)
+        expected = max(self._check_parts, self._block_parts * blocks, retry + retry // 8 + 1)
         if boundary.at_rest:
             delay = 0 if wait else start_delay_ticks(self.rate)
             if retry:  # time enough for one part a tick

@@ -53,6 +53,7 @@ from zmpwalk.robots.model import RobotModel
 from zmpwalk.sample import WalkingSample
 from zmpwalk.sides import SUPPORT_LABELS
 from zmpwalk.slices import Parts
+from zmpwalk.whole_body import leg_parts
 
 Array = NDArray[np.float64]
 
@@ -180,7 +181,7 @@ class CapturePolicy:
         self.parts_per_tick = 0
         self._last = -math.inf  # [ticks] of the last trigger or take-over
         self._planning: _Planning | None = None
-        self._expected = EXPECTED_PARTS
+        self._expected = EXPECTED_PARTS + leg_parts(robot, math.ceil(REST * self.rate) + 1)  # an imported robot's legs
         self._errors = np.zeros((max(1, round(ERROR_RATE_WINDOW * self.rate)) + 1, 2))  # [m] the last DCM errors
         self._observed = 0
         self._omega = math.sqrt(robot.gravity / robot.pendulum_length)  # [1/s] the pendulum's

@@ -17,7 +17,8 @@ import dataclasses
 import math
 import zlib
 from collections import namedtuple
-from typing import Any
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,6 +26,9 @@ from numpy.typing import NDArray
 from zmpwalk.errors import InvalidParameterError
 from zmpwalk.sides import Support
 from zmpwalk.stabilizer_gains import StabilizerGains
+
+if TYPE_CHECKING:
+    from zmpwalk.leg_chain import LegChain
 
 # The pattern's support codes as plain integers, the constants the compiled loops compare with
 DOUBLE_SUPPORT, LEFT_SUPPORT, RIGHT_SUPPORT = int(Support.DOUBLE), int(Support.LEFT), int(Support.RIGHT)
@@ -128,3 +132,17 @@ def initial_state(state: NDArray[np.float64], log: NDArray[np.float64]) -> None:
     state[S.floor_normal + 2] = 1.0
     log[:] = 0.0
     log[L.zmp_measured:L.zmp_measured + 2] = math.nan
+
+
+def chain_table(chains: Sequence[LegChain]) -> NDArray[np.float64]:
+    """The compiled leg's table (2, 6, 11) of both leg chains (:mod:`zmpwalk.stabilizer.leg`): per leg and chain
+    joint its axis and a point on it in the base frame at zero angles [m], its link's CoM [m] and mass [kg], and
+    its role-ordered column."""
+    chain = np.empty((2, 6, 11))
+    for leg, leg_chain in enumerate(chains):
+        chain[leg, :, 0:3] = leg_chain.axes
+        chain[leg, :, 3:6] = leg_chain.points
+        chain[leg, :, 6:9] = leg_chain.link_coms
+        chain[leg, :, 9] = leg_chain.link_masses
+        chain[leg, :, 10] = np.argsort(np.asarray(leg_chain.role_order))  # chain joint -> role column
+    return chain

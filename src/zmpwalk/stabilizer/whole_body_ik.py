@@ -1,0 +1,269 @@
+# mypy: disallow-untyped-decorators=False
+r"""The compiled inverse kinematics of an imported robot, sample by sample (numba, cached on disk): the base placed
+under the pattern's centre of mass, both legs' angles there, and their rates.
+
+An imported robot's pattern moves its whole-body CoM (Eqs. 1-2 of Park et al. move one mass), so each sample's
+base is found with its legs (:func:`zmpwalk.kinematics.joint_trajectory_in_parts`). Per sample ``k``:
+
+1. each leg is solved for its ankle and sole in the base frame by damped least squares on the compiled leg
+   (:mod:`zmpwalk.stabilizer.leg`, the chain :class:`~zmpwalk.leg_chain.LegChain` writes as a product of
+   exponentials):
+
+   .. math:: \Delta q = J^T (J J^T + \lambda^2 I)^{-1} e
+
+   ``e`` the ankle's position error and the rotation vector of the sole's orientation error, steps at most
+   :data:`~zmpwalk.leg_chain.numeric.IK_MAX_STEP`, until every component is within
+   :data:`~zmpwalk.leg_chain.numeric.IK_TOLERANCE` (the numeric IK of :mod:`zmpwalk.leg_chain.numeric`, one
+   sample at a time);
+2. the base is moved horizontally by the CoM's remaining error times a gain, ``p_base += g (c_pattern - c(p_base,
+   q))_xy``, and 1-2 repeat until that error is below :data:`~zmpwalk.whole_body.COM_TOLERANCE`. With the feet
+   fixed, moving the base by ``d`` moves the CoM by about ``d (1 - m_feet / M)``: ``g = 1`` is a contraction by
+   ``m_feet / M`` a move; each axis's ``g`` is learned from the last move (a secant, :func:`_secant_gain`), which
+   makes it one of about ``10^-3`` (TALOS) and cuts the moves a sample needs from 10-11 to 3-4.
+
+Each sample starts from the last one's angles and its base's offset from the CoM in the base frame, so the
+legs stay on the branch they stand in (the reference posture's, at the first sample) and a sample costs a few
+Newton steps: microseconds, where the same iteration on whole arrays in numpy cost 83 us a sample (TALOS).
+
+Arrays (all float64): ``params``, ``chain`` and ``work`` of :mod:`zmpwalk.stabilizer.leg` (the parameters read:
+the robot's mass, the rest of the body's mass moment, each leg's ankle offset); ``sole_back`` (2, 3, 3) each
+leg's sole frame transposed, ``R_s^T`` (the chain's own rotation is the sole's times it);
+``start`` (16,): the angles of the last sample (12, role-ordered columns) [rad], its base's offset from the CoM
+in the base frame (2) [m] and the base's gains (2) [-], carried from one sample (and one call) to the next.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+
+import numpy as np
+from numba import njit
+
+from zmpwalk.leg_chain.numeric import IK_DAMPING, IK_MAX_ITERATIONS, IK_MAX_STEP, IK_TOLERANCE
+from zmpwalk.stabilizer import leg as compiled_leg
+from zmpwalk.stabilizer.freshness import BUILD_KEY, renew_stale
+from zmpwalk.stabilizer.leg import (
+    FIRST,
+    SECOND,
+    ankle_in_base,
+    com_in_base,
+    leg_jacobian,
+    leg_kinematics,
+    lu6,
+    lu_solve6,
+)
+
+UNCONVERGED = 1e3 * IK_TOLERANCE  # [m] or [rad]: a sample whose residual is larger did not converge
+SECANT_MOVE = 1e-7  # [m] a smaller move of the base does not tell its gain (the IK converges to 1e-10)
+SECANT_RANGE = (0.5, 2.0)  # [-] gains outside are not learned: the CoM moves by 0.5-2 times the base's move
+
+
+@njit(cache=True, nogil=True)
+def _orientation_error(target: np.ndarray, frame: np.ndarray, error: np.ndarray) -> None:
+    """``error[3:6]`` <- the rotation vector of ``target frame^T`` (axis times angle, up to pi), ``frame`` the
+    rotation of a leg's last frame (row-major, ``frame[0:9]``)."""
+    def entry(i: int, j: int) -> float:
+        return float(target[i, 0] * frame[3 * j] + target[i, 1] * frame[3 * j + 1] + target[i, 2] * frame[3 * j + 2])
+
+    cosine = min(max((entry(0, 0) + entry(1, 1) + entry(2, 2) - 1.0) / 2.0, -1.0), 1.0)
+    angle = math.acos(cosine)
+    sine = math.sin(angle)
+    scale = angle / sine if sine > 1e-9 else 1.0 + angle * angle / 6.0
+    error[3] = 0.5 * (entry(2, 1) - entry(1, 2)) * scale
+    error[4] = 0.5 * (entry(0, 2) - entry(2, 0)) * scale
+    error[5] = 0.5 * (entry(1, 0) - entry(0, 1)) * scale
+
+
+@njit(cache=True, nogil=True)
+def solve_leg(params: np.ndarray, chain: np.ndarray, leg: int, target: np.ndarray, rotation: np.ndarray,
+              columns: np.ndarray, frames: np.ndarray, scratch: np.ndarray) -> float:
+    """Damped least squares of one leg from the angles in ``columns`` (12, role-ordered, updated in place) to the
+    ankle ``target`` (3,) [m] and the chain's own rotation ``rotation`` (3, 3) in the base frame; ``frames``
+    (7, 12) holds the leg's frames at the angles reached; ``scratch`` (3, 6, 6): the Jacobian, ``J J^T`` and the
+    error and row swaps. Returns the largest error component left [m] or [rad] (within :data:`IK_TOLERANCE` where
+    it converged)."""
+    jacobian, jjt, error, swaps = scratch[0], scratch[1], scratch[2, 0], scratch[2, 1]
+    norm = math.inf
+    for _ in range(IK_MAX_ITERATIONS + 1):
+        leg_kinematics(chain, leg, columns, frames)
+        ankle = ankle_in_base(params, leg, frames)
+        for i in range(3):
+            error[i] = target[i] - ankle[i]
+        _orientation_error(rotation, frames[6], error)
+        norm = 0.0
+        for i in range(6):
+            norm = max(norm, abs(error[i]))
+        if norm <= IK_TOLERANCE:
+            break
+        leg_jacobian(chain, leg, frames, ankle, jacobian)
+        for i in range(6):
+            for j in range(6):
+                total = IK_DAMPING * IK_DAMPING if i == j else 0.0
+                for m in range(6):
+                    total += jacobian[i, m] * jacobian[j, m]
+                jjt[i, j] = total
+        lu6(jjt, swaps)
+        lu_solve6(jjt, swaps, error)
+        largest = 0.0
+        for i in range(6):  # the step J^T y, in error[0:6] no longer needed: into jjt's first row
+            step = 0.0
+            for m in range(6):
+                step += jacobian[m, i] * error[m]
+            jjt[0, i] = step
+            largest = max(largest, abs(step))
+        scale = min(1.0, IK_MAX_STEP / max(largest, 1e-300))
+        for i in range(6):
+            columns[6 * leg + int(chain[leg, i, 10])] += scale * jjt[0, i]
+    return norm
+
+
+@njit(cache=True, nogil=True)
+def base_under_com(params: np.ndarray, chain: np.ndarray, sole_back: np.ndarray, com: np.ndarray, yaw: np.ndarray,
+                   feet: np.ndarray, feet_yaw: np.ndarray, first: int, last: int, start: np.ndarray,
+                   tolerance: float, iterations: int, base: np.ndarray, angles: np.ndarray,
+                   excess: np.ndarray) -> None:
+    """Samples ``first:last``: the base (n, 3) [m] whose whole-body CoM is the pattern's ``com`` (n, 3) [m]
+    within ``tolerance`` [m] (at most ``iterations`` moves), the legs' angles there (n, 12) [rad], and per leg
+    and sample the IK's residual where it did not converge (> 0), else -1 (``excess`` (2, n)); ``yaw`` (n,) the
+    base's heading [rad], ``feet`` (2, n, 3) the ankles and ``feet_yaw`` (2, n) the soles' headings in world.
+    ``start`` (16,) carries the last sample's angles, base offset and gains (module docstring)."""
+    work = np.zeros((4, 7, 12))
+    scratch = np.empty((3, 6, 6))
+    target = np.empty(3)
+    rotation = np.empty((3, 3))
+    columns = start[:12]
+    for k in range(first, last):
+        c, s = math.cos(yaw[k]), math.sin(yaw[k])
+        bx = com[k, 0] + c * start[12] - s * start[13]
+        by = com[k, 1] + s * start[12] + c * start[13]
+        bz = com[k, 2]
+        residuals = (math.inf, math.inf)
+        sx = sy = 0.0  # the base's last move [m]
+        for _ in range(iterations):
+            r0 = _solve_at(params, chain, sole_back, feet, feet_yaw, k, FIRST, yaw[k], bx, by, bz, columns,
+                           work[0], scratch, target, rotation)
+            r1 = _solve_at(params, chain, sole_back, feet, feet_yaw, k, SECOND, yaw[k], bx, by, bz, columns,
+                           work[2], scratch, target, rotation)
+            residuals = (r0, r1)
+            mx, my, _ = com_in_base(params, chain, work, 0)
+            ex = com[k, 0] - (bx + c * mx - s * my)
+            ey = com[k, 1] - (by + s * mx + c * my)
+            if max(abs(ex), abs(ey)) < tolerance:
+                break
+            start[14] = _secant_gain(start[14], sx, ex)
+            start[15] = _secant_gain(start[15], sy, ey)
+            sx, sy = start[14] * ex, start[15] * ey
+            bx += sx
+            by += sy
+        base[k, 0], base[k, 1], base[k, 2] = bx, by, bz
+        for m in range(12):
+            angles[k, m] = _wrap(columns[m])
+        for leg in range(2):
+            excess[leg, k] = residuals[leg] if residuals[leg] > UNCONVERGED else -1.0
+        dx, dy = bx - com[k, 0], by - com[k, 1]
+        start[12], start[13] = c * dx + s * dy, -s * dx + c * dy
+
+
+@njit(cache=True, nogil=True)
+def _solve_at(params: np.ndarray, chain: np.ndarray, sole_back: np.ndarray, feet: np.ndarray, feet_yaw: np.ndarray,
+              k: int, leg: int, yaw: float, bx: float, by: float, bz: float, columns: np.ndarray, frames: np.ndarray,
+              scratch: np.ndarray, target: np.ndarray, rotation: np.ndarray) -> float:
+    """:func:`solve_leg` for sample ``k``'s ankle and sole of ``leg``, seen from the base at ``(bx, by, bz)`` with
+    heading ``yaw`` [rad]."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    rx, ry = feet[leg, k, 0] - bx, feet[leg, k, 1] - by
+    target[0], target[1], target[2] = c * rx + s * ry, -s * rx + c * ry, feet[leg, k, 2] - bz
+    turn = feet_yaw[leg, k] - yaw
+    ct, st = math.cos(turn), math.sin(turn)
+    for j in range(3):  # R_z(turn) R_s^T
+        rotation[0, j] = ct * sole_back[leg, 0, j] - st * sole_back[leg, 1, j]
+        rotation[1, j] = st * sole_back[leg, 0, j] + ct * sole_back[leg, 1, j]
+        rotation[2, j] = sole_back[leg, 2, j]
+    return solve_leg(params, chain, leg, target, rotation, columns, frames, scratch)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _secant_gain(gain: float, moved: float, error: float) -> float:
+    """The base's move per unit of CoM error along one axis, learned from its last move ``moved`` [m], which
+    changed the error by ``moved / gain - error`` [m]: ``moved`` over that change, where the move was large
+    enough to tell (:data:`SECANT_MOVE`) and the response is one of a base carrying most of the mass
+    (:data:`SECANT_RANGE`); else ``gain`` kept."""
+    if abs(moved) < SECANT_MOVE:
+        return gain
+    change = moved / gain - error
+    if change == 0.0:
+        return gain
+    learned = moved / change
+    return learned if SECANT_RANGE[0] <= learned <= SECANT_RANGE[1] else gain
+
+
+@njit(cache=True, nogil=True)
+def joint_rates(params: np.ndarray, chain: np.ndarray, time: np.ndarray, angles: np.ndarray, base: np.ndarray,
+                com: np.ndarray, velocity_com: np.ndarray, yaw: np.ndarray, yaw_rate: np.ndarray, feet: np.ndarray,
+                feet_velocity: np.ndarray, feet_yaw_rate: np.ndarray, first: int, last: int,
+                rates: np.ndarray) -> None:
+    """Samples ``first:last`` of the joint rates (n, 12) [rad/s] that give each ankle its velocity relative to the
+    base, ``J(q)^-1 twist`` (:meth:`~zmpwalk.leg_chain.LegChain.joint_rates`). The base's velocity is the CoM's,
+    ``velocity_com`` (n, 3) [m/s], plus the time derivative of the base's offset from it (:func:`_offset_rate`:
+    the base of samples ``first - 1`` to ``last`` is read); ``yaw_rate`` (n,) [rad/s] is the base's,
+    ``feet_velocity`` (2, n, 3) [m/s] and ``feet_yaw_rate`` (2, n) [rad/s] the ankles' and soles' in world. A
+    singular leg's rates are NaN."""
+    frames = np.empty((7, 12))
+    jacobian = np.empty((6, 6))
+    swaps = np.empty(6)
+    twist = np.empty(6)
+    for k in range(first, last):
+        c, s = math.cos(yaw[k]), math.sin(yaw[k])
+        vbx = velocity_com[k, 0] + _offset_rate(time, base, com, k, 0)
+        vby = velocity_com[k, 1] + _offset_rate(time, base, com, k, 1)
+        vbz = velocity_com[k, 2] + _offset_rate(time, base, com, k, 2)
+        for leg in range(2):
+            rx, ry = feet[leg, k, 0] - base[k, 0], feet[leg, k, 1] - base[k, 1]
+            vx = feet_velocity[leg, k, 0] - vbx + yaw_rate[k] * ry  # in the rotating base frame
+            vy = feet_velocity[leg, k, 1] - vby - yaw_rate[k] * rx
+            twist[0], twist[1] = c * vx + s * vy, -s * vx + c * vy
+            twist[2] = feet_velocity[leg, k, 2] - vbz
+            twist[3], twist[4], twist[5] = 0.0, 0.0, feet_yaw_rate[leg, k] - yaw_rate[k]
+            leg_kinematics(chain, leg, angles[k], frames)
+            leg_jacobian(chain, leg, frames, ankle_in_base(params, leg, frames), jacobian)
+            singular = lu6(jacobian, swaps) == 0.0
+            if not singular:
+                lu_solve6(jacobian, swaps, twist)
+            for i in range(6):
+                rates[k, 6 * leg + int(chain[leg, i, 10])] = math.nan if singular else twist[i]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _offset_rate(time: np.ndarray, base: np.ndarray, com: np.ndarray, k: int, axis: int) -> float:
+    """The time derivative at sample ``k`` of the base's offset from the CoM along ``axis`` [m/s], as
+    ``numpy.gradient`` takes it: one-sided at the ends, second order inside (on uneven steps too); 0 for one
+    sample."""
+    n = len(time)
+    if n < 2:
+        return 0.0
+    if k == 0 or k == n - 1:
+        a, b = (0, 1) if k == 0 else (n - 2, n - 1)
+        return float(((base[b, axis] - com[b, axis]) - (base[a, axis] - com[a, axis])) / (time[b] - time[a]))
+    h1, h2 = time[k] - time[k - 1], time[k + 1] - time[k]
+    before, here, after = (base[k - 1, axis] - com[k - 1, axis], base[k, axis] - com[k, axis],
+                           base[k + 1, axis] - com[k + 1, axis])
+    return float((h1 * h1 * after - h2 * h2 * before + (h2 * h2 - h1 * h1) * here) / (h1 * h2 * (h1 + h2)))
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _wrap(angle: float) -> float:
+    """``angle`` [rad] in [-pi, pi)."""
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+@njit("int64()", cache=True, nogil=True)
+def compiled_key() -> int:
+    """:data:`~zmpwalk.stabilizer.freshness.BUILD_KEY` as this module's compiled functions know it."""
+    return BUILD_KEY
+
+
+# this module's cached code holds the compiled leg's: renew both where a module or the layout changed since
+renew_stale((compiled_leg, sys.modules[__name__]))
+
+__all__ = ["UNCONVERGED", "base_under_com", "joint_rates", "solve_leg"]

@@ -1,0 +1,150 @@
+"""The compiled whole-body IK of an imported robot (zmpwalk.whole_body, zmpwalk.stabilizer.whole_body_ik): on a walk
+with a turn and a side step, the legs' forward kinematics (the general chain's, zmpwalk.leg_chain.LegChain) puts each
+ankle and sole where the pattern does, the whole-body CoM is the pattern's point, the rates are the chain's
+``J^-1 twist``, and the parts are bounded in samples; on a closed-form leg (TALOS), a numeric one (Booster T1), a
+five-joint one (Unitree H1's chain with its virtual ankle roll) and a sole pitched at zero angles (the keyframe
+biped)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from test_keyframe_sole import pitched_biped
+from zmpwalk.commands import StepCommand
+from zmpwalk.errors import InvalidParameterError
+from zmpwalk.kinematics import JointTrajectory, pattern_joint_trajectory, pattern_joint_trajectory_in_parts, rot_z
+from zmpwalk.patterns.polynomial import generate
+from zmpwalk.patterns.result import WalkingPattern
+from zmpwalk.robots import load_robot
+from zmpwalk.robots.model import RobotModel
+from zmpwalk.whole_body import COM_TOLERANCE, IK_CHUNK, imported_legs_in_parts, leg_parts
+
+ROBOTS = Path(__file__).resolve().parents[2] / "shared" / "robots"
+MODELS = {"talos": ROBOTS / "pal_talos" / "scene_position.xml", "booster_t1": ROBOTS / "booster_t1" / "scene.xml",
+          "unitree_h1": ROBOTS / "unitree_h1" / "scene.xml"}
+FEET_TOLERANCE = 1e-9  # [m] and [-] (rotation matrices): the IK converges to 1e-10 per component
+RATE_TOLERANCE = 1e-7  # [rad/s] against numpy's solve of the chain's Jacobian
+WALK = [StepCommand(duration=1.0, forward=0.1), StepCommand(duration=1.0, forward=0.1, turn=0.2),
+        StepCommand(duration=1.0, side=0.05)]
+
+
+def robot_of(name: str, tmp_path: Path) -> RobotModel:
+    if name == "pitched":
+        path = tmp_path / "pitched.xml"
+        path.write_text(pitched_biped(), encoding="utf-8")
+        return load_robot(path)
+    if not MODELS[name].is_file():
+        pytest.skip(f"{MODELS[name]} is absent")
+    return load_robot(MODELS[name])
+
+
+def walk_of(robot: RobotModel) -> tuple[WalkingPattern, JointTrajectory]:
+    pattern = generate(robot, WALK[:2] if robot.legs is not None and robot.legs[0].virtual is not None else WALK,
+                       rate=500.0)
+    if robot.legs is not None and robot.legs[0].virtual is not None:  # H1: the sole's roll is what gives
+        return pattern, pattern_joint_trajectory(pattern, check_limits=False)
+    return pattern, pattern_joint_trajectory(pattern)
+
+
+def chain_angles(trajectory: JointTrajectory, robot: RobotModel, leg: int) -> np.ndarray:
+    """The leg's angles in chain order (n, 6)."""
+    assert robot.legs is not None
+    chain = robot.legs[leg]
+    q = np.empty((len(trajectory.time), 6))
+    q[:, list(chain.role_order)] = trajectory.angles[:, 6 * leg:6 * leg + 6]
+    return q
+
+
+@pytest.mark.parametrize("name", ["talos", "booster_t1", "unitree_h1", "pitched"])
+def test_the_legs_meet_the_feet_and_the_com_meets_the_pattern(name: str, tmp_path: Path) -> None:
+    robot = robot_of(name, tmp_path)
+    assert robot.legs is not None and robot.plant is not None
+    pattern, trajectory = walk_of(robot)
+    base = trajectory.position_base_in_world
+    assert base is not None
+    rotation = rot_z(pattern.yaw_pelvis_in_world)
+    moment = robot.plant.rest_mass * np.asarray(robot.plant.rest_com)
+    mass = robot.plant.rest_mass
+    feet = ((pattern.position_left_ankle_in_world, pattern.yaw_left_foot_in_world),
+            (pattern.position_right_ankle_in_world, pattern.yaw_right_foot_in_world))
+    for leg, (chain, (ankle, yaw)) in enumerate(zip(robot.legs, feet, strict=True)):
+        q = chain_angles(trajectory, robot, leg)
+        position, sole = chain.fk(q)
+        np.testing.assert_allclose(base + np.einsum("nij,nj->ni", rotation, position), ankle, rtol=0,
+                                   atol=FEET_TOLERANCE)
+        if chain.virtual is None:  # a five-joint leg's sole rolls about its centre line (its virtual joint)
+            np.testing.assert_allclose(rotation @ sole, rot_z(yaw), rtol=0, atol=FEET_TOLERANCE)
+        moment = moment + np.einsum("k,nki->ni", chain.link_masses, chain.link_com_positions(q))
+        mass += float(chain.link_masses.sum())
+    com = base + np.einsum("nij,nj->ni", rotation, moment / mass)
+    np.testing.assert_allclose(com[:, :2], pattern.position_pelvis_in_world[:, :2], rtol=0, atol=COM_TOLERANCE)
+    np.testing.assert_allclose(base[:, 2], pattern.position_pelvis_in_world[:, 2], rtol=0, atol=1e-15)
+
+
+@pytest.mark.parametrize("name", ["talos", "booster_t1"])
+def test_the_rates_are_the_chains_inverse_jacobian_of_the_feet_twists(name: str, tmp_path: Path) -> None:
+    robot = robot_of(name, tmp_path)
+    assert robot.legs is not None
+    pattern, trajectory = walk_of(robot)
+    base = trajectory.position_base_in_world
+    assert base is not None
+    velocity_base = pattern.velocity_pelvis_in_world + np.gradient(base - pattern.position_pelvis_in_world,
+                                                                    pattern.time, axis=0)
+    c, s, w = np.cos(pattern.yaw_pelvis_in_world), np.sin(pattern.yaw_pelvis_in_world), pattern.yaw_rate_pelvis
+    feet = ((pattern.position_left_ankle_in_world, pattern.velocity_left_ankle_in_world, pattern.yaw_rate_left_foot),
+            (pattern.position_right_ankle_in_world, pattern.velocity_right_ankle_in_world,
+             pattern.yaw_rate_right_foot))
+    for leg, (chain, (position, velocity, yaw_rate)) in enumerate(zip(robot.legs, feet, strict=True)):
+        rel, v = position - base, velocity - velocity_base
+        vx, vy = v[:, 0] + w * rel[:, 1], v[:, 1] - w * rel[:, 0]
+        zero = np.zeros(len(c))
+        twist = np.column_stack([c * vx + s * vy, -s * vx + c * vy, v[:, 2], zero, zero, yaw_rate - w])
+        expected = chain.joint_rates(chain_angles(trajectory, robot, leg), twist)
+        rates = np.empty_like(expected)
+        rates[:, :] = trajectory.velocities[:, 6 * leg:6 * leg + 6][:, np.argsort(chain.role_order)]
+        np.testing.assert_allclose(rates, expected, rtol=0, atol=RATE_TOLERANCE)
+    # and they are the angles' time derivative (central differences at 500 Hz: O(dt^2))
+    finite = np.gradient(np.unwrap(trajectory.angles, axis=0), pattern.time, axis=0)
+    assert np.abs(finite[1:-1] - trajectory.velocities[1:-1]).max() < 0.02  # [rad/s]
+
+
+def test_a_part_solves_at_most_a_chunk_of_samples(tmp_path: Path) -> None:
+    """Bounded work per part: a walk's legs take a part per chunk of IK_CHUNK samples (leg_parts), and the walk's
+    joint trajectory is the same run whole or part by part."""
+    robot = robot_of("talos", tmp_path)
+    pattern, trajectory = walk_of(robot)
+    n = len(pattern.time)
+    feet = ((pattern.position_left_ankle_in_world, pattern.yaw_left_foot_in_world,
+             pattern.velocity_left_ankle_in_world, pattern.yaw_rate_left_foot),
+            (pattern.position_right_ankle_in_world, pattern.yaw_right_foot_in_world,
+             pattern.velocity_right_ankle_in_world, pattern.yaw_rate_right_foot))
+    parts = imported_legs_in_parts(pattern.time, pattern.position_pelvis_in_world, pattern.yaw_pelvis_in_world,
+                                   pattern.velocity_pelvis_in_world, pattern.yaw_rate_pelvis, feet, robot)
+    count = 0
+    try:
+        while True:
+            next(parts)
+            count += 1
+    except StopIteration as done:
+        base, angles, rates, excess = done.value
+    assert count == -(-n // IK_CHUNK) == leg_parts(robot, n)
+    assert np.array_equal(angles, trajectory.angles) and np.array_equal(rates, trajectory.velocities)
+    assert np.array_equal(base, trajectory.position_base_in_world)
+    assert np.all(excess == -1.0)  # every sample converged
+    stepped = pattern_joint_trajectory_in_parts(pattern)
+    while True:
+        try:
+            next(stepped)
+        except StopIteration as done:
+            assert np.array_equal(done.value.angles, trajectory.angles)
+            break
+
+
+def test_a_robot_file_robot_is_not_an_imported_one(hubo: RobotModel) -> None:
+    empty = np.zeros((1, 3))
+    feet = ((empty, np.zeros(1), empty, np.zeros(1)),) * 2
+    with pytest.raises(InvalidParameterError, match="an imported robot"):
+        next(imported_legs_in_parts(np.zeros(1), empty, np.zeros(1), empty, np.zeros(1), feet, hubo))
