@@ -145,11 +145,12 @@ def test_a_seeded_loop_on_the_machines_own_clock(hubo, rate, joints):
 
 @settings(max_examples=200, deadline=None)
 @given(costs=st.lists(st.tuples(st.floats(0.0, 3.0), st.booleans()), min_size=1, max_size=40),
-       budget=st.floats(0.0, 5.0), quota=st.integers(1, 10))
-def test_run_for_begins_no_part_after_its_budget_and_gives_the_same_result(costs, budget, quota):
+       budget=st.floats(0.0, 5.0), quota=st.integers(1, 10), cap=st.one_of(st.none(), st.floats(0.0, 10.0)))
+def test_run_for_begins_no_part_after_its_budget_and_gives_the_same_result(costs, budget, quota, cap):
     """slices.run_for on a clock that each part advances by its cost: at least one part, none begun once the
-    budget is spent (so the time is at most the budget and one part), a part marked ALONE only while at most a
-    quarter of the budget is spent, and, run until done, the result that run_to_end gives."""
+    budget is spent (so the time is at most the budget and one part), or with a cap, once the cap is spent and
+    past the budget only the call's first ``quota``; a part marked ALONE only while at most a quarter of the
+    budget is spent; and, run until done, the result that run_to_end gives."""
     from zmpwalk.slices import ALONE, LONG_PART_START, UNFINISHED, Parts, run_for, run_to_end
 
     now = [0.0]
@@ -167,11 +168,13 @@ def test_run_for_begins_no_part_after_its_budget_and_gives_the_same_result(costs
     parts, total, result = computation(), 0, UNFINISHED
     while result is UNFINISHED:
         start, first = now[0], len(begun)
-        result, count = run_for(parts, budget, quota, lambda: now[0])
+        result, count = run_for(parts, budget, quota, lambda: now[0], cap)
         total += count
         assert count >= 1
         later = begun[first + 1:]  # the parts begun after the call's first one
-        assert all(time - start < budget for time, _ in later)
+        limit = budget if cap is None else max(cap, budget)
+        assert all(time - start < limit for time, _ in later)
+        assert all(time - start < budget for i, (time, _) in enumerate(later, start=1) if i >= quota)
         assert all(time - start <= LONG_PART_START * budget for time, alone in later if alone)
     begun.clear()
     assert result == run_to_end(computation()) == len(costs) and total == len(costs) + 1

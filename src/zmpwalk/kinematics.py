@@ -32,7 +32,7 @@ from zmpwalk.leg_chain.rotations import rot_x, rot_y, rot_z  # re-exported (__al
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sides import Side
 from zmpwalk.slices import Parts, whole
-from zmpwalk.whole_body import COM_ITERATIONS, COM_TOLERANCE, imported_legs_in_parts
+from zmpwalk.whole_body import COM_TOLERANCE, LegFill, imported_legs_in_parts
 
 Array = NDArray[np.float64]
 
@@ -183,8 +183,7 @@ def joint_trajectory_in_parts(
         base, angles, velocities, excess = yield from imported_legs_in_parts(
             time, position_pelvis_in_world, yaw_pelvis_in_world, velocity_pelvis_in_world, yaw_rate_pelvis, feet,
             robot)
-        for index, side in enumerate(Side):
-            _check_reach(excess[index], time, side.label, "inverse kinematics")
+        check_ik_residuals(excess, time, "inverse kinematics")
     if check_limits:  # the joint ranges: parts of their own, each half of the samples (the first sample out
         half = (n + 1) // 2  # of range is the first of the first half that has one, else of the second)
         yield
@@ -228,10 +227,30 @@ def _closed_form_legs_in_parts(
     return rows_angles.T, rows_rates.T
 
 
+def check_ik_residuals(excess: Array, time: Array, detail: str) -> None:
+    """Raise for the first leg whose inverse kinematics did not converge (``excess`` (2, n) [m], > 0 there:
+    :class:`~zmpwalk.whole_body.LegFill`'s) at samples ``time`` [s].
+
+    Raises:
+        UnreachableError: Names the leg, the first such time and the largest residual; ``detail`` says where.
+    """
+    for index, side in enumerate(Side):
+        _check_reach(excess[index], time, side.label, detail)
+
+
 def _check_reach(excess: Array, time: Array, label: str, detail: str) -> None:
     if np.any(excess > 0):
         first = int(np.argmax(excess > 0))
         raise UnreachableError(label, float(time[first]), float(excess.max()), detail)
+
+
+def _pattern_feet(pattern: SampledMotion) -> tuple[tuple[Array, Array, Array, Array], tuple[Array, Array, Array,
+                                                                                              Array]]:
+    """The pattern's feet as :func:`joint_trajectory_in_parts` takes them."""
+    return ((pattern.position_left_ankle_in_world, pattern.yaw_left_foot_in_world,
+             pattern.velocity_left_ankle_in_world, pattern.yaw_rate_left_foot),
+            (pattern.position_right_ankle_in_world, pattern.yaw_right_foot_in_world,
+             pattern.velocity_right_ankle_in_world, pattern.yaw_rate_right_foot))
 
 
 def pattern_joint_trajectory_in_parts(pattern: SampledMotion, knee_forward: bool = True,
@@ -240,12 +259,15 @@ def pattern_joint_trajectory_in_parts(pattern: SampledMotion, knee_forward: bool
     (:func:`joint_trajectory_in_parts`); :func:`pattern_joint_trajectory` runs it whole."""
     return joint_trajectory_in_parts(
         pattern.time, pattern.position_pelvis_in_world, pattern.yaw_pelvis_in_world,
-        pattern.velocity_pelvis_in_world, pattern.yaw_rate_pelvis,
-        ((pattern.position_left_ankle_in_world, pattern.yaw_left_foot_in_world,
-          pattern.velocity_left_ankle_in_world, pattern.yaw_rate_left_foot),
-         (pattern.position_right_ankle_in_world, pattern.yaw_right_foot_in_world,
-          pattern.velocity_right_ankle_in_world, pattern.yaw_rate_right_foot)),
-        pattern.robot, knee_forward, check_limits)
+        pattern.velocity_pelvis_in_world, pattern.yaw_rate_pelvis, _pattern_feet(pattern), pattern.robot,
+        knee_forward, check_limits)
+
+
+def pattern_leg_fill(pattern: SampledMotion) -> LegFill:
+    """An imported robot's legs for ``pattern``, to be filled chunk by chunk (:class:`~zmpwalk.whole_body.LegFill`:
+    no reach or range check; a capture step plays its rows as they are filled)."""
+    return LegFill(pattern.time, pattern.position_pelvis_in_world, pattern.yaw_pelvis_in_world,
+                   pattern.velocity_pelvis_in_world, pattern.yaw_rate_pelvis, _pattern_feet(pattern), pattern.robot)
 
 
 pattern_joint_trajectory = whole(pattern_joint_trajectory_in_parts, "pattern_joint_trajectory")
@@ -301,7 +323,8 @@ def rest_mass(robot: RobotModel) -> tuple[float, Array]:
     return robot.mass, np.zeros(3)
 
 
-__all__ = ["COM_ITERATIONS", "COM_TOLERANCE", "JOINT_COLUMNS", "LEG_JOINTS", "JointLimitError", "JointTrajectory",
-           "SampledMotion", "check_joint_limits", "check_leg_reach", "check_sole_roll", "hip_positions_in_world",
-           "joint_bounds", "joint_trajectory", "joint_trajectory_in_parts", "leg_chains", "leg_reach_excess",
-           "pattern_joint_trajectory", "rest_mass", "rot_x", "rot_y", "rot_z", "virtual_columns"]
+__all__ = ["COM_TOLERANCE", "JOINT_COLUMNS", "LEG_JOINTS", "JointLimitError", "JointTrajectory",
+           "SampledMotion", "check_ik_residuals", "check_joint_limits", "check_leg_reach", "check_sole_roll",
+           "hip_positions_in_world", "joint_bounds", "joint_trajectory", "joint_trajectory_in_parts", "leg_chains",
+           "leg_reach_excess", "pattern_joint_trajectory", "pattern_leg_fill", "rest_mass", "rot_x", "rot_y", "rot_z",
+           "virtual_columns"]

@@ -26,8 +26,10 @@ Behaviour:
   parts while the next one, taken as long as the mean of the tick's so far, ends within its budget
   (:func:`work_budget`: :data:`WORK_BUDGET`, 50 us, or :data:`WORK_FRACTION` of the control period where
   that is longer, 100 us at 100 Hz, at most :data:`WORK_LIMIT`), at least one, and none begins after the budget
-  is spent (with a :class:`~zmpwalk.control.WalkingController`, the budget less the tick's own work): a tick's work
-  is bounded by its budget and one part, whenever commands come. So a check ends as early as the budget
+  is spent (with a :class:`~zmpwalk.control.WalkingController`, the budget less the tick's own work); a check behind
+  its pace (its share of the parts left, per tick) runs its share up to :data:`CATCH_UP` times the budget (an
+  imported robot's legs, long parts on a busy machine). A tick's work is bounded by that and one part, whenever
+  commands come. So a check ends as early as the budget
   allows (a few hundred ticks at 1 kHz), and most ticks have nothing to do. When the check completes the
   command is :attr:`~OnlineWalker.queued`; when it fails the reason is kept in
   :attr:`~OnlineWalker.rejection` and the walk goes on as if the command had not been given (no tick ever
@@ -49,16 +51,13 @@ Behaviour:
   ``wait``). It starts on a tick, so whichever tick it was commanded at, its footsteps and trajectories
   are the same, shifted by whole ticks (the cart-table ZMP too, except that a sample falling exactly on a
   stage boundary, to rounding, may take either stage's value where the ZMP jumps there).
-* If no command is queued when the step under way ends, the walker stops
-  safely: a closing step of the last step time (the swinging foot lands beside
-  the other one) and a settle stage, after which it stands still in the ready
-  posture until the next command. :meth:`OnlineWalker.stop` asks for the same
-  explicitly. That closing step is planned, sampled and checked (reach, joint
-  ranges) with the command before it: a command whose own stop is
-  infeasible is rejected, so no accepted command makes a later tick fail, and
-  :meth:`~OnlineWalker.stop` and the automatic stop cost a tick nothing.
-* The trajectories of a command (and of its stop) are sampled when the command
-  is checked, so a :meth:`~OnlineWalker.tick` only reads a row.
+* If no command is queued when the step under way ends, the walker stops safely: a closing step of the last
+  step time (the swinging foot lands beside the other one) and a settle stage, after which it stands still in the
+  ready posture until the next command. :meth:`OnlineWalker.stop` asks for the same explicitly. That closing step
+  is planned, sampled and checked (reach, joint ranges) with the command before it: a command whose own stop is
+  infeasible is rejected, so no accepted command makes a later tick fail, and :meth:`~OnlineWalker.stop` and the
+  automatic stop cost a tick nothing.
+* The trajectories of a command (and of its stop) are sampled when the command is checked, so a tick reads a row.
 """
 
 from __future__ import annotations
@@ -121,6 +120,7 @@ WORK_BUDGET = 50e-6  # [s] a tick runs parts of a check while the next one is ex
 WORK_FRACTION = 0.01  # [-] ... or within this fraction of the control period, where that is longer (below 200 Hz)
 WORK_LIMIT = 500e-6  # [s] ... but never over this (below 20 Hz): a tick's work stays well under a millisecond
 WORK_SHARE = 0.5  # [-] of the budget a check's parts get however long the loop's own work in the tick took
+CATCH_UP = 2.0  # [-] of the budget a check behind its pace may take to run its share of parts in a tick
 PARTS_PER_BLOCK = 45  # parts of a block of SLICE_ROWS samples (a first guess of a check's length; an imported robot's
 # legs add theirs, zmpwalk.whole_body.leg_parts)
 FINISH_EARLY = 0.95  # [-] a check is paced to end within this fraction of the ticks before its step begins
@@ -355,7 +355,7 @@ class OnlineWalker:
         plan: object
         try:
             plan, parts = run_for(job.planning, max(self._budget - spent, WORK_SHARE * self._budget), quota,
-                                  self._own_clock or _clock)
+                                  self._own_clock or _clock, CATCH_UP * self._budget)
             job.parts += parts
         except ZmpwalkError as error:
             self._drop_job()

@@ -36,19 +36,22 @@ def run_to_end(parts: Parts[T]) -> T:
 UNFINISHED = object()  # what :func:`run_for` returns while the computation has parts left
 
 
-def run_for(parts: Parts[T], budget: float, quota: int = 1,
-            clock: Callable[[], float] = time.perf_counter) -> tuple[T | object, int]:
+def run_for(parts: Parts[T], budget: float, quota: int = 1, clock: Callable[[], float] = time.perf_counter,
+            cap: float | None = None) -> tuple[T | object, int]:
     """Run parts of a sliced computation within ``budget`` [s] of ``clock``: one, then more while the next one,
     taken as long as the mean of those run so far, ends within ``budget``, or (up to ``quota`` parts) while
-    ``budget`` is not spent. No part begins after ``budget`` is spent, so the time taken is bounded by
-    ``budget`` and one part, whatever the computation; a part marked :data:`ALONE` begins only while at most
-    :data:`LONG_PART_START` of ``budget`` is spent (so it begins the next call instead of ending this one).
+    ``budget`` is not spent; given a ``cap`` [s] (above ``budget``), up to ``quota`` parts while the next one is
+    expected to end within ``cap`` (a computation behind its pace catches up, within the cap). No part begins
+    after ``budget`` (or ``cap``) is spent, so the time taken is bounded by it and one part, whatever the
+    computation; a part marked :data:`ALONE` begins only while at most :data:`LONG_PART_START` of ``budget`` is
+    spent (so it begins the next call instead of ending this one).
 
     Returns:
         Its result (:data:`UNFINISHED` while it has parts left), and the number of parts run.
     """
     begin = clock()
     count = 0
+    limit = budget if cap is None else max(cap, budget)
     while True:
         try:
             mark = next(parts)
@@ -57,7 +60,8 @@ def run_for(parts: Parts[T], budget: float, quota: int = 1,
             return result, count + 1
         count += 1
         elapsed = clock() - begin
-        if elapsed >= budget or (count >= quota and elapsed * (count + 1) > budget * count) or (
+        within = budget if count >= quota else limit  # where the next part must end
+        if elapsed >= within or (elapsed * (count + 1) > within * count and (count >= quota or cap is not None)) or (
                 mark is ALONE and elapsed > LONG_PART_START * budget):
             return UNFINISHED, count
 

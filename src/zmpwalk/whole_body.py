@@ -24,7 +24,6 @@ Array = NDArray[np.float64]
 
 IK_CHUNK = 8  # samples per part (TALOS, T1, N1: 6-8 us a sample, angles and rates)
 COM_TOLERANCE = 1e-9  # [m] the base is placed until the whole-body CoM is this close to the pattern's
-COM_ITERATIONS = 12  # the most moves of the base per sample
 
 
 @dataclass(frozen=True)
@@ -104,7 +103,8 @@ class LegFill:
         self._yaw = np.ascontiguousarray(yaw_pelvis_in_world, dtype=np.float64)
         self._yaw_rate = np.ascontiguousarray(yaw_rate_pelvis, dtype=np.float64)
         self._feet = tuple(np.ascontiguousarray([feet[0][i], feet[1][i]], dtype=np.float64) for i in range(4))
-        self._start = np.concatenate([self._arrays.posture, self._arrays.offset, [1.0, 1.0]])
+        self._start = np.zeros(whole_body_ik.START_SIZE)
+        self._start[:16] = np.concatenate([self._arrays.posture, self._arrays.offset, [1.0, 1.0]])
         self.base = np.full((n, 3), np.nan)
         self.angles, self.rates = np.full((n, 12), np.nan), np.full((n, 12), np.nan)
         self.excess = np.full((2, n), -1.0)
@@ -123,7 +123,7 @@ class LegFill:
             last = min(self._solved + IK_CHUNK, n)
             kernel.base_under_com(arrays.params, arrays.chain, arrays.sole_back, self._com, self._yaw,
                                   self._feet[0], self._feet[1], self._solved, last, self._start, COM_TOLERANCE,
-                                  COM_ITERATIONS, self.base, self.angles, self.excess)
+                                  self.base, self.angles, self.excess)
             self._solved = last
         ready = n if self._solved == n else self._solved - 1  # a row's rate reads the next row's base
         if ready > self.done:
@@ -157,4 +157,4 @@ def leg_parts(robot: RobotModel, samples: int) -> int:
     return 0 if robot.legs is None else -(-samples // IK_CHUNK)
 
 
-__all__ = ["COM_ITERATIONS", "COM_TOLERANCE", "IK_CHUNK", "LegFill", "imported_legs_in_parts", "leg_parts"]
+__all__ = ["COM_TOLERANCE", "IK_CHUNK", "LegFill", "imported_legs_in_parts", "leg_parts"]

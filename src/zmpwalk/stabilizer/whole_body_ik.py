@@ -28,8 +28,10 @@ Newton steps: microseconds, where the same iteration on whole arrays in numpy co
 Arrays (all float64): ``params``, ``chain`` and ``work`` of :mod:`zmpwalk.stabilizer.leg` (the parameters read:
 the robot's mass, the rest of the body's mass moment, each leg's ankle offset); ``sole_back`` (2, 3, 3) each
 leg's sole frame transposed, ``R_s^T`` (the chain's own rotation is the sole's times it);
-``start`` (16,): the angles of the last sample (12, role-ordered columns) [rad], its base's offset from the CoM
-in the base frame (2) [m] and the base's gains (2) [-], carried from one sample (and one call) to the next.
+``start`` (:data:`START_SIZE`,), carried from one sample (and one call) to the next: the angles of the last sample
+(12, role-ordered columns) [rad], its base's offset from the CoM in the base frame (2) [m], the base's gains (2)
+[-], the sample before's angles and offset (14), and how many samples have been solved (at most 2); a sample starts
+from the angles and offset extrapolated linearly from the last two.
 """
 
 from __future__ import annotations
@@ -55,7 +57,8 @@ from zmpwalk.stabilizer.leg import (
 )
 
 UNCONVERGED = 1e3 * IK_TOLERANCE  # [m] or [rad]: a sample whose residual is larger did not converge
-SECANT_MOVE = 1e-7  # [m] a smaller move of the base does not tell its gain (the IK converges to 1e-10)
+START_SIZE = 31  # the carried state of a fill (module docstring)
+SECANT_MOVE = 1e-10  # [m] a smaller move of the base does not tell its gain (the CoM is computed to about 1e-13)
 SECANT_RANGE = (0.5, 2.0)  # [-] gains outside are not learned: the CoM moves by 0.5-2 times the base's move
 
 
@@ -76,86 +79,54 @@ def _orientation_error(target: np.ndarray, frame: np.ndarray, error: np.ndarray)
 
 
 @njit(cache=True, nogil=True)
-def solve_leg(params: np.ndarray, chain: np.ndarray, leg: int, target: np.ndarray, rotation: np.ndarray,
-              columns: np.ndarray, frames: np.ndarray, scratch: np.ndarray) -> float:
-    """Damped least squares of one leg from the angles in ``columns`` (12, role-ordered, updated in place) to the
-    ankle ``target`` (3,) [m] and the chain's own rotation ``rotation`` (3, 3) in the base frame; ``frames``
-    (7, 12) holds the leg's frames at the angles reached; ``scratch`` (3, 6, 6): the Jacobian, ``J J^T`` and the
-    error and row swaps. Returns the largest error component left [m] or [rad] (within :data:`IK_TOLERANCE` where
-    it converged)."""
-    jacobian, jjt, error, swaps = scratch[0], scratch[1], scratch[2, 0], scratch[2, 1]
-    norm = math.inf
-    for _ in range(IK_MAX_ITERATIONS + 1):
-        leg_kinematics(chain, leg, columns, frames)
-        ankle = ankle_in_base(params, leg, frames)
-        for i in range(3):
-            error[i] = target[i] - ankle[i]
-        _orientation_error(rotation, frames[6], error)
-        norm = 0.0
-        for i in range(6):
-            norm = max(norm, abs(error[i]))
-        if norm <= IK_TOLERANCE:
-            break
-        leg_jacobian(chain, leg, frames, ankle, jacobian)
-        for i in range(6):
-            for j in range(6):
-                total = IK_DAMPING * IK_DAMPING if i == j else 0.0
-                for m in range(6):
-                    total += jacobian[i, m] * jacobian[j, m]
-                jjt[i, j] = total
-        lu6(jjt, swaps)
-        lu_solve6(jjt, swaps, error)
-        largest = 0.0
-        for i in range(6):  # the step J^T y, in error[0:6] no longer needed: into jjt's first row
-            step = 0.0
-            for m in range(6):
-                step += jacobian[m, i] * error[m]
-            jjt[0, i] = step
-            largest = max(largest, abs(step))
-        scale = min(1.0, IK_MAX_STEP / max(largest, 1e-300))
-        for i in range(6):
-            columns[6 * leg + int(chain[leg, i, 10])] += scale * jjt[0, i]
-    return norm
-
-
-@njit(cache=True, nogil=True)
 def base_under_com(params: np.ndarray, chain: np.ndarray, sole_back: np.ndarray, com: np.ndarray, yaw: np.ndarray,
                    feet: np.ndarray, feet_yaw: np.ndarray, first: int, last: int, start: np.ndarray,
-                   tolerance: float, iterations: int, base: np.ndarray, angles: np.ndarray,
-                   excess: np.ndarray) -> None:
+                   tolerance: float, base: np.ndarray, angles: np.ndarray, excess: np.ndarray) -> None:
     """Samples ``first:last``: the base (n, 3) [m] whose whole-body CoM is the pattern's ``com`` (n, 3) [m]
-    within ``tolerance`` [m] (at most ``iterations`` moves), the legs' angles there (n, 12) [rad], and per leg
-    and sample the IK's residual where it did not converge (> 0), else -1 (``excess`` (2, n)); ``yaw`` (n,) the
-    base's heading [rad], ``feet`` (2, n, 3) the ankles and ``feet_yaw`` (2, n) the soles' headings in world.
-    ``start`` (16,) carries the last sample's angles, base offset and gains (module docstring)."""
+    within ``tolerance`` [m], the legs' angles there (n, 12) [rad], and per leg and sample the IK's residual
+    where it did not converge (> 0), else -1 (``excess`` (2, n)); ``yaw`` (n,) the base's heading [rad], ``feet``
+    (2, n, 3) the ankles and ``feet_yaw`` (2, n) the soles' headings in world. ``start`` (16,) carries the last
+    sample's angles, base offset and gains (module docstring).
+
+    One iteration: both legs' frames at their angles, the CoM's error there and the base's move (step 2 of the
+    module docstring), then each leg's error from the moved base and its step (step 1); it ends when the CoM and
+    both legs are within tolerance at the same angles and base."""
     work = np.zeros((4, 7, 12))
     scratch = np.empty((3, 6, 6))
+    errors = np.empty((2, 6))
     target = np.empty(3)
     rotation = np.empty((3, 3))
     columns = start[:12]
     for k in range(first, last):
+        _extrapolate(start)
         c, s = math.cos(yaw[k]), math.sin(yaw[k])
         bx = com[k, 0] + c * start[12] - s * start[13]
         by = com[k, 1] + s * start[12] + c * start[13]
         bz = com[k, 2]
-        residuals = (math.inf, math.inf)
         sx = sy = 0.0  # the base's last move [m]
-        for _ in range(iterations):
-            r0 = _solve_at(params, chain, sole_back, feet, feet_yaw, k, FIRST, yaw[k], bx, by, bz, columns,
-                           work[0], scratch, target, rotation)
-            r1 = _solve_at(params, chain, sole_back, feet, feet_yaw, k, SECOND, yaw[k], bx, by, bz, columns,
-                           work[2], scratch, target, rotation)
-            residuals = (r0, r1)
+        residuals = (math.inf, math.inf)
+        for _ in range(IK_MAX_ITERATIONS):
+            leg_kinematics(chain, FIRST, columns, work[0])
+            leg_kinematics(chain, SECOND, columns, work[2])
             mx, my, _ = com_in_base(params, chain, work, 0)
             ex = com[k, 0] - (bx + c * mx - s * my)
             ey = com[k, 1] - (by + s * mx + c * my)
-            if max(abs(ex), abs(ey)) < tolerance:
+            placed = max(abs(ex), abs(ey)) < tolerance
+            if not placed:
+                start[14] = _secant_gain(start[14], sx, ex)
+                start[15] = _secant_gain(start[15], sy, ey)
+                sx, sy = start[14] * ex, start[15] * ey
+                bx += sx
+                by += sy
+            for leg in range(2):
+                _leg_target(feet, feet_yaw, sole_back, k, leg, yaw[k], c, s, bx, by, bz, target, rotation)
+                _leg_error(params, leg, work[2 * leg], target, rotation, errors[leg])
+            residuals = (_largest(errors[0]), _largest(errors[1]))
+            if placed and residuals[0] <= IK_TOLERANCE and residuals[1] <= IK_TOLERANCE:
                 break
-            start[14] = _secant_gain(start[14], sx, ex)
-            start[15] = _secant_gain(start[15], sy, ey)
-            sx, sy = start[14] * ex, start[15] * ey
-            bx += sx
-            by += sy
+            for leg in range(2):
+                if residuals[leg] > IK_TOLERANCE:
+                    _newton_step(params, chain, leg, work[2 * leg], columns, errors[leg], scratch)
         base[k, 0], base[k, 1], base[k, 2] = bx, by, bz
         for m in range(12):
             angles[k, m] = _wrap(columns[m])
@@ -165,13 +136,33 @@ def base_under_com(params: np.ndarray, chain: np.ndarray, sole_back: np.ndarray,
         start[12], start[13] = c * dx + s * dy, -s * dx + c * dy
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _extrapolate(start: np.ndarray) -> None:
+    """The next sample's first guess in ``start`` (:data:`START_SIZE`): the angles and base offset extrapolated
+    linearly from the last two samples (the last one's alone before there are two), the last one's kept."""
+    extrapolate = start[30] >= 2.0
+    for m in range(14):
+        last = start[m]
+        start[m] = 2.0 * last - start[16 + m] if extrapolate else last
+        start[16 + m] = last
+    start[30] = min(start[30] + 1.0, 2.0)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _largest(values: np.ndarray) -> float:
+    """The largest magnitude of ``values``."""
+    largest = 0.0
+    for value in values:
+        largest = max(largest, abs(value))
+    return largest
+
+
 @njit(cache=True, nogil=True)
-def _solve_at(params: np.ndarray, chain: np.ndarray, sole_back: np.ndarray, feet: np.ndarray, feet_yaw: np.ndarray,
-              k: int, leg: int, yaw: float, bx: float, by: float, bz: float, columns: np.ndarray, frames: np.ndarray,
-              scratch: np.ndarray, target: np.ndarray, rotation: np.ndarray) -> float:
-    """:func:`solve_leg` for sample ``k``'s ankle and sole of ``leg``, seen from the base at ``(bx, by, bz)`` with
-    heading ``yaw`` [rad]."""
-    c, s = math.cos(yaw), math.sin(yaw)
+def _leg_target(feet: np.ndarray, feet_yaw: np.ndarray, sole_back: np.ndarray, k: int, leg: int, yaw: float,
+                c: float, s: float, bx: float, by: float, bz: float, target: np.ndarray, rotation: np.ndarray) -> None:
+    """Sample ``k``'s ankle of ``leg`` (``target`` (3,) [m]) and the chain's own rotation (``rotation`` (3, 3):
+    the sole's turned back by ``R_s``) seen from the base at ``(bx, by, bz)`` [m] with heading ``yaw`` [rad]
+    (its cosine ``c`` and sine ``s``)."""
     rx, ry = feet[leg, k, 0] - bx, feet[leg, k, 1] - by
     target[0], target[1], target[2] = c * rx + s * ry, -s * rx + c * ry, feet[leg, k, 2] - bz
     turn = feet_yaw[leg, k] - yaw
@@ -180,7 +171,45 @@ def _solve_at(params: np.ndarray, chain: np.ndarray, sole_back: np.ndarray, feet
         rotation[0, j] = ct * sole_back[leg, 0, j] - st * sole_back[leg, 1, j]
         rotation[1, j] = st * sole_back[leg, 0, j] + ct * sole_back[leg, 1, j]
         rotation[2, j] = sole_back[leg, 2, j]
-    return solve_leg(params, chain, leg, target, rotation, columns, frames, scratch)
+
+
+@njit(cache=True, nogil=True)
+def _leg_error(params: np.ndarray, leg: int, frames: np.ndarray, target: np.ndarray, rotation: np.ndarray,
+               error: np.ndarray) -> None:
+    """``error`` (6,) <- the leg's ankle error [m] and the rotation vector of its orientation error [rad], from its
+    ``frames`` to ``target`` and ``rotation`` (:func:`_leg_target`)."""
+    ankle = ankle_in_base(params, leg, frames)
+    for i in range(3):
+        error[i] = target[i] - ankle[i]
+    _orientation_error(rotation, frames[6], error)
+
+
+@njit(cache=True, nogil=True)
+def _newton_step(params: np.ndarray, chain: np.ndarray, leg: int, frames: np.ndarray, columns: np.ndarray,
+                 error: np.ndarray, scratch: np.ndarray) -> None:
+    """The leg's damped least-squares step ``J^T (J J^T + lambda^2 I)^-1 e`` for its ``error`` (6,) (overwritten)
+    at its ``frames``, at most :data:`IK_MAX_STEP` on a joint, added to ``columns`` (12, role-ordered) [rad];
+    ``scratch`` (3, 6, 6) holds the Jacobian, ``J J^T`` and the row swaps."""
+    jacobian, jjt, swaps = scratch[0], scratch[1], scratch[2, 1]
+    leg_jacobian(chain, leg, frames, ankle_in_base(params, leg, frames), jacobian)
+    for i in range(6):
+        for j in range(6):
+            total = IK_DAMPING * IK_DAMPING if i == j else 0.0
+            for m in range(6):
+                total += jacobian[i, m] * jacobian[j, m]
+            jjt[i, j] = total
+    lu6(jjt, swaps)
+    lu_solve6(jjt, swaps, error)
+    largest = 0.0
+    for i in range(6):  # the step J^T y, into jjt's first row (no longer needed)
+        step = 0.0
+        for m in range(6):
+            step += jacobian[m, i] * error[m]
+        jjt[0, i] = step
+        largest = max(largest, abs(step))
+    scale = min(1.0, IK_MAX_STEP / max(largest, 1e-300))
+    for i in range(6):
+        columns[6 * leg + int(chain[leg, i, 10])] += scale * jjt[0, i]
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -266,4 +295,4 @@ def compiled_key() -> int:
 # this module's cached code holds the compiled leg's: renew both where a module or the layout changed since
 renew_stale((compiled_leg, sys.modules[__name__]))
 
-__all__ = ["UNCONVERGED", "base_under_com", "joint_rates", "solve_leg"]
+__all__ = ["START_SIZE", "UNCONVERGED", "base_under_com", "joint_rates"]
