@@ -148,3 +148,28 @@ def test_a_robot_file_robot_is_not_an_imported_one(hubo: RobotModel) -> None:
     feet = ((empty, np.zeros(1), empty, np.zeros(1)),) * 2
     with pytest.raises(InvalidParameterError, match="an imported robot"):
         next(imported_legs_in_parts(np.zeros(1), empty, np.zeros(1), empty, np.zeros(1), feet, hubo))
+
+
+def test_a_capture_plays_its_legs_as_they_are_filled(tmp_path: Path) -> None:
+    """An imported robot's capture step (control.capture.CaptureMotion with a LegFill) solves its first FILL_HEAD
+    rows before it takes over and the rest as it plays, at most one part a tick, keeping FILL_AHEAD rows ahead;
+    every row it plays is the one the whole joint trajectory has (the fill is the same computation)."""
+    from zmpwalk.control.capture import FILL_AHEAD, FILL_HEAD, CaptureMotion
+    from zmpwalk.kinematics import pattern_leg_fill
+
+    robot = robot_of("talos", tmp_path)
+    pattern, trajectory = walk_of(robot)
+    fill = pattern_leg_fill(pattern)
+    while fill.done < FILL_HEAD:
+        fill.advance()
+    joints = JointTrajectory(pattern.time, fill.angles, fill.rates, position_base_in_world=fill.base)
+    motion = CaptureMotion(None, pattern, joints, 100, 500.0, fill)  # type: ignore[arg-type]
+    for tick in range(100, 100 + len(pattern.time)):
+        done = fill.done
+        sample = motion.sample(tick, None)
+        row = tick - 100
+        assert fill.done - done <= IK_CHUNK  # one part at most
+        assert fill.done > min(row + FILL_AHEAD, len(pattern.time) - 1) or fill.complete
+        assert np.array_equal(sample.joint_angles, trajectory.angles[row])
+        assert np.array_equal(sample.joint_velocities, trajectory.velocities[row])
+    assert fill.complete
