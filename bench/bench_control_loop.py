@@ -36,13 +36,15 @@ from pathlib import Path
 
 import numpy as np
 
-CONFIGURATIONS = {  # name: (rate [Hz], joints, generator, the whole controller)
-    "1 kHz, joints": (1000.0, True, "polynomial", False),
-    "1 kHz, no joints": (1000.0, False, "polynomial", False),
-    "100 Hz, joints": (100.0, True, "polynomial", False),
-    "1 kHz, joints, hyperbolic": (1000.0, True, "hyperbolic", False),
-    "controller 1 kHz": (1000.0, True, "polynomial", True),
-    "controller 100 Hz": (100.0, True, "polynomial", True),
+TALOS = Path(__file__).resolve().parents[2] / "shared" / "robots" / "pal_talos" / "scene_position.xml"
+CONFIGURATIONS = {  # name: (rate [Hz], joints, generator, the whole controller, robot)
+    "1 kHz, joints": (1000.0, True, "polynomial", False, "hubo"),
+    "1 kHz, no joints": (1000.0, False, "polynomial", False, "hubo"),
+    "100 Hz, joints": (100.0, True, "polynomial", False, "hubo"),
+    "1 kHz, joints, hyperbolic": (1000.0, True, "hyperbolic", False, "hubo"),
+    "controller 1 kHz": (1000.0, True, "polynomial", True, "hubo"),
+    "controller 100 Hz": (100.0, True, "polynomial", True, "hubo"),
+    "TALOS controller 1 kHz": (1000.0, True, "polynomial", True, str(TALOS)),  # an imported robot's legs
 }
 HOSTILE_KINDS = ("reach", "fast", "stop", "zero")
 HOSTILE_SHARE = 0.2  # [-] of the commands
@@ -170,15 +172,16 @@ def run_loop(rate: float, joints: bool, ticks: int, seed: int, generator: str = 
 
 
 def run_controller(rate: float, ticks: int, seed: int, generator: str = "polynomial",
-                   collector: str = "freeze") -> dict[str, object]:
+                   collector: str = "freeze", robot_name: str = "hubo") -> dict[str, object]:
     """The whole controller's loop: a :class:`~zmpwalk.control.WalkingController` (pattern, legs, stabilizer) on
     a :class:`~zmpwalk.control.MockPlant`; timed per iteration: ``plant.measure()``, the command given in it, if
     any, ``controller.update()`` and ``plant.apply()``; and apart, the controller's own work: the command given, if
-    any, and ``update()`` (the mock plant's ``measure`` and ``apply`` stand for a robot's driver)."""
+    any, and ``update()`` (the mock plant's ``measure`` and ``apply`` stand for a robot's driver). ``robot_name``:
+    a built-in robot or a model's path."""
     from zmpwalk import load_robot
     from zmpwalk.control import MockPlant, WalkingController
 
-    robot = load_robot("hubo")
+    robot = load_robot(robot_name if robot_name == "hubo" else Path(robot_name))
     controller = WalkingController(robot, rate=rate, generator=generator)
     plant = MockPlant(robot, rate)
     walker = controller.walker
@@ -269,8 +272,8 @@ def main() -> None:
         if args.child == "floor":
             result = run_floor(args.ticks)
         else:
-            rate, joints, generator, whole = CONFIGURATIONS[args.child]
-            result = (run_controller(rate, args.ticks, args.seed, generator, args.gc) if whole
+            rate, joints, generator, whole, robot = CONFIGURATIONS[args.child]
+            result = (run_controller(rate, args.ticks, args.seed, generator, args.gc, robot) if whole
                       else run_loop(rate, joints, args.ticks, args.seed, generator, args.gc))
         import zmpwalk
 
@@ -284,6 +287,9 @@ def main() -> None:
           f"plant.measure(), command(), update(), plant.apply()), {args.ticks} ticks each, seed {args.seed}, garbage "
           f"collector: {args.gc}")
     for configuration in args.only or ["floor", *CONFIGURATIONS]:
+        if configuration != "floor" and CONFIGURATIONS[configuration][4] != "hubo" \
+                and not Path(CONFIGURATIONS[configuration][4]).is_file():
+            continue  # ../shared/robots absent
         for name, source in trees if configuration != "floor" else [("", None)]:
             result = child(configuration, args.ticks, args.seed, source, args.gc)
             counts = "" if configuration == "floor" else (

@@ -274,10 +274,12 @@ class CommandCheck:
         yield ALONE  # the stage table's numbers: a long part (a Python loop over the stages' fields)
         table = yield from StageTable.in_parts(stages)
         yield
-        # in slices for command(); an imported robot's legs in one pass (its base velocities are differences
-        # along the step)
-        size = SLICE_ROWS if buffers is not None and self.robot.legs is None else max(len(rows), 1)
+        # in slices for command(); an imported robot's legs once the step is sampled (its base velocities are
+        # differences along the step), in parts of their own
+        size = SLICE_ROWS if buffers is not None else max(len(rows), 1)
         scalars = row_scalars(rows[:0])
+        whole_step = self.joints and self.robot.legs is not None
+        blocks: list[Samples] = []
         for begin in range(0, len(rows), size):
             block = rows[begin:min(begin + size, len(rows))]
             times = np.arange(first_index + begin, first_index + begin + len(block)) / rate
@@ -288,11 +290,18 @@ class CommandCheck:
             for column, values in zip(scalars, row_scalars(block), strict=True):
                 column.extend(values)
             yield
-            if self.joints:
+            if whole_step:
+                blocks.append(samples)
+            elif self.joints:
                 yield from self._fill_joints(block, samples)
             else:
                 check_leg_reach(samples.time, block[:, ROW_PELVIS], samples.pelvis_yaw, samples.left_position,
                                 samples.right_position, self.robot)
+            yield
+        if whole_step and blocks:
+            samples = Samples.joined(blocks)
+            yield
+            yield from self._fill_joints(rows, samples)
             yield
         standing = None
         if next_boundary.at_rest:  # the row of standing still (one IK and the joint ranges, 50 us): a long part
@@ -316,10 +325,14 @@ class CommandCheck:
         rows[:, ROW_SUPPORT] = samples.support
 
     def _fill_joints(self, rows: Array, samples: Samples) -> Parts[None]:
+        """Fill ``rows`` with the legs' angles and rates at ``samples``
+        (:func:`~zmpwalk.kinematics.joint_trajectory_in_parts`: its parts and its checks)."""
         n = len(samples.time)
         pelvis = np.column_stack([samples.pelvis_xy, np.full(n, self.robot.pelvis_height)])
+        velocity = np.column_stack([samples.pelvis_velocity_xy, np.zeros(n)])
+        yield
         trajectory = yield from joint_trajectory_in_parts(
-            samples.time, pelvis, samples.pelvis_yaw, np.column_stack([samples.pelvis_velocity_xy, np.zeros(n)]),
+            samples.time, pelvis, samples.pelvis_yaw, velocity,
             samples.pelvis_yaw_rate,
             ((samples.left_position, samples.left_yaw, samples.left_velocity, samples.left_yaw_rate),
              (samples.right_position, samples.right_yaw, samples.right_velocity, samples.right_yaw_rate)),

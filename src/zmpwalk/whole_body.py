@@ -79,10 +79,9 @@ class LegFill:
     Attributes:
         base: The base positions (n, 3) [m] (the CoM's height kept: its vertical motion is what the pattern
             neglects too); its velocity is the CoM's plus the time derivative of their offset.
-        angles, rates: (n, 12) [rad] and [rad/s] in :data:`~zmpwalk.kinematics.JOINT_COLUMNS` order (NaN where
-            not filled yet).
+        angles, rates: (n, 12) [rad] and [rad/s] in :data:`~zmpwalk.kinematics.JOINT_COLUMNS` order.
         excess: Per leg and sample the IK's residual where it did not converge, else -1 (2, n) [m].
-        done: The rows complete.
+        done: The rows complete (each array's rows from ``done`` on are not set yet).
 
     Raises:
         InvalidParameterError: ``robot`` is not an imported one.
@@ -102,12 +101,16 @@ class LegFill:
         self._velocity = np.ascontiguousarray(velocity_com_in_world, dtype=np.float64)
         self._yaw = np.ascontiguousarray(yaw_pelvis_in_world, dtype=np.float64)
         self._yaw_rate = np.ascontiguousarray(yaw_rate_pelvis, dtype=np.float64)
-        self._feet = tuple(np.ascontiguousarray([feet[0][i], feet[1][i]], dtype=np.float64) for i in range(4))
+        # each foot's position, yaw, velocity and yaw rate as a (left, right) pair (copies only where not
+        # contiguous float64)
+        self._feet = tuple((np.ascontiguousarray(feet[0][i], dtype=np.float64),
+                            np.ascontiguousarray(feet[1][i], dtype=np.float64)) for i in range(4))
         self._start = np.zeros(whole_body_ik.START_SIZE)
         self._start[:16] = np.concatenate([self._arrays.posture, self._arrays.offset, [1.0, 1.0]])
-        self.base = np.full((n, 3), np.nan)
-        self.angles, self.rates = np.full((n, 12), np.nan), np.full((n, 12), np.nan)
-        self.excess = np.full((2, n), -1.0)
+        # not written here: a fresh array's pages fault in when first written (1-10 us each on a virtual
+        # machine), so the parts that fill the rows take them a few at a time
+        self.base, self.angles, self.rates = np.empty((n, 3)), np.empty((n, 12)), np.empty((n, 12))
+        self.excess = np.empty((2, n))
         self.done = 0
         self._solved = 0  # rows whose base and angles are solved
 
@@ -147,7 +150,7 @@ def imported_legs_in_parts(time: Array, position_com_in_world: Array, yaw_pelvis
     [rad/s], and the IK's residuals (2, n) [m] (arguments and errors: :class:`LegFill`'s)."""
     fill = LegFill(time, position_com_in_world, yaw_pelvis_in_world, velocity_com_in_world, yaw_rate_pelvis, feet,
                    robot)
-    yield from fill.parts()
+    yield from fill.parts()  # (its first part begins with a yield: the fill's arrays are a part of their own)
     return fill.base, fill.angles, fill.rates, fill.excess
 
 

@@ -126,7 +126,7 @@ class CaptureMotion:
 
     def planned(self, tick: int) -> WalkingSample | None:
         """The pattern's sample of controller tick ``tick``, where the pattern holds it (None after its end; an
-        imported robot's joints NaN where not filled yet)."""
+        imported robot's joints not set where not filled yet)."""
         i = tick - self.first
         return self._row(i) if 0 <= i < len(self.pattern.time) else None
 

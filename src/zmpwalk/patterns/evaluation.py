@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import Any, Protocol
 
 import numpy as np
@@ -201,6 +201,12 @@ class Samples:
     right_yaw: Array  # [rad]
     right_yaw_rate: Array  # [rad/s]
     zmp_xy: Array  # [m], cart-table ZMP of Eqs. 1-2
+
+    @classmethod
+    def joined(cls, pieces: Sequence[Samples]) -> Samples:
+        """The samples of consecutive ``pieces``, one after the other."""
+        return cls(**{f.name: np.concatenate([getattr(piece, f.name) for piece in pieces])
+                      for f in fields(cls)})
 
 
 def evaluate_in_parts(table: StageTable, time: Array, robot: RobotModel,

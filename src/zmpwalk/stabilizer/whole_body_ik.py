@@ -56,6 +56,7 @@ from zmpwalk.stabilizer.leg import (
     lu_solve6,
 )
 
+Pair = tuple[np.ndarray, np.ndarray]  # the left and the right foot's array (numba: a homogeneous tuple)
 UNCONVERGED = 1e3 * IK_TOLERANCE  # [m] or [rad]: a sample whose residual is larger did not converge
 START_SIZE = 31  # the carried state of a fill (module docstring)
 SECANT_MOVE = 1e-10  # [m] a smaller move of the base does not tell its gain (the CoM is computed to about 1e-13)
@@ -80,13 +81,13 @@ def _orientation_error(target: np.ndarray, frame: np.ndarray, error: np.ndarray)
 
 @njit(cache=True, nogil=True)
 def base_under_com(params: np.ndarray, chain: np.ndarray, sole_back: np.ndarray, com: np.ndarray, yaw: np.ndarray,
-                   feet: np.ndarray, feet_yaw: np.ndarray, first: int, last: int, start: np.ndarray,
+                   feet: Pair, feet_yaw: Pair, first: int, last: int, start: np.ndarray,
                    tolerance: float, base: np.ndarray, angles: np.ndarray, excess: np.ndarray) -> None:
     """Samples ``first:last``: the base (n, 3) [m] whose whole-body CoM is the pattern's ``com`` (n, 3) [m]
     within ``tolerance`` [m], the legs' angles there (n, 12) [rad], and per leg and sample the IK's residual
     where it did not converge (> 0), else -1 (``excess`` (2, n)); ``yaw`` (n,) the base's heading [rad], ``feet``
-    (2, n, 3) the ankles and ``feet_yaw`` (2, n) the soles' headings in world. ``start`` (16,) carries the last
-    sample's angles, base offset and gains (module docstring).
+    (left, right) each (n, 3) the ankles and ``feet_yaw`` each (n,) the soles' headings in world. ``start``
+    (:data:`START_SIZE`,) carries the last samples' angles, base offsets and gains (module docstring).
 
     One iteration: both legs' frames at their angles, the CoM's error there and the base's move (step 2 of the
     module docstring), then each leg's error from the moved base and its step (step 1); it ends when the CoM and
@@ -158,14 +159,14 @@ def _largest(values: np.ndarray) -> float:
 
 
 @njit(cache=True, nogil=True)
-def _leg_target(feet: np.ndarray, feet_yaw: np.ndarray, sole_back: np.ndarray, k: int, leg: int, yaw: float,
+def _leg_target(feet: Pair, feet_yaw: Pair, sole_back: np.ndarray, k: int, leg: int, yaw: float,
                 c: float, s: float, bx: float, by: float, bz: float, target: np.ndarray, rotation: np.ndarray) -> None:
     """Sample ``k``'s ankle of ``leg`` (``target`` (3,) [m]) and the chain's own rotation (``rotation`` (3, 3):
     the sole's turned back by ``R_s``) seen from the base at ``(bx, by, bz)`` [m] with heading ``yaw`` [rad]
     (its cosine ``c`` and sine ``s``)."""
-    rx, ry = feet[leg, k, 0] - bx, feet[leg, k, 1] - by
-    target[0], target[1], target[2] = c * rx + s * ry, -s * rx + c * ry, feet[leg, k, 2] - bz
-    turn = feet_yaw[leg, k] - yaw
+    rx, ry = feet[leg][k, 0] - bx, feet[leg][k, 1] - by
+    target[0], target[1], target[2] = c * rx + s * ry, -s * rx + c * ry, feet[leg][k, 2] - bz
+    turn = feet_yaw[leg][k] - yaw
     ct, st = math.cos(turn), math.sin(turn)
     for j in range(3):  # R_z(turn) R_s^T
         rotation[0, j] = ct * sole_back[leg, 0, j] - st * sole_back[leg, 1, j]
@@ -229,14 +230,15 @@ def _secant_gain(gain: float, moved: float, error: float) -> float:
 
 @njit(cache=True, nogil=True)
 def joint_rates(params: np.ndarray, chain: np.ndarray, time: np.ndarray, angles: np.ndarray, base: np.ndarray,
-                com: np.ndarray, velocity_com: np.ndarray, yaw: np.ndarray, yaw_rate: np.ndarray, feet: np.ndarray,
-                feet_velocity: np.ndarray, feet_yaw_rate: np.ndarray, first: int, last: int,
+                com: np.ndarray, velocity_com: np.ndarray, yaw: np.ndarray, yaw_rate: np.ndarray, feet: Pair,
+                feet_velocity: Pair, feet_yaw_rate: Pair, first: int, last: int,
                 rates: np.ndarray) -> None:
     """Samples ``first:last`` of the joint rates (n, 12) [rad/s] that give each ankle its velocity relative to the
     base, ``J(q)^-1 twist`` (:meth:`~zmpwalk.leg_chain.LegChain.joint_rates`). The base's velocity is the CoM's,
     ``velocity_com`` (n, 3) [m/s], plus the time derivative of the base's offset from it (:func:`_offset_rate`:
     the base of samples ``first - 1`` to ``last`` is read); ``yaw_rate`` (n,) [rad/s] is the base's,
-    ``feet_velocity`` (2, n, 3) [m/s] and ``feet_yaw_rate`` (2, n) [rad/s] the ankles' and soles' in world. A
+    ``feet_velocity`` (left, right) each (n, 3) [m/s] and ``feet_yaw_rate`` each (n,) [rad/s] the ankles' and
+    soles' in world. A
     singular leg's rates are NaN."""
     frames = np.empty((7, 12))
     jacobian = np.empty((6, 6))
@@ -248,12 +250,12 @@ def joint_rates(params: np.ndarray, chain: np.ndarray, time: np.ndarray, angles:
         vby = velocity_com[k, 1] + _offset_rate(time, base, com, k, 1)
         vbz = velocity_com[k, 2] + _offset_rate(time, base, com, k, 2)
         for leg in range(2):
-            rx, ry = feet[leg, k, 0] - base[k, 0], feet[leg, k, 1] - base[k, 1]
-            vx = feet_velocity[leg, k, 0] - vbx + yaw_rate[k] * ry  # in the rotating base frame
-            vy = feet_velocity[leg, k, 1] - vby - yaw_rate[k] * rx
+            rx, ry = feet[leg][k, 0] - base[k, 0], feet[leg][k, 1] - base[k, 1]
+            vx = feet_velocity[leg][k, 0] - vbx + yaw_rate[k] * ry  # in the rotating base frame
+            vy = feet_velocity[leg][k, 1] - vby - yaw_rate[k] * rx
             twist[0], twist[1] = c * vx + s * vy, -s * vx + c * vy
-            twist[2] = feet_velocity[leg, k, 2] - vbz
-            twist[3], twist[4], twist[5] = 0.0, 0.0, feet_yaw_rate[leg, k] - yaw_rate[k]
+            twist[2] = feet_velocity[leg][k, 2] - vbz
+            twist[3], twist[4], twist[5] = 0.0, 0.0, feet_yaw_rate[leg][k] - yaw_rate[k]
             leg_kinematics(chain, leg, angles[k], frames)
             leg_jacobian(chain, leg, frames, ankle_in_base(params, leg, frames), jacobian)
             singular = lu6(jacobian, swaps) == 0.0
