@@ -14,8 +14,8 @@ import pytest
 
 from test_keyframe_sole import pitched_biped
 from zmpwalk.commands import StepCommand
-from zmpwalk.errors import InvalidParameterError
-from zmpwalk.kinematics import JointTrajectory, pattern_joint_trajectory, pattern_joint_trajectory_in_parts, rot_z
+from zmpwalk.errors import InvalidParameterError, UnreachableError
+from zmpwalk.kinematics import JointTrajectory, pattern_joint_trajectory, pattern_leg_fill, rot_z
 from zmpwalk.patterns.polynomial import generate
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots import load_robot
@@ -112,8 +112,8 @@ def test_the_rates_are_the_chains_inverse_jacobian_of_the_feet_twists(name: str,
 
 
 def test_a_part_solves_at_most_a_chunk_of_samples(tmp_path: Path) -> None:
-    """Bounded work per part: a walk's legs take a part per chunk of IK_CHUNK samples (leg_parts), and the walk's
-    joint trajectory is the same run whole or part by part."""
+    """Bounded work per part: a walk's legs take a part per chunk of IK_CHUNK samples (leg_parts), and give what
+    the joint trajectory gives."""
     robot = robot_of("talos", tmp_path)
     pattern, trajectory = walk_of(robot)
     n = len(pattern.time)
@@ -134,13 +134,61 @@ def test_a_part_solves_at_most_a_chunk_of_samples(tmp_path: Path) -> None:
     assert np.array_equal(angles, trajectory.angles) and np.array_equal(rates, trajectory.velocities)
     assert np.array_equal(base, trajectory.position_base_in_world)
     assert np.all(excess == -1.0)  # every sample converged
-    stepped = pattern_joint_trajectory_in_parts(pattern)
-    while True:
-        try:
-            next(stepped)
-        except StopIteration as done:
-            assert np.array_equal(done.value.angles, trajectory.angles)
-            break
+
+def test_the_chunks_do_not_change_the_walk(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The same legs in one chunk as in chunks of IK_CHUNK samples (each sample starts from the last ones, whichever
+    part solved them), and in chunks of 1, 2 or 3 samples for walks of 0 to 3 samples."""
+    import zmpwalk.whole_body as whole_body
+
+    robot = robot_of("talos", tmp_path)
+    pattern, trajectory = walk_of(robot)
+    monkeypatch.setattr(whole_body, "IK_CHUNK", len(pattern.time))
+    again = pattern_joint_trajectory(pattern)
+    assert np.array_equal(again.angles, trajectory.angles) and np.array_equal(again.velocities, trajectory.velocities)
+    for n in range(4):
+        first: JointTrajectory | None = None
+        for chunk in (1, 2, 3):
+            monkeypatch.setattr(whole_body, "IK_CHUNK", chunk)
+            fill = pattern_leg_fill(_rows(pattern, n))
+            assert leg_parts(robot, n) == -(-n // chunk) and all(True for _ in fill.parts()) and fill.complete
+            assert np.isfinite(fill.rates[:n]).all() and np.all(fill.excess == -1.0)
+            if first is None:
+                first = JointTrajectory(fill.time, fill.angles.copy(), fill.rates.copy())
+            assert np.array_equal(fill.angles, first.angles) and np.array_equal(fill.rates, first.velocities)
+
+
+def _rows(pattern: WalkingPattern, n: int) -> WalkingPattern:
+    """The first ``n`` samples of ``pattern`` (its fields that are per-sample arrays)."""
+    from dataclasses import fields, replace
+
+    size = len(pattern.time)
+    return replace(pattern, **{f.name: getattr(pattern, f.name)[:n] for f in fields(pattern)
+                               if isinstance(getattr(pattern, f.name), np.ndarray)
+                               and len(getattr(pattern, f.name)) == size})
+
+
+def test_a_foot_out_of_reach_or_not_finite_is_refused_and_the_samples_after_it_are_solved(tmp_path: Path) -> None:
+    """A sample whose ankle is 0.5 m beyond the leg's reach, and one whose CoM is NaN: each raises UnreachableError
+    naming the leg and the time (from the sample's residual), and the fill's other samples are those of the walk
+    without them (the sample after a bad one starts from the last good one)."""
+    from dataclasses import replace
+
+    robot = robot_of("talos", tmp_path)
+    pattern, trajectory = walk_of(robot)
+    bad = 600
+    for field, change in (("position_left_ankle_in_world", (0.0, 0.0, -0.5)),
+                          ("position_pelvis_in_world", (np.nan, 0.0, 0.0))):
+        values = getattr(pattern, field).copy()
+        values[bad] += change
+        broken = replace(pattern, **{field: values})
+        with pytest.raises(UnreachableError, match="left" if "ankle" in field else "left|right") as error:
+            pattern_joint_trajectory(broken)
+        assert error.value.time == pytest.approx(pattern.time[bad])
+        fill = pattern_leg_fill(broken)
+        for _ in fill.parts():
+            pass
+        assert not fill.excess[0, bad] <= 0.0 and np.all(fill.excess[:, bad + 2:] == -1.0)
+        assert np.abs(fill.angles[bad + 2:] - trajectory.angles[bad + 2:]).max() < 1e-8  # [rad]
 
 
 def test_a_robot_file_robot_is_not_an_imported_one(hubo: RobotModel) -> None:
@@ -155,7 +203,6 @@ def test_a_capture_plays_its_legs_as_they_are_filled(tmp_path: Path) -> None:
     rows before it takes over and the rest as it plays, at most one part a tick, keeping FILL_AHEAD rows ahead;
     every row it plays is the one the whole joint trajectory has (the fill is the same computation)."""
     from zmpwalk.control.capture import FILL_AHEAD, FILL_HEAD, CaptureMotion
-    from zmpwalk.kinematics import pattern_leg_fill
 
     robot = robot_of("talos", tmp_path)
     pattern, trajectory = walk_of(robot)
@@ -168,7 +215,7 @@ def test_a_capture_plays_its_legs_as_they_are_filled(tmp_path: Path) -> None:
         done = fill.done
         sample = motion.sample(tick, None)
         row = tick - 100
-        assert fill.done - done <= IK_CHUNK  # one part at most
+        assert fill.done - done <= IK_CHUNK + 1  # one part at most (the last completes its chunk and the one before)
         assert fill.done > min(row + FILL_AHEAD, len(pattern.time) - 1) or fill.complete
         assert np.array_equal(sample.joint_angles, trajectory.angles[row])
         assert np.array_equal(sample.joint_velocities, trajectory.velocities[row])

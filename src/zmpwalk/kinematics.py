@@ -228,14 +228,17 @@ def _closed_form_legs_in_parts(
 
 
 def check_ik_residuals(excess: Array, time: Array, detail: str) -> None:
-    """Raise for the first leg whose inverse kinematics did not converge (``excess`` (2, n) [m], > 0 there:
-    :class:`~zmpwalk.whole_body.LegFill`'s) at samples ``time`` [s].
+    """Raise for the first leg whose inverse kinematics did not converge (``excess`` (2, n) [m] or [rad], > 0 or NaN
+    there: :class:`~zmpwalk.whole_body.LegFill`'s) at samples ``time`` [s].
 
     Raises:
         UnreachableError: Names the leg, the first such time and the largest residual; ``detail`` says where.
     """
     for index, side in enumerate(Side):
-        _check_reach(excess[index], time, side.label, detail)
+        failed = ~(excess[index] <= 0.0)  # NaN too (a sample that is not finite)
+        if failed.any():
+            first = int(np.argmax(failed))
+            raise UnreachableError(side.label, float(time[first]), float(np.max(excess[index][failed])), detail)
 
 
 def _check_reach(excess: Array, time: Array, label: str, detail: str) -> None:

@@ -355,7 +355,7 @@ class OnlineWalker:
         plan: object
         try:
             plan, parts = run_for(job.planning, max(self._budget - spent, WORK_SHARE * self._budget), quota,
-                                  self._own_clock or _clock, CATCH_UP * self._budget)
+                                  self._own_clock or _clock, CATCH_UP * self._budget - spent)
             job.parts += parts
         except ZmpwalkError as error:
             self._drop_job()

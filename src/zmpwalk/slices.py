@@ -40,8 +40,8 @@ def run_for(parts: Parts[T], budget: float, quota: int = 1, clock: Callable[[], 
             cap: float | None = None) -> tuple[T | object, int]:
     """Run parts of a sliced computation within ``budget`` [s] of ``clock``: one, then more while the next one,
     taken as long as the mean of those run so far, ends within ``budget``, or (up to ``quota`` parts) while
-    ``budget`` is not spent; given a ``cap`` [s] (above ``budget``), up to ``quota`` parts while the next one is
-    expected to end within ``cap`` (a computation behind its pace catches up, within the cap). No part begins
+    ``budget`` is not spent, or, given a ``cap`` [s] (above ``budget``), while the next one is expected to end
+    within ``cap`` (a computation behind its pace catches up, within the cap). No part begins
     after ``budget`` (or ``cap``) is spent, so the time taken is bounded by it and one part, whatever the
     computation; a part marked :data:`ALONE` begins only while at most :data:`LONG_PART_START` of ``budget`` is
     spent (so it begins the next call instead of ending this one).
@@ -60,9 +60,12 @@ def run_for(parts: Parts[T], budget: float, quota: int = 1, clock: Callable[[], 
             return result, count + 1
         count += 1
         elapsed = clock() - begin
-        within = budget if count >= quota else limit  # where the next part must end
-        if elapsed >= within or (elapsed * (count + 1) > within * count and (count >= quota or cap is not None)) or (
-                mark is ALONE and elapsed > LONG_PART_START * budget):
+        expected = elapsed * (count + 1) / count  # when the next part would end
+        if count >= quota:
+            stop = elapsed >= budget or expected > budget
+        else:  # its share: while the budget is not spent, or the next part ends within the cap
+            stop = elapsed >= limit or (elapsed >= budget and expected > limit)
+        if stop or (mark is ALONE and elapsed > LONG_PART_START * budget):
             return UNFINISHED, count
 
 

@@ -22,7 +22,7 @@ from zmpwalk.stabilizer.layout import PARAMETERS, P, chain_table
 
 Array = NDArray[np.float64]
 
-IK_CHUNK = 8  # samples per part (TALOS, T1, N1: 6-8 us a sample, angles and rates)
+IK_CHUNK = 8  # samples per part (TALOS, T1, N1: about 3.2 us a sample with the rates, 25 us a part)
 COM_TOLERANCE = 1e-9  # [m] the base is placed until the whole-body CoM is this close to the pattern's
 
 
@@ -80,7 +80,8 @@ class LegFill:
         base: The base positions (n, 3) [m] (the CoM's height kept: its vertical motion is what the pattern
             neglects too); its velocity is the CoM's plus the time derivative of their offset.
         angles, rates: (n, 12) [rad] and [rad/s] in :data:`~zmpwalk.kinematics.JOINT_COLUMNS` order.
-        excess: Per leg and sample the IK's residual where it did not converge, else -1 (2, n) [m].
+        excess: Per leg and sample the IK's residual where it did not converge (or NaN), else -1 (2, n) [m] or
+            [rad].
         done: The rows complete (each array's rows from ``done`` on are not set yet).
 
     Raises:

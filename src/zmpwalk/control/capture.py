@@ -54,7 +54,7 @@ from zmpwalk.robots.model import RobotModel
 from zmpwalk.sample import WalkingSample
 from zmpwalk.sides import SUPPORT_LABELS
 from zmpwalk.slices import Parts
-from zmpwalk.whole_body import IK_CHUNK, LegFill, leg_parts
+from zmpwalk.whole_body import IK_CHUNK, LegFill
 
 Array = NDArray[np.float64]
 
@@ -126,9 +126,14 @@ class CaptureMotion:
 
     def planned(self, tick: int) -> WalkingSample | None:
         """The pattern's sample of controller tick ``tick``, where the pattern holds it (None after its end; an
-        imported robot's joints not set where not filled yet)."""
+        imported robot's joints None where not filled yet)."""
         i = tick - self.first
-        return self._row(i) if 0 <= i < len(self.pattern.time) else None
+        if not 0 <= i < len(self.pattern.time):
+            return None
+        row = self._row(i)
+        if self.fill is not None and i >= self.fill.done:
+            row.joint_angles = row.joint_velocities = None
+        return row
 
     def ended(self, tick: int) -> bool:
         """Whether the pattern has ended by controller tick ``tick`` (the robot at rest on both feet)."""
@@ -199,7 +204,7 @@ class CapturePolicy:
         self.parts_per_tick = 0
         self._last = -math.inf  # [ticks] of the last trigger or take-over
         self._planning: _Planning | None = None
-        self._expected = EXPECTED_PARTS + leg_parts(robot, FILL_HEAD)  # an imported robot's legs: their head
+        self._expected = EXPECTED_PARTS + (HEAD_PARTS if robot.legs is not None else 0)  # imported legs' head
         self._errors = np.zeros((max(1, round(ERROR_RATE_WINDOW * self.rate)) + 1, 2))  # [m] the last DCM errors
         self._observed = 0
         self._omega = math.sqrt(robot.gravity / robot.pendulum_length)  # [1/s] the pendulum's
@@ -337,6 +342,7 @@ IN_TICK_SHARE = 0.5  # [-] a whole plan taking this share of the control period 
 EXPECTED_PARTS = 40  # the parts a capture plan is paced for before the first one has been counted
 FILL_HEAD = 3 * IK_CHUNK  # rows of an imported robot's legs solved before its capture takes over
 FILL_AHEAD = IK_CHUNK  # [ticks] the rows solved ahead of the one played, at least
+HEAD_PARTS = -(-(FILL_HEAD + 1) // IK_CHUNK)  # the fill's parts to FILL_HEAD rows (a part completes a chunk less one)
 
 
 def _swing_force(sample: WalkingSample, measurement: BalanceMeasurement) -> float:
@@ -350,8 +356,10 @@ def _with_joints(parts: Parts[tuple[WalkingPattern, CapturePlan]]
     """A capture step's parts, then its joint angles' (no range check: a capture is taken within reach whatever the
     joints' soft ranges): a robot file's legs whole (:func:`~zmpwalk.kinematics.pattern_joint_trajectory_in_parts`),
     an imported robot's first :data:`FILL_HEAD` rows (:func:`~zmpwalk.kinematics.pattern_leg_fill`; the rest as
-    the capture plays, :class:`CaptureMotion`). A sample the legs cannot reach raises
-    :class:`~zmpwalk.errors.UnreachableError` (the plan is dropped)."""
+    the capture plays, :class:`CaptureMotion`). Every sample of the pattern is within both legs' reach (the plan's
+    own check, hip to ankle with :data:`~zmpwalk.capture.REACH_MARGIN` to spare); a sample of the solved rows the
+    legs' IK does not meet raises :class:`~zmpwalk.errors.UnreachableError` (the plan is dropped), one of the rows
+    solved as the capture plays keeps its angles (its residual in ``fill.excess``)."""
     pattern, plan = yield from parts
     yield
     if pattern.robot.legs is None:

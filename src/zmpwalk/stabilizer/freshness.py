@@ -20,7 +20,8 @@ from zmpwalk.stabilizer.layout import LAYOUT_KEY
 
 _PACKAGE = Path(__file__).resolve().parent
 SOURCES = (*sorted(_PACKAGE.glob("*.py")), _PACKAGE.parent / "balance_kernel.py",  # the compiled modules' files
-           _PACKAGE.parent / "sides.py")  # and the support codes they compare with
+           _PACKAGE.parent / "sides.py",  # the support codes they compare with
+           _PACKAGE.parent / "leg_chain" / "numeric.py")  # and the IK's tolerances (whole_body_ik)
 
 
 def _fingerprint() -> int:
