@@ -15,12 +15,12 @@ import pytest
 from test_keyframe_sole import pitched_biped
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import InvalidParameterError, UnreachableError
-from zmpwalk.kinematics import JointTrajectory, pattern_joint_trajectory, pattern_leg_fill, rot_z
+from zmpwalk.kinematics import JointTrajectory, pattern_joint_trajectory, rot_z
 from zmpwalk.patterns.polynomial import generate
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots import load_robot
 from zmpwalk.robots.model import RobotModel
-from zmpwalk.whole_body import COM_TOLERANCE, IK_CHUNK, imported_legs_in_parts, leg_parts
+from zmpwalk.whole_body import COM_TOLERANCE, IK_CHUNK, LegFill, imported_legs_in_parts, leg_parts
 
 ROBOTS = Path(__file__).resolve().parents[2] / "shared" / "robots"
 MODELS = {"talos": ROBOTS / "pal_talos" / "scene_position.xml", "booster_t1": ROBOTS / "booster_t1" / "scene.xml",
@@ -157,6 +157,16 @@ def test_the_chunks_do_not_change_the_walk(tmp_path: Path, monkeypatch: pytest.M
             assert np.array_equal(fill.angles, first.angles) and np.array_equal(fill.rates, first.velocities)
 
 
+def pattern_leg_fill(pattern: WalkingPattern) -> LegFill:
+    """The legs of ``pattern`` to be filled chunk by chunk."""
+    return LegFill(pattern.time, pattern.position_pelvis_in_world, pattern.yaw_pelvis_in_world,
+                   pattern.velocity_pelvis_in_world, pattern.yaw_rate_pelvis,
+                   ((pattern.position_left_ankle_in_world, pattern.yaw_left_foot_in_world,
+                     pattern.velocity_left_ankle_in_world, pattern.yaw_rate_left_foot),
+                    (pattern.position_right_ankle_in_world, pattern.yaw_right_foot_in_world,
+                     pattern.velocity_right_ankle_in_world, pattern.yaw_rate_right_foot)), pattern.robot)
+
+
 def _rows(pattern: WalkingPattern, n: int) -> WalkingPattern:
     """The first ``n`` samples of ``pattern`` (its fields that are per-sample arrays)."""
     from dataclasses import fields, replace
@@ -196,27 +206,3 @@ def test_a_robot_file_robot_is_not_an_imported_one(hubo: RobotModel) -> None:
     feet = ((empty, np.zeros(1), empty, np.zeros(1)),) * 2
     with pytest.raises(InvalidParameterError, match="an imported robot"):
         next(imported_legs_in_parts(np.zeros(1), empty, np.zeros(1), empty, np.zeros(1), feet, hubo))
-
-
-def test_a_capture_plays_its_legs_as_they_are_filled(tmp_path: Path) -> None:
-    """An imported robot's capture step (control.capture.CaptureMotion with a LegFill) solves its first FILL_HEAD
-    rows before it takes over and the rest as it plays, at most one part a tick, keeping FILL_AHEAD rows ahead;
-    every row it plays is the one the whole joint trajectory has (the fill is the same computation)."""
-    from zmpwalk.control.capture import FILL_AHEAD, FILL_HEAD, CaptureMotion
-
-    robot = robot_of("talos", tmp_path)
-    pattern, trajectory = walk_of(robot)
-    fill = pattern_leg_fill(pattern)
-    while fill.done < FILL_HEAD:
-        fill.advance()
-    joints = JointTrajectory(pattern.time, fill.angles, fill.rates, position_base_in_world=fill.base)
-    motion = CaptureMotion(None, pattern, joints, 100, 500.0, fill)  # type: ignore[arg-type]
-    for tick in range(100, 100 + len(pattern.time)):
-        done = fill.done
-        sample = motion.sample(tick, None)
-        row = tick - 100
-        assert fill.done - done <= IK_CHUNK + 1  # one part at most (the last completes its chunk and the one before)
-        assert fill.done > min(row + FILL_AHEAD, len(pattern.time) - 1) or fill.complete
-        assert np.array_equal(sample.joint_angles, trajectory.angles[row])
-        assert np.array_equal(sample.joint_velocities, trajectory.velocities[row])
-    assert fill.complete

@@ -32,7 +32,7 @@ from zmpwalk.leg_chain.rotations import rot_x, rot_y, rot_z  # re-exported (__al
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sides import Side
 from zmpwalk.slices import Parts, whole
-from zmpwalk.whole_body import COM_TOLERANCE, LegFill, imported_legs_in_parts
+from zmpwalk.whole_body import COM_TOLERANCE, imported_legs_in_parts
 
 Array = NDArray[np.float64]
 
@@ -266,13 +266,6 @@ def pattern_joint_trajectory_in_parts(pattern: SampledMotion, knee_forward: bool
         knee_forward, check_limits)
 
 
-def pattern_leg_fill(pattern: SampledMotion) -> LegFill:
-    """An imported robot's legs for ``pattern``, to be filled chunk by chunk (:class:`~zmpwalk.whole_body.LegFill`:
-    no reach or range check; a capture step plays its rows as they are filled)."""
-    return LegFill(pattern.time, pattern.position_pelvis_in_world, pattern.yaw_pelvis_in_world,
-                   pattern.velocity_pelvis_in_world, pattern.yaw_rate_pelvis, _pattern_feet(pattern), pattern.robot)
-
-
 pattern_joint_trajectory = whole(pattern_joint_trajectory_in_parts, "pattern_joint_trajectory")
 
 
@@ -329,5 +322,5 @@ def rest_mass(robot: RobotModel) -> tuple[float, Array]:
 __all__ = ["COM_TOLERANCE", "JOINT_COLUMNS", "LEG_JOINTS", "JointLimitError", "JointTrajectory",
            "SampledMotion", "check_ik_residuals", "check_joint_limits", "check_leg_reach", "check_sole_roll",
            "hip_positions_in_world", "joint_bounds", "joint_trajectory", "joint_trajectory_in_parts", "leg_chains",
-           "leg_reach_excess", "pattern_joint_trajectory", "pattern_leg_fill", "rest_mass", "rot_x", "rot_y", "rot_z",
+           "leg_reach_excess", "pattern_joint_trajectory", "rest_mass", "rot_x", "rot_y", "rot_z",
            "virtual_columns"]

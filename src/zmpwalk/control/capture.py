@@ -9,9 +9,9 @@ measured DCM can come to rest).
 **Bounded work per tick.** The plan does not run inside the triggering tick: it takes over
 :attr:`CaptureSettings.lead` later (40 ticks at 1 kHz), from the state the walk plays then, and its parts
 (:func:`~zmpwalk.capture.capture_step_parts` and the joints', each at most about 0.2 ms on HUBO; an imported
-robot's legs only their first :data:`FILL_HEAD` samples, the rest a part every few ticks as the capture plays,
-:class:`CaptureMotion`) run over the ticks in between, the parts left (those of the last plan and of one
-more landing tried, :data:`PULL_PARTS`) spread evenly over the ticks left (a count, not a clock: the same walk
+robot's legs :data:`~zmpwalk.whole_body.IK_CHUNK` samples a part, about 25 us) run over the ticks in between,
+the parts left (those of the last plan and of one more landing tried, :data:`PULL_PARTS`) spread evenly over the
+ticks left (a count, not a clock: the same walk
 plans the same way on any machine). That state is known at the trigger: the walker's step under way holds its samples
 (:meth:`~zmpwalk.online.OnlineWalker.peek`), a capture under way its pattern; the DCM there is the plan's plus
 the stabilizer's error predicted over the lead from its own rate (:meth:`CapturePolicy.predicted_dcm_error`: the
@@ -48,13 +48,13 @@ from zmpwalk.balance import BalanceMeasurement, Stabilizer
 from zmpwalk.capture import CAPTURE_INTERVAL, CapturePlan, CaptureSettings, capture_step_parts, capture_wanted
 from zmpwalk.errors import ZmpwalkError
 from zmpwalk.footsteps import Pose2D, Stance
-from zmpwalk.kinematics import JointTrajectory, check_ik_residuals, pattern_joint_trajectory_in_parts, pattern_leg_fill
+from zmpwalk.kinematics import JointTrajectory, pattern_joint_trajectory_in_parts
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sample import WalkingSample
 from zmpwalk.sides import SUPPORT_LABELS
 from zmpwalk.slices import Parts
-from zmpwalk.whole_body import IK_CHUNK, LegFill
+from zmpwalk.whole_body import leg_parts
 
 Array = NDArray[np.float64]
 
@@ -76,9 +76,6 @@ class CaptureMotion:
         joints: Its joint angles and rates.
         first: The controller tick of its first sample.
         rate: Control rate [Hz].
-        fill: An imported robot's legs, filled as the pattern plays (``joints``' arrays: :data:`FILL_AHEAD` rows
-            ahead of the tick, a part of :data:`~zmpwalk.whole_body.IK_CHUNK` samples every few ticks), or None
-            (a robot file's legs, solved whole in the plan's parts).
     """
 
     plan: CapturePlan
@@ -86,7 +83,6 @@ class CaptureMotion:
     joints: JointTrajectory
     first: int
     rate: float  # [Hz]
-    fill: LegFill | None = None
 
     def sample(self, tick: int, standing: WalkingSample | None) -> WalkingSample:
         """The sample of controller tick ``tick``: the pattern's; after its end, a linear blend over
@@ -95,7 +91,6 @@ class CaptureMotion:
         legs' angles differ by as much), or its last sample held where there is none (the walker cannot stand
         there)."""
         i = tick - self.first
-        self._fill_to(min(max(i, 0), len(self.pattern.time) - 1))
         if i < len(self.pattern.time) or standing is None:
             return self._row(min(max(i, 0), len(self.pattern.time) - 1))
         share = min((i - len(self.pattern.time) + 1) / (BLEND * self.rate), 1.0)
@@ -113,27 +108,10 @@ class CaptureMotion:
             joint_velocities=(standing.joint_angles - last.joint_angles) / BLEND if share < 1.0  # type: ignore[operator]
             else np.zeros(12))
 
-    def _fill_to(self, i: int) -> None:
-        """One part of the legs' fill where it is less than :data:`FILL_AHEAD` rows ahead of row ``i``, and as many
-        as row ``i`` needs (none in a walk played tick by tick: the plan filled :data:`FILL_HEAD` rows)."""
-        fill = self.fill
-        if fill is None or fill.complete:
-            return
-        if fill.done <= i + FILL_AHEAD:
-            fill.advance()
-        while fill.done <= i:
-            fill.advance()
-
     def planned(self, tick: int) -> WalkingSample | None:
-        """The pattern's sample of controller tick ``tick``, where the pattern holds it (None after its end; an
-        imported robot's joints None where not filled yet)."""
+        """The pattern's sample of controller tick ``tick``, where the pattern holds it (None after its end)."""
         i = tick - self.first
-        if not 0 <= i < len(self.pattern.time):
-            return None
-        row = self._row(i)
-        if self.fill is not None and i >= self.fill.done:
-            row.joint_angles = row.joint_velocities = None
-        return row
+        return self._row(i) if 0 <= i < len(self.pattern.time) else None
 
     def ended(self, tick: int) -> bool:
         """Whether the pattern has ended by controller tick ``tick`` (the robot at rest on both feet)."""
@@ -169,13 +147,13 @@ class CaptureMotion:
 class _Planning:
     """A capture step being planned: its parts, the tick it takes over at, the single support it was planned in."""
 
-    parts: Parts[tuple[WalkingPattern, CapturePlan, JointTrajectory, LegFill | None]]
+    parts: Parts[tuple[WalkingPattern, CapturePlan, JointTrajectory]]
     first: int  # [ticks]
     support: str
     expected: int  # parts it is paced for
     aim: Array  # [m] (2,) the swinging foot's landing correction the plan starts from
     done: int = 0  # parts run
-    result: tuple[WalkingPattern, CapturePlan, JointTrajectory, LegFill | None] | None = None
+    result: tuple[WalkingPattern, CapturePlan, JointTrajectory] | None = None
 
 
 class CapturePolicy:
@@ -204,7 +182,7 @@ class CapturePolicy:
         self.parts_per_tick = 0
         self._last = -math.inf  # [ticks] of the last trigger or take-over
         self._planning: _Planning | None = None
-        self._expected = EXPECTED_PARTS + (HEAD_PARTS if robot.legs is not None else 0)  # imported legs' head
+        self._expected = EXPECTED_PARTS + leg_parts(robot, math.ceil(REST * self.rate) + 1)  # an imported robot's legs
         self._errors = np.zeros((max(1, round(ERROR_RATE_WINDOW * self.rate)) + 1, 2))  # [m] the last DCM errors
         self._observed = 0
         self._omega = math.sqrt(robot.gravity / robot.pendulum_length)  # [1/s] the pendulum's
@@ -329,10 +307,10 @@ class CapturePolicy:
             self._expected = max(self._expected, job.done)
             return None
         self._last = tick  # the next capture at least CAPTURE_INTERVAL after this one takes over
-        pattern, plan, joints, fill = job.result
+        pattern, plan, joints = job.result
         stabilizer.hand_over_landing(plan.swing, job.aim)  # the correction's moves since the trigger stay its own
         self.captures.append(plan)
-        return CaptureMotion(plan, pattern, joints, tick, self.rate, fill)
+        return CaptureMotion(plan, pattern, joints, tick, self.rate)
 
 
 ERROR_RATE_WINDOW = 0.005  # [s] the DCM error's rate is taken over this (whole ticks, at least one)
@@ -340,9 +318,6 @@ PULL_PARTS = 16  # a plan is paced for this many parts more than the last one to
 NOMINAL_PART = 1e-4  # [s] a part's cost, nominal (HUBO: 10-130 us alone, up to about 0.35 ms inside the loop)
 IN_TICK_SHARE = 0.5  # [-] a whole plan taking this share of the control period or less, nominally, is made in one tick
 EXPECTED_PARTS = 40  # the parts a capture plan is paced for before the first one has been counted
-FILL_HEAD = 3 * IK_CHUNK  # rows of an imported robot's legs solved before its capture takes over
-FILL_AHEAD = IK_CHUNK  # [ticks] the rows solved ahead of the one played, at least
-HEAD_PARTS = -(-(FILL_HEAD + 1) // IK_CHUNK)  # the fill's parts to FILL_HEAD rows (a part completes a chunk less one)
 
 
 def _swing_force(sample: WalkingSample, measurement: BalanceMeasurement) -> float:
@@ -351,24 +326,14 @@ def _swing_force(sample: WalkingSample, measurement: BalanceMeasurement) -> floa
     return float(swing[2])
 
 
-def _with_joints(parts: Parts[tuple[WalkingPattern, CapturePlan]]
-                 ) -> Parts[tuple[WalkingPattern, CapturePlan, JointTrajectory, LegFill | None]]:
-    """A capture step's parts, then its joint angles' (no range check: a capture is taken within reach whatever the
-    joints' soft ranges): a robot file's legs whole (:func:`~zmpwalk.kinematics.pattern_joint_trajectory_in_parts`),
-    an imported robot's first :data:`FILL_HEAD` rows (:func:`~zmpwalk.kinematics.pattern_leg_fill`; the rest as
-    the capture plays, :class:`CaptureMotion`). Every sample of the pattern is within both legs' reach (the plan's
-    own check, hip to ankle with :data:`~zmpwalk.capture.REACH_MARGIN` to spare); a sample of the solved rows the
-    legs' IK does not meet raises :class:`~zmpwalk.errors.UnreachableError` (the plan is dropped), one of the rows
-    solved as the capture plays keeps its angles (its residual in ``fill.excess``)."""
+def _with_joints(parts: Parts[tuple[WalkingPattern, CapturePlan]]) -> Parts[tuple[WalkingPattern, CapturePlan,
+                                                                                   JointTrajectory]]:
+    """A capture step's parts, then its joint angles' (:func:`~zmpwalk.kinematics.pattern_joint_trajectory_in_parts`,
+    no range check: a capture is taken within reach whatever the joints' soft ranges). Every sample's legs are
+    solved before the capture takes over: a sample they cannot reach drops the plan (an imported robot's base is not
+    the pattern's point, so the plan's own reach check, hip to ankle from that point, does not settle it: TALOS
+    pushed 68 N s sideways re-planned a capture whose left ankle its IK left 32 mm short for 0.5 s)."""
     pattern, plan = yield from parts
     yield
-    if pattern.robot.legs is None:
-        joints = yield from pattern_joint_trajectory_in_parts(pattern, check_limits=False)
-        return pattern, plan, joints, None
-    fill = pattern_leg_fill(pattern)
-    while fill.done < min(FILL_HEAD, len(pattern.time)):
-        yield
-        fill.advance()
-    check_ik_residuals(fill.excess[:, :fill.done], pattern.time[:fill.done], "capture step")
-    joints = JointTrajectory(pattern.time, fill.angles, fill.rates, position_base_in_world=fill.base)
-    return pattern, plan, joints, fill
+    joints = yield from pattern_joint_trajectory_in_parts(pattern, check_limits=False)
+    return pattern, plan, joints
