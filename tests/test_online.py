@@ -329,6 +329,43 @@ def test_commands_checked_in_parts_walk_the_batch_pattern(hubo, rate, generator,
     np.testing.assert_allclose([s.joint_velocities for s in samples], joints.velocities, atol=1e-9, rtol=0)
 
 
+@pytest.mark.slow
+def test_an_imported_robots_commands_checked_in_parts_walk_the_batch_pattern(monkeypatch):
+    """An imported robot (TALOS): its check evaluates the pattern in blocks and fills the legs once over each step
+    (zmpwalk.whole_body, chunk by chunk from each plan's first sample): the batch pattern's positions sample for
+    sample, and its joints within the IK's tolerances (each plan's legs start from the ready posture, the batch's
+    from its first sample: the same solution to 1e-8 rad; the rates to 1e-5 rad/s but where a plan's rows meet the
+    next's and at the walk's end: there the base's velocity takes its offset's derivative one-sided, within a plan,
+    at most 1e-3 rad/s off, two samples each)."""
+    from pathlib import Path
+
+    from zmpwalk.kinematics import pattern_joint_trajectory
+    from zmpwalk.online import work_budget
+    from zmpwalk.robots import load_robot
+
+    model = Path(__file__).resolve().parents[2] / "shared" / "robots" / "pal_talos" / "scene_position.xml"
+    if not model.is_file():
+        pytest.skip(f"{model} is absent")
+    robot, rate = load_robot(model), 500.0
+    counting_clock(monkeypatch, work_budget(rate) / 5)
+    commands = [StepCommand(0.9, 0.1), StepCommand(0.9, 0.05, turn=0.15), StepCommand(0.9, side=0.05),
+                StepCommand(0.9, 0.1)]
+    pattern = generate(robot, commands, rate=rate)
+    joints = pattern_joint_trajectory(pattern)
+    walker = OnlineWalker(robot, rate=rate, joints=True, generator="polynomial")
+    walker.command(commands[0], wait=True)
+    pending, samples = commands[1:], []
+    for _ in range(len(pattern.time)):
+        if pending and walker.queued is None and walker.checking is None:
+            walker.command(pending.pop(0))
+        samples.append(walker.tick())
+    assert not pending and walker.rejection is None and not walker.walking
+    np.testing.assert_allclose([_rows(s) for s in samples], _pattern_rows(pattern), atol=TOL, rtol=0)
+    np.testing.assert_allclose([s.joint_angles for s in samples], joints.angles, atol=1e-8, rtol=0)
+    rates = np.abs(np.array([s.joint_velocities for s in samples]) - joints.velocities)
+    assert rates.max() < 1e-3 and (rates > 1e-5).any(axis=1).sum() <= 2 * (len(commands) + 1)  # [rad/s]
+
+
 @pytest.mark.parametrize("rate", [100.0, 1000.0])
 def test_a_command_given_as_the_step_before_starts_is_checked_before_its_own_step(hubo, rate, monkeypatch):
     """A command given as the step before it starts, or from standstill, is checked before its step begins,
