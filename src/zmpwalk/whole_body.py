@@ -66,7 +66,7 @@ def _arrays(robot: RobotModel) -> _Arrays:
 class LegFill:
     r"""An imported robot's base and legs for a pattern that moves its whole-body CoM, filled chunk by chunk:
     :meth:`advance` solves the next :data:`IK_CHUNK` samples' base and angles and the chunk before's rates, so that
-    rows ``[0, done)`` are complete (a capture step plays its rows as they are filled).
+    rows ``[0, done)`` are complete.
 
     Args:
         time: [s], (n,).
