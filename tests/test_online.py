@@ -316,17 +316,25 @@ def test_commands_checked_in_parts_walk_the_batch_pattern(hubo, rate, generator,
                 StepCommand(0.95, -0.1), StepCommand(0.8, 0.15)]
     pattern = (generate if generator == "polynomial" else generate_hyperbolic)(hubo, commands, rate=rate)
     joints = pattern_joint_trajectory(pattern)
-    walker = OnlineWalker(hubo, rate=rate, joints=True, generator=generator)
+    samples = _walked_in_parts(OnlineWalker(hubo, rate=rate, joints=True, generator=generator), commands,
+                               len(pattern.time))
+    np.testing.assert_allclose([_rows(s) for s in samples], _pattern_rows(pattern), atol=TOL, rtol=0)
+    np.testing.assert_allclose([s.joint_angles for s in samples], joints.angles, atol=1e-9, rtol=0)
+    np.testing.assert_allclose([s.joint_velocities for s in samples], joints.velocities, atol=1e-9, rtol=0)
+
+
+def _walked_in_parts(walker, commands, ticks):
+    """``ticks`` samples of ``walker`` given the first command with wait (the walk starts at once, as the batch
+    walk does), every other with command() once the one before is under way (checked in parts over the ticks);
+    every command walked, none refused."""
     walker.command(commands[0], wait=True)
-    pending, samples = commands[1:], []
-    for _ in range(len(pattern.time)):
+    pending, samples = list(commands[1:]), []
+    for _ in range(ticks):
         if pending and walker.queued is None and walker.checking is None:
             walker.command(pending.pop(0))
         samples.append(walker.tick())
     assert not pending and walker.rejection is None and not walker.walking
-    np.testing.assert_allclose([_rows(s) for s in samples], _pattern_rows(pattern), atol=TOL, rtol=0)
-    np.testing.assert_allclose([s.joint_angles for s in samples], joints.angles, atol=1e-9, rtol=0)
-    np.testing.assert_allclose([s.joint_velocities for s in samples], joints.velocities, atol=1e-9, rtol=0)
+    return samples
 
 
 @pytest.mark.slow
@@ -352,14 +360,8 @@ def test_an_imported_robots_commands_checked_in_parts_walk_the_batch_pattern(mon
                 StepCommand(0.9, 0.1)]
     pattern = generate(robot, commands, rate=rate)
     joints = pattern_joint_trajectory(pattern)
-    walker = OnlineWalker(robot, rate=rate, joints=True, generator="polynomial")
-    walker.command(commands[0], wait=True)
-    pending, samples = commands[1:], []
-    for _ in range(len(pattern.time)):
-        if pending and walker.queued is None and walker.checking is None:
-            walker.command(pending.pop(0))
-        samples.append(walker.tick())
-    assert not pending and walker.rejection is None and not walker.walking
+    samples = _walked_in_parts(OnlineWalker(robot, rate=rate, joints=True, generator="polynomial"), commands,
+                               len(pattern.time))
     np.testing.assert_allclose([_rows(s) for s in samples], _pattern_rows(pattern), atol=TOL, rtol=0)
     np.testing.assert_allclose([s.joint_angles for s in samples], joints.angles, atol=1e-8, rtol=0)
     rates = np.abs(np.array([s.joint_velocities for s in samples]) - joints.velocities)
