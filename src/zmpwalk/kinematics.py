@@ -183,7 +183,8 @@ def joint_trajectory_in_parts(
         base, angles, velocities, excess = yield from imported_legs_in_parts(
             time, position_pelvis_in_world, yaw_pelvis_in_world, velocity_pelvis_in_world, yaw_rate_pelvis, feet,
             robot)
-        check_ik_residuals(excess, time, "inverse kinematics")
+        for index, side in enumerate(Side):
+            _check_reach(excess[index], time, side.label, "inverse kinematics")
     if check_limits:  # the joint ranges: parts of their own, each half of the samples (the first sample out
         half = (n + 1) // 2  # of range is the first of the first half that has one, else of the second)
         yield
@@ -227,24 +228,17 @@ def _closed_form_legs_in_parts(
     return rows_angles.T, rows_rates.T
 
 
-def check_ik_residuals(excess: Array, time: Array, detail: str) -> None:
-    """Raise for the first leg whose inverse kinematics did not converge (``excess`` (2, n) [m] or [rad], > 0 or NaN
-    there: :class:`~zmpwalk.whole_body.LegFill`'s) at samples ``time`` [s].
+def _check_reach(excess: Array, time: Array, label: str, detail: str) -> None:
+    """Raise where a leg's IK did not meet its target: ``excess`` (n,) [m] (or [rad]) > 0, or NaN (a sample that is
+    not finite), at samples ``time`` [s].
 
     Raises:
-        UnreachableError: Names the leg, the first such time and the largest residual; ``detail`` says where.
+        UnreachableError: Names the leg (``label``), the first such time and the largest excess.
     """
-    for index, side in enumerate(Side):
-        failed = ~(excess[index] <= 0.0)  # NaN too (a sample that is not finite)
-        if failed.any():
-            first = int(np.argmax(failed))
-            raise UnreachableError(side.label, float(time[first]), float(np.max(excess[index][failed])), detail)
-
-
-def _check_reach(excess: Array, time: Array, label: str, detail: str) -> None:
-    if np.any(excess > 0):
-        first = int(np.argmax(excess > 0))
-        raise UnreachableError(label, float(time[first]), float(excess.max()), detail)
+    failed = ~(excess <= 0.0)
+    if failed.any():
+        first = int(np.argmax(failed))
+        raise UnreachableError(label, float(time[first]), float(np.max(excess[failed])), detail)
 
 
 def _pattern_feet(pattern: SampledMotion) -> tuple[tuple[Array, Array, Array, Array], tuple[Array, Array, Array,
@@ -320,7 +314,7 @@ def rest_mass(robot: RobotModel) -> tuple[float, Array]:
 
 
 __all__ = ["COM_TOLERANCE", "JOINT_COLUMNS", "LEG_JOINTS", "JointLimitError", "JointTrajectory",
-           "SampledMotion", "check_ik_residuals", "check_joint_limits", "check_leg_reach", "check_sole_roll",
+           "SampledMotion", "check_joint_limits", "check_leg_reach", "check_sole_roll",
            "hip_positions_in_world", "joint_bounds", "joint_trajectory", "joint_trajectory_in_parts", "leg_chains",
            "leg_reach_excess", "pattern_joint_trajectory", "rest_mass", "rot_x", "rot_y", "rot_z",
            "virtual_columns"]
