@@ -68,7 +68,7 @@ def test_the_cop_criterion_skips_each_touchdown_the_first_sample_included() -> N
     import numpy as np
 
     from zmpwalk.robots import load_robot
-    from zmpwalk.sim.verdict import TOUCHDOWN_WINDOW, cop_margin_outside_touchdowns
+    from zmpwalk.sim.verdict import TOUCHDOWN_WINDOW, cop_inside, cop_margin_outside_touchdowns
 
     robot = load_robot("hubo")
     time = np.arange(0.0, 1.0, 0.001)
@@ -78,12 +78,21 @@ def test_the_cop_criterion_skips_each_touchdown_the_first_sample_included() -> N
     right[400:600] = 0.0  # the right foot swings from 0.4 to 0.6 s and lands again
     margin = np.full(len(time), 0.02)
     margin[:10] = -0.010  # placed on a tilted floor: 10 ms beyond a sole edge
-    result = types.SimpleNamespace(robot=robot, time=time, force_left=left, force_right=right, cop_margin=margin)
+    result = types.SimpleNamespace(robot=robot, time=time, force_left=left, force_right=right, cop_margin=margin,
+                                   fell=False)
     assert cop_margin_outside_touchdowns(result) == pytest.approx(0.02, abs=1e-12)  # type: ignore[arg-type]
     margin[600 + round(TOUCHDOWN_WINDOW / 0.001) + 5] = -0.007  # after the landing's window: judged
     assert cop_margin_outside_touchdowns(result) == pytest.approx(-0.007, abs=1e-12)  # type: ignore[arg-type]
     margin[600 + 3] = -0.030  # inside it: not judged
     assert cop_margin_outside_touchdowns(result) == pytest.approx(-0.007, abs=1e-12)  # type: ignore[arg-type]
+    result.fell = False
+    assert not cop_inside(result).passed and cop_inside(result).note == ""  # type: ignore[arg-type]  # -7 mm
+    margin[600 + round(TOUCHDOWN_WINDOW / 0.001) + 5] = -0.003  # within the -5 mm limit
+    assert cop_inside(result).passed and cop_inside(result).note == ""  # type: ignore[arg-type]
+    result.fell = True  # within the limit, failed by the fall, and it says so
+    fallen = cop_inside(result)  # type: ignore[arg-type]
+    assert not fallen.passed and fallen.figure == pytest.approx(-0.003, abs=1e-12)
+    assert fallen.text() == "-3.0 mm (limit: at least -5.0 mm); fails with the fall: measured until it"
 
 
 def test_a_touchdown_starts_at_first_contact_not_when_the_sole_becomes_loaded() -> None:
@@ -110,7 +119,8 @@ def test_a_touchdown_starts_at_first_contact_not_when_the_sole_becomes_loaded() 
     left[touch + 1:] = weight / 2
     margin = np.full(len(time), 0.02)
     margin[touch] = -0.030
-    result = types.SimpleNamespace(robot=robot, time=time, force_left=left, force_right=right, cop_margin=margin)
+    result = types.SimpleNamespace(robot=robot, time=time, force_left=left, force_right=right, cop_margin=margin,
+                                   fell=False)
     assert cop_margin_outside_touchdowns(result) == pytest.approx(0.02, abs=1e-12)  # type: ignore[arg-type]
     margin[touch - 1] = -0.030  # before the contact: judged
     assert cop_margin_outside_touchdowns(result) == pytest.approx(-0.030, abs=1e-12)  # type: ignore[arg-type]

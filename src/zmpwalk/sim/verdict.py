@@ -214,13 +214,20 @@ def walk_verdict(result: SimulationResult, hold: float, motors: Sequence[Motor] 
                   not fell and result.final_feet_yaw_error <= FEET_YAW, "largest yaw error of a final foot",
                   "at most"),
     ]
-    margin = cop_margin_outside_touchdowns(result)
-    criteria.append(Criterion("CoP inside the loaded soles", margin, COP_MARGIN, "m",
-                              not fell and margin >= COP_MARGIN,
-                              f"least CoP margin (positive inside) of the sensors' CoP, the "
-                              f"{TOUCHDOWN_WINDOW * 1e3:g} ms after each touchdown not judged"))
+    criteria.append(cop_inside(result))
     criteria += [_plan_zmp(result), actuator_criterion(rows, fits)]
     return Verdict(tuple(criteria), tuple(walk_warnings(rows, fits)))
+
+
+def cop_inside(result: SimulationResult) -> Criterion:
+    """The measured CoP's least margin inside the loaded soles (:func:`cop_margin_outside_touchdowns`); a walk that
+    fell fails it, and a margin within its limit then says that the fall failed it."""
+    margin = cop_margin_outside_touchdowns(result)
+    within = margin >= COP_MARGIN
+    return Criterion("CoP inside the loaded soles", margin, COP_MARGIN, "m", not result.fell and within,
+                     f"least CoP margin (positive inside) of the sensors' CoP, the {TOUCHDOWN_WINDOW * 1e3:g} ms "
+                     "after each touchdown not judged",
+                     note="fails with the fall: measured until it" if result.fell and within else "")
 
 
 def _no_fall(result: SimulationResult) -> Criterion:
