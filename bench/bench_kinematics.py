@@ -1,6 +1,8 @@
-"""Speed of the leg IK: closed form (scalar and vectorised) against a numerical IK; tick() with joints.
+"""Speed of the leg IK: closed form (scalar and vectorised) against a numerical IK; tick() with joints; an
+imported robot's legs (the compiled whole-body IK), sample by sample and in a walker's check.
 
-Run: python bench/bench_kinematics.py. Prints figures; asserts nothing.
+Run: python bench/bench_kinematics.py [--only imported]. Prints figures; asserts nothing. The imported robots
+need ../shared/robots (those absent are skipped).
 
 The vectorised figures allocate tens of megabytes per call. Whether glibc serves those from fresh pages (a page
 fault per 4 kB) or from its heap depends on what the process allocated and freed before (its dynamic mmap
@@ -10,15 +12,17 @@ threshold first, so that the figures measure the IK, not the allocator's history
 
 from __future__ import annotations
 
+import argparse
 import ctypes
 import ctypes.util
 import statistics
 import time
+from pathlib import Path
 
 import numpy as np
 from scipy.optimize import least_squares
 
-from zmpwalk import StepCommand, load_robot
+from zmpwalk import StepCommand, generate, load_robot, pattern_joint_trajectory
 from zmpwalk.kinematics import leg_chains
 from zmpwalk.leg_chain import LegChain
 from zmpwalk.online import OnlineWalker
@@ -45,7 +49,48 @@ def steady_allocator() -> None:
         ctypes.CDLL(name).mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD)
 
 
+ROBOTS = Path(__file__).resolve().parents[2] / "shared" / "robots"
+IMPORTED = {"TALOS": ROBOTS / "pal_talos" / "scene_position.xml", "Booster T1": ROBOTS / "booster_t1" / "scene.xml",
+            "Fourier N1": ROBOTS / "fourier_n1" / "scene.xml"}
+
+
+def imported_legs() -> None:
+    """Per imported robot: its legs over a 10 x 10 cm walk at 0.8 s, 1 kHz (``pattern_joint_trajectory``: the base
+    under the CoM, the angles and rates, the ranges), best of 5; and a 1 kHz walker's check of a 1 s step and its
+    stop while walking (``command(step, wait=True)``), median of 7. This thread's CPU time."""
+    for name, path in IMPORTED.items():
+        if not path.exists():
+            print(f"{name}: {path} absent, skipped")
+            continue
+        robot = load_robot(path)
+        pattern = generate(robot, [StepCommand(duration=0.8, forward=0.1)] * 10, rate=1000.0)
+        runs = []
+        for _ in range(6):
+            start = time.thread_time()
+            pattern_joint_trajectory(pattern)
+            runs.append(time.thread_time() - start)
+        per_sample = min(runs[1:]) / len(pattern.time)
+        walker = OnlineWalker(robot, rate=1000.0, joints=True)
+        walker.command(StepCommand(duration=1.0, forward=0.05), wait=True)
+        checks = []
+        for i in range(7):
+            for _ in range(300):
+                walker.tick()
+            start = time.thread_time()
+            walker.command(StepCommand(duration=1.0, forward=0.05 + 0.005 * (i % 2)), wait=True)
+            checks.append(time.thread_time() - start)
+            while walker.queued is not None:
+                walker.tick()
+        print(f"{name}: legs {per_sample * 1e6:.2f} us a sample ({len(pattern.time)} samples); a walking check "
+              f"(1 s step and its stop, 1 kHz, joints): median {statistics.median(checks) * 1e3:.1f} ms")
+
+
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
+    parser.add_argument("--only", choices=["imported"], help="only the imported robots' legs")
+    if parser.parse_args().only == "imported":
+        imported_legs()
+        return
     steady_allocator()
     robot = load_robot("hubo")
     chain = leg_chains(robot)[0]
@@ -95,6 +140,7 @@ def main() -> None:
         us = np.array(durations) / 1e3
         print(f"OnlineWalker.tick() with joints at {rate:.0f} Hz: median {np.median(us):.2f} us, "
               f"p99 {np.percentile(us, 99):.2f} us")
+    imported_legs()
 
 
 if __name__ == "__main__":
