@@ -321,3 +321,30 @@ def test_a_position_servo_s_control_range_does_not_clip_its_feedforward(tmp_path
     data.ctrl[ankle] = q + 2.0  # 40 N m wanted: the force range holds it at 30
     mujoco.mj_forward(model, data)
     assert abs(data.actuator_force[ankle]) == pytest.approx(30.0, abs=1e-9)
+
+
+def test_a_position_servo_is_held_at_the_reference_angle_whatever_the_keyframe_controls(tmp_path: Path) -> None:
+    """A position servo's control is the angle it holds (times its gear): the other servos hold the keyframe's
+    pose even where the keyframe gives no controls (MuJoCo then reads 0) or gives them in another order."""
+    legs = "".join(f'<position name="{s}_{j}_p" joint="{s}_{j}" kp="300" kv="5"/>'
+                   for s in ("l", "r") for j in ("hy", "hr", "hp", "kn", "ap", "ar"))
+    arm = '<position name="shoulder_p" joint="shoulder" kp="20" kv="1" gear="2"/>'
+    no_controls = motor_biped(arm + legs, knee_limit="")
+    shuffled = no_controls.replace(f'qpos="0 0 0.8 1 0 0 0 {ARM_KEY}{" 0" * 12}"/>',
+                                   f'qpos="0 0 0.8 1 0 0 0 {ARM_KEY}{" 0" * 12}" ctrl="{" 0" * 12} {ARM_KEY}"/>')
+    assert shuffled != no_controls  # the arm's angle given to the last actuator, a leg's
+    for name, text in (("bare.xml", no_controls), ("shuffled.xml", shuffled)):
+        plant = build_plant(load_robot(write(tmp_path, name, text)))
+        model, data = plant.model, mujoco.MjData(plant.model)
+        shoulder = model.actuator("shoulder_p").id
+        assert plant.ctrl_hold[shoulder] == pytest.approx(2 * ARM_KEY, abs=1e-12)  # gear x angle [rad]
+        data.qpos[:] = plant.qpos_hold
+        data.ctrl[:] = plant.ctrl_hold
+        base = model.body("base").id
+        model.body_gravcomp[base] = 1.0  # the base hangs still: the arm alone
+        for _ in range(500):
+            data.qvel[:6] = 0.0
+            data.qpos[:7] = plant.qpos_hold[:7]
+            mujoco.mj_step(model, data)
+        # its weight (1 kg, 0.15 m, 1.2 rad: 1.37 N m) on gear^2 kp = 80 N m/rad sags it 17 mrad, not 1.2 rad
+        assert data.qpos[model.joint("shoulder").qposadr[0]] == pytest.approx(ARM_KEY, abs=0.03)

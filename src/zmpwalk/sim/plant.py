@@ -247,13 +247,20 @@ def add_pd_layer(spec: mujoco.MjSpec, plant: ModelPlant) -> None:
 
 
 def _held_controls(model: mujoco.MjModel, plant: ModelPlant) -> Array:
-    """Controls (nu,) that hold the reference pose: the keyframe's, and for a joint of the PD layer its reference
-    angle (a motor's keyframe control is a torque; the actuators the layer adds come after the model's)."""
+    """Controls (nu,) that hold the reference pose: a position servo's on a joint, the reference angle times its gear
+    (its control is the angle it holds: a keyframe without controls, or with them in another order than the
+    actuators', holds the pose all the same); for a joint of the PD layer its reference angle (a motor's keyframe
+    control is a torque; the actuators the layer adds come after the model's); any other actuator's, the keyframe's
+    control."""
     controls = np.zeros(model.nu)
     controls[:len(plant.ctrl_reference)] = plant.ctrl_reference
-    for joint, actuator in plant.pd_joints:
+    for actuator in range(len(plant.ctrl_reference)):
+        if is_position_servo(model, actuator):
+            address = model.jnt_qposadr[model.actuator_trnid[actuator][0]]
+            controls[actuator] = model.actuator_gear[actuator][0] * plant.qpos_reference[address]
+    for joint, pd in plant.pd_joints:
         address = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint)]
-        controls[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, actuator.name)] = plant.qpos_reference[address]
+        controls[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, pd.name)] = plant.qpos_reference[address]
     return controls
 
 
