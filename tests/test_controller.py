@@ -398,3 +398,28 @@ def test_a_budget_clock_that_is_not_callable_is_refused(hubo):
         OnlineWalker(hubo, RATE, clock=0.001)  # type: ignore[arg-type]
     with pytest.raises(InvalidParameterError, match="clock"):
         WalkingController(hubo, RATE, clock="perf_counter")  # type: ignore[arg-type]
+
+
+def test_the_controller_s_budget_is_the_walker_s(hubo):
+    """``WalkingController(budget=...)`` gives the walker's check that much of each tick: on a clock that counts
+    (one reading 10 us, one before a tick's parts and one after each), 50 us run 4 parts a tick and 150 us 14, so
+    a check given three times the budget ends in 1/3.5 of the ticks."""
+    from zmpwalk.online import work_budget
+    from zmpwalk.slices import CountingClock
+
+    ticks = {}
+    for budget in (None, 3 * work_budget(RATE)):
+        controller = WalkingController(hubo, RATE, balance=False, clock=CountingClock(10e-6), budget=budget)
+        assert controller.walker.budget == pytest.approx(budget or work_budget(RATE), rel=1e-12)
+        plant = MockPlant(hubo, RATE)
+        controller.command(StepCommand(0.8, 0.1))
+        count = 0
+        while controller.walker.checking is not None:
+            plant.apply(controller.update(plant.measure()))
+            count += 1
+        ticks[budget] = count
+    default, larger = ticks.values()
+    assert default > 100  # [ticks] a check of some hundred parts, a few a tick
+    assert 3.0 < default / larger < 4.5  # measured 146 and 38 ticks: 3.8
+    with pytest.raises(InvalidParameterError, match="budget"):
+        WalkingController(hubo, RATE, budget=0.002)  # [s] beyond the 1 ms period

@@ -203,6 +203,11 @@ class OnlineWalker:
         return self._index / self.rate
 
     @property
+    def budget(self) -> float:
+        """The time [s] a tick may spend on a command's check (the ``budget`` argument)."""
+        return self._budget
+
+    @property
     def walking(self) -> bool:
         """True while a walk is under way or queued (False: standing still)."""
         return self._current is not None or self._pending is not None

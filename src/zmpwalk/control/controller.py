@@ -144,10 +144,15 @@ class WalkingController:
             then stands where it left the feet); None: none.
         clock: The walker's budget clock (:class:`~zmpwalk.online.OnlineWalker`): None, the machine's; the
             simulator gives one that counts parts (:func:`zmpwalk.sim.loop.simulated_clock`).
+        budget: The time [s] a tick may spend on a command's check, the tick's own work (stabilizer, feedforward)
+            included (:class:`~zmpwalk.online.OnlineWalker`'s ``budget``; None: :func:`~zmpwalk.online.work_budget`,
+            50 us at 1 kHz). An imported robot's checks at 1 kHz need about 100 us to keep up with commands given
+            half a step ahead on a machine like this one (docs/speed.md).
 
     Raises:
         InvalidParameterError: As :class:`~zmpwalk.online.OnlineWalker` and :class:`~zmpwalk.balance.Stabilizer`
-            (a rate outside [10, 10000] Hz, an unknown generator or pelvis), or ``capture`` without the
+            (a rate outside [10, 10000] Hz, an unknown generator or pelvis, a budget not within the control
+            period), or ``capture`` without the
             stabilizer (its DCM estimate triggers a capture).
 
     Attributes:
@@ -161,7 +166,8 @@ class WalkingController:
     def __init__(self, robot: RobotModel, rate: float = 1000.0, *, schedule: Schedule | None = None,
                  generator: str | None = None, pelvis: str = "cubic", balance: bool = True,
                  gains: StabilizerGains | None = None, feedforward: Feedforward | None = None,
-                 capture: CaptureSettings | None = None, clock: Callable[[], float] | None = None) -> None:
+                 capture: CaptureSettings | None = None, clock: Callable[[], float] | None = None,
+                 budget: float | None = None) -> None:
         if capture is not None and not isinstance(capture, CaptureSettings):
             raise InvalidParameterError("capture", capture, "a CaptureSettings, or None")
         if capture is not None and not balance:
@@ -170,7 +176,7 @@ class WalkingController:
         self.robot = robot
         self.schedule = schedule or Schedule.hubo()
         self.walker = OnlineWalker(robot, rate, self.schedule, joints=True, pelvis=pelvis, generator=generator,
-                                   clock=clock)
+                                   clock=clock, budget=budget)
         self.rate = self.walker.rate
         self.stabilizer = Stabilizer(robot, rate, gains) if balance else None
         self.feedforward = feedforward
