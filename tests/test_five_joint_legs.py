@@ -279,3 +279,25 @@ def test_the_feedforward_of_a_five_joint_robot_reads_its_real_columns() -> None:
     given = feedforward.torques(sample)
     assert given.shape == (12,) and np.all(np.isfinite(given))
     assert given == pytest.approx(held, abs=1e-9)  # [N m] the same pose either way
+
+
+def test_the_least_sway_of_a_walk_without_double_support() -> None:
+    """The derivation behind docs/robot-import.md's bound on H1's step time: a periodic walk of the linear inverted
+    pendulum whose ZMP switches every ``T`` between sole centres ``+-a`` (no double support) has its CoM on
+    ``x(t) = a - a cosh(w (t - T/2)) / cosh(w T/2)`` about the stance sole at ``+a``, so its sway from the mid-line
+    is at least ``a (1 - 1 / cosh(w T / 2))``. Checked by integrating the pendulum from that orbit's start."""
+    a, length, gravity = 0.4057 / 2, 0.9512, 9.81  # [m] H1's ankles' half distance, its CoM's height
+    omega = math.sqrt(gravity / length)
+    for period in (0.34, 0.5, 0.8):  # [s]
+        x, v = 0.0, a * omega * math.tanh(omega * period / 2)  # the orbit at the switch: mid-line, towards +a
+        dt, far = 1e-5, 0.0
+        for _ in range(round(period / dt)):  # semi-implicit Euler of x'' = w^2 (x - a)
+            v += omega ** 2 * (x - a) * dt
+            x += v * dt
+            far = max(far, x)
+        assert abs(x) < 1e-4 and v == pytest.approx(-a * omega * math.tanh(omega * period / 2), rel=1e-3)  # periodic
+        assert far == pytest.approx(a * (1 - 1 / math.cosh(omega * period / 2)), abs=1e-5)  # [m]
+    sway = a * (1 - 1 / math.cosh(omega * 0.8 / 2))
+    assert sway == pytest.approx(0.0986, abs=1e-4)  # [m] at 0.8 s: a sole roll of 0.121 rad over the 0.817 m leg
+    shortest = 2 / omega * math.acosh(1 / (1 - sole_roll_bound(0.06) * 0.8168 / a))  # [s] the bound's step time
+    assert shortest == pytest.approx(0.342, abs=1e-3)
