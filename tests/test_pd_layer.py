@@ -348,3 +348,38 @@ def test_a_position_servo_is_held_at_the_reference_angle_whatever_the_keyframe_c
             mujoco.mj_step(model, data)
         # its weight (1 kg, 0.15 m, 1.2 rad: 1.37 N m) on gear^2 kp = 80 N m/rad sags it 17 mrad, not 1.2 rad
         assert data.qpos[model.joint("shoulder").qposadr[0]] == pytest.approx(ARM_KEY, abs=0.03)
+
+
+def test_the_feedforward_carries_the_joints_own_damping_and_friction(tmp_path: Path) -> None:
+    """A joint's ``damping`` b and ``frictionloss`` f in the model take ``b q' + f tanh(q' / v_f)`` from a motion at
+    ``q'``: the per-tick feedforward adds it to the inverse dynamics (Apptronik Apollo's legs: 11-171 N m s/rad,
+    0.9-21 N m), so a swinging leg is not held back by the joints it moves."""
+    from zmpwalk.online import WalkingSample
+    from zmpwalk.sim.mujoco_plant import ModelFeedforward
+    from zmpwalk.sim.plant import FRICTION_RATE, passive_torques
+
+    servos = "".join(f'<position name="{s}_{j}_p" joint="{s}_{j}" kp="300" kv="5"/>'
+                     for s in ("l", "r") for j in ("hy", "hr", "hp", "kn", "ap", "ar"))
+    plain = motor_biped(servos, knee_limit="")
+    lossy = plain.replace('damping="0.1"/>', 'damping="2.0" frictionloss="3.0"/>', 1)
+    assert lossy != plain
+    rates = np.array([0.0, 0.0, 0.5, 1.0, -0.5, 0.01] * 2)  # [rad/s] the legs' planned rates, column order
+    torques = {}
+    for name, text in (("plain", plain), ("lossy", lossy)):
+        robot = load_robot(write(tmp_path, f"{name}.xml", text))
+        plant = build_plant(robot)
+        assert robot.legs is not None
+        angles = np.concatenate([chain.reference[list(chain.role_order)] for chain in robot.legs])
+        half = robot.hip_spacing / 2
+        sample = WalkingSample(0.0, "double", np.array([0.0, 0.0, robot.pelvis_height]), 0.0,
+                               np.array([0.0, half, robot.ankle_height]), 0.0,
+                               np.array([0.0, -half, robot.ankle_height]), 0.0, np.zeros(2))
+        sample.joint_angles, sample.joint_velocities = angles, rates
+        torques[name] = ModelFeedforward(plant, 1000.0).torques(sample)
+    expected = (2.0 - 0.1) * rates + 3.0 * np.tanh(rates / FRICTION_RATE)  # [N m] (plain: damping 0.1, no friction)
+    assert torques["lossy"] - torques["plain"] == pytest.approx(expected, abs=1e-9)
+    assert 3.0 * np.tanh(0.01 / FRICTION_RATE) == pytest.approx(0.592, abs=1e-3)  # near rest it fades
+    model = mujoco.MjModel.from_xml_string(lossy)
+    qvel = np.linspace(-1.0, 1.0, model.nv)
+    assert passive_torques(model, qvel) == pytest.approx(
+        model.dof_damping * qvel + model.dof_frictionloss * np.tanh(qvel / FRICTION_RATE), abs=1e-15)

@@ -27,7 +27,7 @@ from zmpwalk.sample import WalkingSample
 from zmpwalk.sim.disturbances import NOSLIP_ITERATIONS, SensorNoise
 from zmpwalk.sim.mjcf import contact_mapping
 from zmpwalk.sim.plant import Plant as SimPlant
-from zmpwalk.sim.plant import build_plant, set_initial_state, static_feedforward
+from zmpwalk.sim.plant import build_plant, passive_torques, set_initial_state, static_feedforward
 from zmpwalk.sim.ranges import check_range
 from zmpwalk.sim.run import FALL_HEIGHT_FRACTION, FALL_TILT, Disturbances, _MeasurementReader
 from zmpwalk.sim.soles import SensorSlices
@@ -74,8 +74,9 @@ class ModelFeedforward:
     """The joint torques of each tick's planned motion by inverse dynamics of a MuJoCo model (a
     :class:`~zmpwalk.control.controller.Feedforward`).
 
-    As :func:`zmpwalk.sim.plant.static_feedforward` for a whole pattern, ``tau = M(q) q'' + C(q, q') + g(q) -
-    sum_feet J^T w``, for one sample: ``q`` its pose (the base upright at the pelvis yaw), ``q'`` the base's rate by
+    As :func:`zmpwalk.sim.plant.static_feedforward` for a whole pattern, ``tau = M(q) q'' + C(q, q') + g(q) +
+    tau_passive(q') - sum_feet J^T w``, for one sample (:func:`~zmpwalk.sim.plant.passive_torques`: the joints' own
+    damping and friction in the model): ``q`` its pose (the base upright at the pelvis yaw), ``q'`` the base's rate by
     a backward difference over one tick and the legs' planned rates, ``q''`` their backward difference; ``w`` the
     ground wrench ``m (c'' + g)`` at the planned ZMP, ``c'' = (g / z_c)(c - p)`` of the model's CoM, on the stance
     sole, split by the ZMP's place between the soles in double support. Bounded work per tick: one forward
@@ -107,6 +108,7 @@ class ModelFeedforward:
         self._previous_qpos: Array | None = None
         self._qvel, self._previous_qvel = np.zeros(model.nv), np.zeros(model.nv)
         self._tau = np.zeros(model.nv)
+        self._passive = bool(model.dof_damping.any() or model.dof_frictionloss.any())
         self._feet = tuple(int(model.site_bodyid[site]) for site in self._sites)  # the ankle sites' bodies
         self._reaction, self._force, self._point = np.zeros(model.nv), np.zeros(3), np.zeros(3)
         self._no_torque = np.zeros(3)
@@ -150,6 +152,8 @@ class ModelFeedforward:
         mujoco.mj_comPos(model, data)
         mujoco.mj_comVel(model, data)
         mujoco.mj_rne(model, data, 1, self._tau)
+        if self._passive:
+            self._tau += passive_torques(model, qvel)  # the joints' own damping and friction, which the motion meets
         self._subtract_reaction(sample)
         self.servo_torques[self._servos] = self._tau[self._dofs]
         leg: Array = self.servo_torques[self.plant.leg_actuators]  # a new array

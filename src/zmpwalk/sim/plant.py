@@ -289,6 +289,16 @@ def set_initial_state(plant: Plant, data: mujoco.MjData, position_base: Array, y
 
 
 FEEDFORWARD_PERIOD = 0.005  # [s] the static feedforward is computed at this period and interpolated
+FRICTION_RATE = 0.05  # [rad/s] a joint's dry friction enters the feedforward as f tanh(q' / this): in full when moving
+
+
+def passive_torques(model: mujoco.MjModel, qvel: Array) -> Array:
+    """The torques (nv,) [N m] a joint's own damping and dry friction in the model (``<joint damping>``,
+    ``frictionloss``) take from a motion at rates ``qvel`` (nv,), which the actuators must add to move it so:
+    ``b q' + f tanh(q' / v_f)``, the friction smoothed below :data:`FRICTION_RATE` ``v_f`` (at rest its sign is
+    undefined: the feedforward of a joint held still does not push either way)."""
+    return np.asarray(model.dof_damping * qvel + model.dof_frictionloss * np.tanh(qvel / FRICTION_RATE),
+                      dtype=np.float64)
 
 
 def plant_qpos(plant: Plant, position_base: Array, yaw: Array, angles: Array) -> Array:
@@ -311,9 +321,11 @@ def static_feedforward(plant: Plant, qpos: Array, zmp: Array, support: NDArray[n
     touches down 30 mm short). zmpwalk computes that torque from the model by inverse dynamics of the
     planned motion with the planned ground reaction:
 
-    .. math:: \tau = M(q)\ddot q + C(q, \dot q) + g(q) - \sum_{feet} J_{foot}^T w_{foot}
+    .. math:: \tau = M(q)\ddot q + C(q, \dot q) + g(q) + \tau_{passive}(\dot q) - \sum_{feet} J_{foot}^T w_{foot}
 
-    with ``q`` the planned poses (base included), ``q', q''`` their central differences, and ``w`` each
+    with ``q`` the planned poses (base included), ``q', q''`` their central differences, ``B \dot q`` the
+    joints' own damping and dry friction in the model (:func:`passive_torques`: Apptronik Apollo's legs have
+    11-171 N m s/rad and 0.9-21 N m, which its swinging legs work against), and ``w`` each
     sole's planned wrench: the force ``m (c'' + g)`` of the pattern's CoM acceleration at the planned ZMP,
     on the stance foot in single support and split between the feet by where the ZMP lies between them in
     double support. The reference of each position actuator becomes ``u = q_ref + tau / (kp gear^2)``.
@@ -393,7 +405,7 @@ def _servo_torques(plant: Plant, qpos: Array, zmp: Array, support: NDArray[np.in
         if dynamic:
             mujoco.mj_comVel(model, data)
         mujoco.mj_rne(model, data, 1 if dynamic else 0, result)
-        tau = result.copy()
+        tau = result + passive_torques(model, data.qvel)  # the joints' own damping and friction
         if dynamic and stride <= k < n - stride:
             # the CoM acceleration the ZMP implies (cart-table, Eqs. 1-2 of Park et al.): c'' = (g / l)(c - p)
             com = data.subtree_com[0]
