@@ -299,5 +299,5 @@ def test_the_least_sway_of_a_walk_without_double_support() -> None:
         assert far == pytest.approx(a * (1 - 1 / math.cosh(omega * period / 2)), abs=1e-5)  # [m]
     sway = a * (1 - 1 / math.cosh(omega * 0.8 / 2))
     assert sway == pytest.approx(0.0986, abs=1e-4)  # [m] at 0.8 s: a sole roll of 0.121 rad over the 0.817 m leg
-    shortest = 2 / omega * math.acosh(1 / (1 - sole_roll_bound(0.06) * 0.8168 / a))  # [s] the bound's step time
-    assert shortest == pytest.approx(0.342, abs=1e-3)
+    longest = 2 / omega * math.acosh(1 / (1 - sole_roll_bound(0.06) * 0.8168 / a))  # [s] the longest step it allows
+    assert longest == pytest.approx(0.342, abs=1e-3)

@@ -356,7 +356,7 @@ def test_the_feedforward_carries_the_joints_own_damping_and_friction(tmp_path: P
     0.9-21 N m), so a swinging leg is not held back by the joints it moves."""
     from zmpwalk.online import WalkingSample
     from zmpwalk.sim.mujoco_plant import ModelFeedforward
-    from zmpwalk.sim.plant import FRICTION_RATE, passive_torques
+    from zmpwalk.sim.plant import FRICTION_RATE, servo_torques
 
     servos = "".join(f'<position name="{s}_{j}_p" joint="{s}_{j}" kp="300" kv="5"/>'
                      for s in ("l", "r") for j in ("hy", "hr", "hp", "kn", "ap", "ar"))
@@ -378,8 +378,19 @@ def test_the_feedforward_carries_the_joints_own_damping_and_friction(tmp_path: P
         torques[name] = ModelFeedforward(plant, 1000.0).torques(sample)
     expected = (2.0 - 0.1) * rates + 3.0 * np.tanh(rates / FRICTION_RATE)  # [N m] (plain: damping 0.1, no friction)
     assert torques["lossy"] - torques["plain"] == pytest.approx(expected, abs=1e-9)
-    assert 3.0 * np.tanh(0.01 / FRICTION_RATE) == pytest.approx(0.592, abs=1e-3)  # near rest it fades
-    model = mujoco.MjModel.from_xml_string(lossy)
-    qvel = np.linspace(-1.0, 1.0, model.nv)
-    assert passive_torques(model, qvel) == pytest.approx(
-        model.dof_damping * qvel + model.dof_frictionloss * np.tanh(qvel / FRICTION_RATE), abs=1e-15)
+    assert expected[5] == pytest.approx(1.9 * 0.01 + 3.0 * math.tanh(0.2), abs=1e-12)  # near rest the friction fades
+    # the batch feedforward (static_feedforward's torques): the left knee at a steady 1 rad/s over 21 samples
+    batch = {}
+    for name, text in (("plain", plain), ("lossy", lossy)):
+        robot = load_robot(write(tmp_path, f"{name}.xml", text))
+        plant = build_plant(robot)
+        assert robot.legs is not None
+        qpos = np.tile(plant.qpos_hold, (21, 1))
+        knee = plant.leg_qpos[3]
+        qpos[:, knee] += 0.001 * np.arange(21)  # [rad] 1 rad/s at 1 kHz
+        half = robot.hip_spacing / 2
+        ankles = (np.tile([0.0, half, robot.ankle_height], (21, 1)), np.tile([0.0, -half, robot.ankle_height], (21, 1)))
+        torques_batch = servo_torques(plant, qpos, np.zeros((21, 2)), np.zeros(21, dtype=int), ankles, 1000.0)
+        batch[name] = torques_batch[10, plant.leg_actuators[3]]  # [N m] a middle sample (central differences)
+    assert batch["lossy"] - batch["plain"] == pytest.approx(1.9 * 1.0 + 3.0 * math.tanh(1.0 / FRICTION_RATE),
+                                                            abs=1e-9)

@@ -146,8 +146,8 @@ class WalkingController:
             simulator gives one that counts parts (:func:`zmpwalk.sim.loop.simulated_clock`).
         budget: The time [s] a tick may spend on a command's check, the tick's own work (stabilizer, feedforward)
             included (:class:`~zmpwalk.online.OnlineWalker`'s ``budget``; None: :func:`~zmpwalk.online.work_budget`,
-            50 us at 1 kHz). An imported robot's checks at 1 kHz need about 100 us to keep up with commands given
-            half a step ahead on a machine like this one (docs/speed.md).
+            50 us at 1 kHz). An imported robot's checks at 1 kHz fall a step behind commands given half a step
+            ahead at 50 us on a 2-core machine; 100 us catches up most of that delay (docs/speed.md).
 
     Raises:
         InvalidParameterError: As :class:`~zmpwalk.online.OnlineWalker` and :class:`~zmpwalk.balance.Stabilizer`

@@ -247,7 +247,8 @@ def add_pd_layer(spec: mujoco.MjSpec, plant: ModelPlant) -> None:
 
 
 def _held_controls(model: mujoco.MjModel, plant: ModelPlant) -> Array:
-    """Controls (nu,) that hold the reference pose: a position servo's on a joint, the reference angle times its gear
+    """Controls (nu,) that hold the reference pose: a position servo's on a joint (no integrator: an
+    ``<intvelocity>``'s control is a rate), the reference angle times its gear
     (its control is the angle it holds: a keyframe without controls, or with them in another order than the
     actuators', holds the pose all the same); for a joint of the PD layer its reference angle (a motor's keyframe
     control is a torque; the actuators the layer adds come after the model's); any other actuator's, the keyframe's
@@ -255,7 +256,7 @@ def _held_controls(model: mujoco.MjModel, plant: ModelPlant) -> Array:
     controls = np.zeros(model.nu)
     controls[:len(plant.ctrl_reference)] = plant.ctrl_reference
     for actuator in range(len(plant.ctrl_reference)):
-        if is_position_servo(model, actuator):
+        if is_position_servo(model, actuator) and model.actuator_dyntype[actuator] == mujoco.mjtDyn.mjDYN_NONE:
             address = model.jnt_qposadr[model.actuator_trnid[actuator][0]]
             controls[actuator] = model.actuator_gear[actuator][0] * plant.qpos_reference[address]
     for joint, pd in plant.pd_joints:
@@ -289,14 +290,15 @@ def set_initial_state(plant: Plant, data: mujoco.MjData, position_base: Array, y
 
 
 FEEDFORWARD_PERIOD = 0.005  # [s] the static feedforward is computed at this period and interpolated
-FRICTION_RATE = 0.05  # [rad/s] a joint's dry friction enters the feedforward as f tanh(q' / this): in full when moving
+FRICTION_RATE = 0.05  # [rad/s] (m/s on a slide) a joint's dry friction enters the feedforward as f tanh(q' / this)
 
 
 def passive_torques(model: mujoco.MjModel, qvel: Array) -> Array:
     """The torques (nv,) [N m] a joint's own damping and dry friction in the model (``<joint damping>``,
     ``frictionloss``) take from a motion at rates ``qvel`` (nv,), which the actuators must add to move it so:
     ``b q' + f tanh(q' / v_f)``, the friction smoothed below :data:`FRICTION_RATE` ``v_f`` (at rest its sign is
-    undefined: the feedforward of a joint held still does not push either way)."""
+    undefined: the feedforward of a joint held still does not push either way). The model's other passive forces
+    (joint springs, gravity compensation, fluid drag) are left out."""
     return np.asarray(model.dof_damping * qvel + model.dof_frictionloss * np.tanh(qvel / FRICTION_RATE),
                       dtype=np.float64)
 
@@ -323,7 +325,7 @@ def static_feedforward(plant: Plant, qpos: Array, zmp: Array, support: NDArray[n
 
     .. math:: \tau = M(q)\ddot q + C(q, \dot q) + g(q) + \tau_{passive}(\dot q) - \sum_{feet} J_{foot}^T w_{foot}
 
-    with ``q`` the planned poses (base included), ``q', q''`` their central differences, ``B \dot q`` the
+    with ``q`` the planned poses (base included), ``q', q''`` their central differences, ``tau_passive`` the
     joints' own damping and dry friction in the model (:func:`passive_torques`: Apptronik Apollo's legs have
     11-171 N m s/rad and 0.9-21 N m, which its swinging legs work against), and ``w`` each
     sole's planned wrench: the force ``m (c'' + g)`` of the pattern's CoM acceleration at the planned ZMP,
