@@ -241,9 +241,14 @@ def test_torque_driven_legs_get_the_pd_layer(capsys: pytest.CaptureFixture[str])
     assert talos.plant is not None
     talos_mgl = talos.mass * talos.gravity * talos.pendulum_length
     assert talos_mgl == pytest.approx(824.83, abs=0.01)  # [N m]
-    for joint, limit in zip(talos.plant.joints, [100.0, 160.0, 160.0, 400.0, 160.0, 100.0] * 2, strict=True):
+    for index, (joint, limit) in enumerate(zip(talos.plant.joints, [100.0, 160.0, 160.0, 400.0, 160.0, 100.0] * 2,
+                                               strict=True)):
         assert joint.actuator is not None and joint.actuator.label == "torque motor + PD"
-        assert joint.actuator.kp == pytest.approx(3 * talos_mgl, rel=1e-9)  # 2474.5 N m/rad: the load term
+        if index % 6 == 5:  # the ankle roll, 0.0104 kg m^2: the step bound, sqrt(kp / I) dt = 0.5 (2605.7 N m/rad)
+            assert joint.actuator.kp == pytest.approx(joint.actuator.inertia * (0.5 / 0.001) ** 2, rel=1e-9)
+            assert joint.actuator.kp == pytest.approx(2605.7, abs=0.1) and joint.actuator.kp < 4 * talos_mgl
+        else:
+            assert joint.actuator.kp == pytest.approx(4 * talos_mgl, rel=1e-9)  # 3299.3 N m/rad: the load term
         assert joint.actuator.force_limit == limit  # [N m] the motor's ctrlrange (and the joint's actuatorfrcrange)
     assert len(talos.plant.pd_joints) == 32  # the legs, torso, head, arms and grippers: every motor
     n1 = load_robot(N1)
@@ -253,8 +258,8 @@ def test_torque_driven_legs_get_the_pd_layer(capsys: pytest.CaptureFixture[str])
     assert hip_roll.inertia == pytest.approx(0.7884, abs=1e-4)  # [kg m^2]: 0.1676 of it the rotor's armature
     # the heaviest-swinging joint's bandwidth term, 498.0 N m/rad, is below the load term
     assert hip_roll.inertia * (2 * np.pi * 4.0) ** 2 == pytest.approx(498.0, abs=0.1)
-    assert hip_roll.kp == knee.kp == pytest.approx(3 * n1.mass * n1.gravity * n1.pendulum_length, rel=1e-12)
-    assert knee.kp == pytest.approx(703.29, abs=0.01) and knee.force_limit == 95.0  # [N m/rad], [N m]
+    assert hip_roll.kp == knee.kp == pytest.approx(4 * n1.mass * n1.gravity * n1.pendulum_length, rel=1e-12)
+    assert knee.kp == pytest.approx(937.71, abs=0.01) and knee.force_limit == 95.0  # [N m/rad], [N m]
     assert main(["robot", str(TALOS_MOTOR)]) == 0
     out = capsys.readouterr().out
     assert "torque motor + PD" in out and "static torques not computed" not in out

@@ -74,7 +74,7 @@ def test_the_rule_bandwidth_load_and_step_bound() -> None:
     assert kp == pytest.approx(1263.309, abs=1e-3)
     assert kv == pytest.approx(2.0 * math.sqrt(kp * 2.0), rel=1e-12)  # critical on its own inertia
     kp, kv = pd_gains(0.01, 100.0)  # light and loaded: kappa W
-    assert kp == pytest.approx(300.0, rel=1e-12) and kv == pytest.approx(2 * math.sqrt(3.0), rel=1e-12)
+    assert kp == pytest.approx(400.0, rel=1e-12) and kv == pytest.approx(2 * math.sqrt(4.0), rel=1e-12)
     kp, kv = pd_gains(1e-4, 1000.0, timestep=0.001)  # a light link would be stiffer than the step allows
     assert kp == pytest.approx(1e-4 * (0.5 / 0.001) ** 2, rel=1e-12)  # 25 N m/rad: sqrt(kp / I) dt = 0.5
     assert kv * 0.001 / 1e-4 == pytest.approx(1.0, rel=1e-12)  # kv dt / I = 2 zeta beta, half the bound 2
@@ -119,8 +119,8 @@ def test_motor_legs_get_the_rule_gains_and_their_limits(tmp_path: Path) -> None:
         assert actuator.kp == pytest.approx(expected, rel=1e-12)
         assert actuator.kv == pytest.approx(2 * math.sqrt(actuator.kp * actuator.inertia), rel=1e-12)
     assert weight_moment == pytest.approx(119.755, abs=1e-3)  # [N m]: 20.4 kg x 9.81 m/s^2 x 0.5984 m
-    assert ankle_roll.kp == pytest.approx(359.265, abs=1e-3)  # [N m/rad]: 3 m g l, the load term (every leg joint)
-    assert ankle_roll.kv == pytest.approx(4.097, abs=1e-3)  # [N m s/rad]: 2 sqrt(359.3 x 0.01168)
+    assert ankle_roll.kp == pytest.approx(479.020, abs=1e-3)  # [N m/rad]: 4 m g l, the load term (every leg joint)
+    assert ankle_roll.kv == pytest.approx(4.731, abs=1e-3)  # [N m s/rad]: 2 sqrt(479.0 x 0.01168)
     limits = {joint.name[2:]: joint.actuator.force_limit for joint in robot.plant.joints if joint.actuator}
     assert limits == {"hy": 40.0, "hr": 40.0, "hp": 40.0, "kn": 35.0, "ap": 40.0, "ar": 40.0}  # gear 2 x 20; 35
     stiffness = servo_stiffness(robot)  # the stabilizer sees the layer's gains

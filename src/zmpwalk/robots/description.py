@@ -23,7 +23,7 @@ PD_BANDWIDTH = 2 * math.pi * 4.0  # [rad/s] omega: a PD joint's natural frequenc
 PD_DAMPING_RATIO = 1.0  # [-] zeta: damping of a PD joint on its own inertia (critical)
 
 
-PD_LOAD_STIFFNESS = 3.0  # [-] kappa: a PD joint is at least this many times the weight moment it holds per rad
+PD_LOAD_STIFFNESS = 4.0  # [-] kappa: a PD joint is at least this many times the weight moment it holds per rad
 
 
 PD_STEP_LIMIT = 0.5  # [-] beta: sqrt(kp / I) times the physics step at most (discrete stability below 2)

@@ -98,9 +98,9 @@ def pd_gains(inertia: float, moment: float, timestep: float = PHYSICS_STEP) -> t
 
     with :data:`PD_BANDWIDTH` ``omega`` (the joint swings on its own inertia at least this fast),
     :data:`PD_LOAD_STIFFNESS` ``kappa`` times the weight moment ``W`` it holds (a leg joint holds the robot on
-    one foot, ``W = m g l``, whose toppling moment grows by ``m g l`` per radian of lean: at ``kappa = 3`` the
-    joint's net stiffness against it is ``2 m g l``, above the 1.7 ``m g l`` below which the stabilizer
-    stiffens servos with its encoder loop; 3 is the least whole value with which every walk of the torque-driven
+    one foot, ``W = m g l``, whose toppling moment grows by ``m g l`` per radian of lean: at ``kappa = 4`` the
+    joint's net stiffness against it is ``3 m g l``, above the 1.7 ``m g l`` below which the stabilizer
+    stiffens servos with its encoder loop; 4 is the least whole value with which every walk of the torque-driven
     robots tried passes, docs/robot-import.md), the discrete bound :data:`PD_STEP_LIMIT` ``beta``
     (``sqrt(kp / I) dt <= beta``, and so ``kv dt / I <= 2 zeta beta``: stable at the physics step even where the
     damping is integrated explicitly, the bound being 2) and :data:`PD_DAMPING_RATIO` ``zeta`` (critical damping
