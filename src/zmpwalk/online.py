@@ -176,7 +176,7 @@ class OnlineWalker:
                  joints: bool = False, pelvis: str = "cubic", generator: str | None = None,
                  budget: float | None = None, clock: Callable[[], float] | None = None) -> None:
         check_rate(rate)
-        self._budget = work_budget(rate) if budget is None else _checked_budget(budget, rate)
+        self.budget = work_budget(rate) if budget is None else _checked_budget(budget, rate)
         if clock is not None and not callable(clock):
             raise InvalidParameterError("clock", clock, "a callable returning seconds, or None (the machine's)")
         self._own_clock = clock
@@ -201,11 +201,6 @@ class OnlineWalker:
     def time(self) -> float:
         """Time of the next tick [s]."""
         return self._index / self.rate
-
-    @property
-    def budget(self) -> float:
-        """The time [s] a tick may spend on a command's check (the ``budget`` argument)."""
-        return self._budget
 
     @property
     def walking(self) -> bool:
@@ -359,8 +354,8 @@ class OnlineWalker:
         quota = -(-(expected - job.parts) // ticks_left)  # its share of the parts left
         plan: object
         try:
-            plan, parts = run_for(job.planning, max(self._budget - spent, WORK_SHARE * self._budget), quota,
-                                  self._own_clock or _clock, CATCH_UP * self._budget - spent)
+            plan, parts = run_for(job.planning, max(self.budget - spent, WORK_SHARE * self.budget), quota,
+                                  self._own_clock or _clock, CATCH_UP * self.budget - spent)
             job.parts += parts
         except ZmpwalkError as error:
             self._drop_job()
