@@ -206,3 +206,37 @@ def test_a_robot_file_robot_is_not_an_imported_one(hubo: RobotModel) -> None:
     feet = ((empty, np.zeros(1), empty, np.zeros(1)),) * 2
     with pytest.raises(InvalidParameterError, match="an imported robot"):
         next(imported_legs_in_parts(np.zeros(1), empty, np.zeros(1), empty, np.zeros(1), feet, hubo))
+
+
+def test_each_guess_is_the_parabola_through_the_last_three_samples_and_a_restart_starts_over() -> None:
+    """The solver's first guess per sample (``_extrapolate``, the state layout of START_SIZE), each sample's
+    solution then written over it: a quadratic sequence of angles and offsets is guessed exactly once three samples
+    are solved (the line through two before, the last one alone before that; the posture the fill starts from is
+    not a solved sample); after a sample that did not converge (``_restart``) the next starts from the last good
+    one and the history builds up again from there, never a parabola through unevenly spaced samples."""
+    from zmpwalk.stabilizer.whole_body_ik import START_SIZE, _extrapolate, _restart
+
+    extrapolate, restart = _extrapolate.py_func, _restart.py_func
+    rng = np.random.default_rng(3)
+    a, b, c = rng.normal(size=(3, 14))
+
+    def x(k: float) -> np.ndarray:  # [rad] and [m]: the samples' angles and offsets
+        return a + b * k + c * k * k
+
+    def guess(start: np.ndarray) -> np.ndarray:
+        extrapolate(start)
+        return start[:14].copy()
+
+    start = np.zeros(START_SIZE)
+    start[:14] = x(0)  # the posture the fill starts from
+    expected = {1: x(0), 2: x(1), 3: 2 * x(2) - x(1), 4: x(4), 5: x(5)}
+    for k in range(1, 6):
+        assert guess(start) == pytest.approx(expected[k], abs=1e-12)
+        start[:14] = x(k)  # the solver's solution
+    guess(start)  # sample 6 ...
+    restart(start)  # ... did not converge: back to sample 5, not extrapolated
+    assert start[:14] == pytest.approx(x(5), abs=1e-12) and start[30] == 0.0
+    expected = {7: x(5), 8: x(7), 9: 2 * x(8) - x(7), 10: x(10)}  # from 5, then the history of 7, 8, 9 alone
+    for k in range(7, 11):
+        assert guess(start) == pytest.approx(expected[k], abs=1e-12)
+        start[:14] = x(k)
