@@ -301,3 +301,21 @@ def test_the_least_sway_of_a_walk_without_double_support() -> None:
     assert sway == pytest.approx(0.0986, abs=1e-4)  # [m] at 0.8 s: a sole roll of 0.121 rad over the 0.817 m leg
     longest = 2 / omega * math.acosh(1 / (1 - sole_roll_bound(0.06) * 0.8168 / a))  # [s] the longest step it allows
     assert longest == pytest.approx(0.342, abs=1e-3)
+
+
+def test_the_mujoco_plant_drives_the_virtual_column_with_nothing() -> None:
+    """The virtual actuator has gain and gear 0: its column's velocity and torque terms stay 0 in the control (a
+    division by its zero stiffness made them NaN and MuJoCo reset the walk at its first tick)."""
+    from zmpwalk.control.plant import JointTargets
+    from zmpwalk.sim.mujoco_plant import MujocoPlant
+
+    robot = load_robot(H1)
+    plant = MujocoPlant(robot, 1000.0)
+    angles = np.concatenate([np.asarray(c.reference)[list(c.role_order)] for c in robot.legs or ()])
+    plant.apply(JointTargets(time=0.0, angles=angles, velocities=np.full(12, 0.5), torques=np.full(12, 10.0),
+                             sample=None, corrected=False))  # type: ignore[arg-type]
+    control = plant.data.ctrl[plant.plant.leg_actuators]
+    assert np.isfinite(control).all()
+    assert control[[5, 11]].tolist() == angles[[5, 11]].tolist()  # [rad] the virtual columns' angles, nothing added
+    real = [0, 1, 2, 3, 4, 6, 7, 8, 9, 10]
+    assert np.all(control[real] > angles[real])  # [rad] the real joints' rate and torque terms are added

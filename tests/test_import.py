@@ -3,6 +3,7 @@ the simulation of the real model, and one clear error for each bad model."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import mujoco
@@ -277,3 +278,30 @@ def test_position_servo_robots_keep_their_own_gains() -> None:
     assert talos.plant is not None
     assert [j.actuator.kp for j in talos.plant.joints if j.actuator] == [1000.0] * 4 + [10000.0] * 2 + [1000.0] * 4 \
         + [10000.0] * 2
+
+
+def test_the_default_foot_lift_keeps_the_pitch_joints_off_their_limits(tmp_path: Path) -> None:
+    """HUBO's lift scaled to the leg, unless the foot raised level at the apex would bring a pitch joint within
+    0.1 rad of its limit (zmpwalk.robots.imported._foot_lift), here the ankle pitch of 0.3 + 0.3 m legs in the
+    sagittal plane: hip to ankle D = 2 L cos(knee / 2) at the angle beta from the vertical, the level sole's ankle
+    pitch -(knee / 2 - beta); raising the foot by h shortens the vertical part of D by h."""
+    from zmpwalk.robots.imported import HUBO_FOOT_LIFT, LIFT_RANGE_MARGIN
+
+    free = load_robot(write(tmp_path, "free.xml", biped(leg("l", 0.1) + leg("r", -0.1))))
+    assert free.foot_lift == pytest.approx(HUBO_FOOT_LIFT * free.schedule_scale[1], abs=1e-12)  # [m] scaled
+    ankle = '<joint name="{s}_ap" axis="0 1 0" range="-30 30"/>'  # [deg] MJCF's default unit: +-0.5236 rad
+    tight = load_robot(write(tmp_path, "tight.xml", biped(leg("l", 0.1, ankle) + leg("r", -0.1, ankle))))
+    assert tight.legs is not None
+    _, _, hip_pitch, knee, ankle_pitch, _ = tight.legs[0].reference
+    assert ankle_pitch == pytest.approx(-(hip_pitch + knee), abs=1e-9)  # [rad] the sole level
+    beta = knee / 2 + ankle_pitch  # [rad]
+    across, vertical = 0.6 * math.cos(knee / 2) * math.sin(beta), 0.6 * math.cos(knee / 2) * math.cos(beta)  # [m]
+
+    def ankle_at(lift: float) -> float:
+        return -(math.acos(math.hypot(across, vertical - lift) / 0.6) - math.atan2(across, vertical - lift))
+
+    bound, low, high = -math.radians(30) + LIFT_RANGE_MARGIN, 0.0, 0.05  # [rad], [m]
+    for _ in range(60):
+        low, high = ((low + high) / 2, high) if ankle_at((low + high) / 2) > bound else (low, (low + high) / 2)
+    assert tight.foot_lift == pytest.approx(low, abs=1e-6)  # [m] 11.5 mm
+    assert tight.foot_lift < 0.5 * free.foot_lift  # [m] of the scaled 40 mm

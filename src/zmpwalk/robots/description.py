@@ -17,6 +17,8 @@ Array = NDArray[np.float64]
 PHYSICS_STEP = 0.001  # [s] the simulation's physics step at most (zmpwalk.sim.plant), the PD layer's period
 
 
+HUBO_FOOT_LIFT = 0.04  # [m] HUBO's foot lift, scaled by the leg length for another robot
+LIFT_RANGE_MARGIN = 0.1  # [rad] of a pitch joint's range the default foot lift leaves free at the swing's apex
 PD_BANDWIDTH = 2 * math.pi * 4.0  # [rad/s] omega: a PD joint's natural frequency on its own inertia, at least
 
 

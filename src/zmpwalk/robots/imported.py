@@ -59,7 +59,7 @@ from numpy.typing import NDArray
 from zmpwalk.errors import FileFormatError
 from zmpwalk.leg_chain import LegChain
 from zmpwalk.robots.collision import Sole, collision_points, rigid_bodies, sole_face_up, sole_roll_bound
-from zmpwalk.robots.description import Actuator, LegJoint, ModelPlant
+from zmpwalk.robots.description import HUBO_FOOT_LIFT, LIFT_RANGE_MARGIN, Actuator, LegJoint, ModelPlant
 from zmpwalk.robots.legs import VIRTUAL_PREFIX, FootAtReference, Segments, build_leg, leg_joint_ids, segments
 from zmpwalk.robots.model import RobotModel, schedule_scale
 from zmpwalk.robots.pd import element_name, pd_layer
@@ -204,6 +204,8 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     ready = _ready_posture(model, data, chains, legs, qpos_reference, adr, distance, hip_x, hip_spacing, hip_drop,
                            ankle_height, values.get("pelvis_height"), source)
     pelvis_height, pendulum, com_offset, chains_ready, qpos = ready
+    length_scale = schedule_scale(pendulum, thigh + shank, hip_spacing)[1]
+    lift = _foot_lift(chains_ready, leg_joints, HUBO_FOOT_LIFT * length_scale)  # [m]
     # The joint PD layer: gains from the ready posture's inertia; a leg joint holds the robot, m g l.
     pd_joints = pd_layer(model, data, qpos, leg_joint_set, mass * float(np.linalg.norm(model.opt.gravity)) * pendulum,
                           pd_gains or {})
@@ -212,8 +214,35 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     return _robot_model(
         name=robot_name, description=f"imported from {path.name} ({mass:.1f} kg)", mass=mass, height=height_scale,
         geometry=geometry, pelvis_height=pelvis_height, pendulum=pendulum, gravity=float(-model.opt.gravity[2]),
-        overrides=values, leg_joints=leg_joints, com_offset=com_offset, legs=(chains_ready[0], chains_ready[1]),
-        plant=plant)
+        foot_lift=lift, overrides=values, leg_joints=leg_joints, com_offset=com_offset,
+        legs=(chains_ready[0], chains_ready[1]), plant=plant)
+
+
+def _foot_lift(chains: list[LegChain], leg_joints: list[LegJoint], scaled: float) -> float:
+    """The default foot lift [m]: HUBO's scaled to the leg (``scaled``), or less where the leg, its foot raised
+    straight up from the ready posture and level (the apex of a step in place), would bring a pitch joint (hip
+    pitch, knee, ankle pitch: the lift bends them) that has at least :data:`LIFT_RANGE_MARGIN` of its range free
+    in the ready posture closer than that to its limit (Berkeley Humanoid's ankle pitch: 30 -> 10 mm). The roll and
+    yaw joints follow the sideways sway more than the lift, and a joint already closer in the ready posture is left
+    to the planner, which names it where a step leaves its range."""
+    ankles = [chain.fk(chain.reference[None]) for chain in chains]
+    limits = [np.array([joint.limits for joint in leg_joints[6 * i:6 * i + 6]]) for i in range(2)]  # by column
+
+    def margins(lift: float) -> Array:
+        angles = [chain.solve(ankle + (0.0, 0.0, lift), rotation)[0][0]
+                  for chain, (ankle, rotation) in zip(chains, ankles, strict=True)]
+        return np.concatenate([np.minimum(q - bounds[:, 0], bounds[:, 1] - q) for q, bounds in zip(angles, limits,
+                                                                                                   strict=True)])
+
+    pitch = np.array([joint.role in ("hip_pitch", "knee", "ankle_pitch") for joint in leg_joints])
+    watched = pitch & (margins(0.0) >= LIFT_RANGE_MARGIN)
+    if not watched.any() or margins(scaled)[watched].min() >= LIFT_RANGE_MARGIN:
+        return scaled
+    low, high = 0.0, scaled
+    for _ in range(30):  # bisection to 1e-9 of the scaled lift
+        middle = (low + high) / 2
+        low, high = (middle, high) if margins(middle)[watched].min() >= LIFT_RANGE_MARGIN else (low, middle)
+    return low
 
 
 def _zero_pose(model: Any, data: Any, qpos_reference: Array, leg_joints: set[int], base: int,
@@ -315,12 +344,12 @@ def _geometry(chains: list[LegChain], soles: tuple[Sole, Sole], source: str) -> 
 
 
 def _robot_model(*, name: str, description: str, mass: float, height: float, geometry: _Geometry,
-                 pelvis_height: float, pendulum: float, gravity: float, overrides: dict[str, float],
+                 foot_lift: float, pelvis_height: float, pendulum: float, gravity: float, overrides: dict[str, float],
                  leg_joints: list[LegJoint], com_offset: Array, legs: tuple[LegChain, LegChain],
                  plant: ModelPlant) -> RobotModel:
     """The robot model: derived values (the robot file's ``overrides`` replacing them), the joint ranges by column,
-    and the HUBO tables scaled to this robot (docs/robot-import.md): times with sqrt(l/g), strides and foot lift
-    with the leg length, sway and V_y with the hip spacing."""
+    and the HUBO tables scaled to this robot (docs/robot-import.md): times with sqrt(l/g), strides with the leg
+    length, sway and V_y with the hip spacing; the foot lift ``foot_lift`` [m] (:func:`_foot_lift`)."""
     g = geometry
     x_min, y_min, x_max, y_max = g.sole_box
     time_scale, length_scale, lateral_scale = schedule_scale(pendulum, g.thigh + g.shank, g.hip_spacing)
@@ -330,7 +359,7 @@ def _robot_model(*, name: str, description: str, mass: float, height: float, geo
         "hip_drop": g.hip_drop, "thigh_length": g.thigh, "shank_length": g.shank, "ankle_height": g.ankle_height,
         "foot_length": x_max - x_min, "foot_width": y_max - y_min, "sole_center_x": (x_max + x_min) / 2,
         "sole_center_y": (y_max + y_min) / 2, "pelvis_height": pelvis_height, "pendulum_length": pendulum,
-        "min_knee": 0.05, "dsp_time": 0.1 * time_scale, "foot_lift": 0.04 * length_scale,
+        "min_knee": 0.05, "dsp_time": 0.1 * time_scale, "foot_lift": foot_lift,
         "lateral_velocity": 0.1 * lateral_scale, "gravity": gravity,
     }
     for key, value in overrides.items():

@@ -9,7 +9,14 @@ from typing import TYPE_CHECKING, Any
 
 from zmpwalk.joint_limits import JOINT_COLUMNS
 from zmpwalk.robots.collision import tilt_of
-from zmpwalk.robots.description import PD_BANDWIDTH, PD_DAMPING_RATIO, PD_LOAD_STIFFNESS, Actuator
+from zmpwalk.robots.description import (
+    HUBO_FOOT_LIFT,
+    LIFT_RANGE_MARGIN,
+    PD_BANDWIDTH,
+    PD_DAMPING_RATIO,
+    PD_LOAD_STIFFNESS,
+    Actuator,
+)
 from zmpwalk.robots.model import RobotModel
 
 if TYPE_CHECKING:
@@ -124,6 +131,7 @@ def robot_table(robot: RobotModel, statics: StaticTorques | None = None) -> str:
         f"{robot.pendulum_length:.4f} m high and ({_mm(robot.com_offset[0])}, {_mm(robot.com_offset[1])}) mm "
         "from the base origin",
         "HUBO tables scaled by: time x{:.3f}, stride x{:.3f}, lateral x{:.3f}".format(*robot.schedule_scale),
+        _lift_line(robot),
     ]
     if "joints" in s:
         lines.append("IK: " + ", ".join(f"{k} {v} (hip axes {s['hip_axes_offset'][k] * 1e3:.1f} mm apart, "
@@ -197,7 +205,8 @@ def robot_toml(robot: RobotModel, folder: Path) -> str:
               f"pelvis_height = {robot.pelvis_height:.6g}   # [m] base origin above the ground, ready posture",
               "", "[walking]",
               f"dsp_time = {robot.dsp_time:.6g}   # [s] double-support time d (HUBO's 0.1 s, time-scaled)",
-              f"foot_lift = {robot.foot_lift:.6g}   # [m] swing apex height (HUBO's 0.04 m, length-scaled)",
+              f"foot_lift = {robot.foot_lift:.6g}   # [m] swing apex height (HUBO's 0.04 m, length-scaled, lowered "
+              f"where a pitch joint would come within {LIFT_RANGE_MARGIN:g} rad of its range)",
               f"lateral_velocity = {robot.lateral_velocity:.6g}   # [m] V_y of Eq. 20 (HUBO's 0.1 m, lateral-scaled)"]
     if robot.plant is not None and robot.plant.pd_joints:
         lines += ["", "[pd]",
@@ -213,3 +222,13 @@ def robot_toml(robot: RobotModel, folder: Path) -> str:
 
 def _quote(text: str) -> str:
     return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def _lift_line(robot: RobotModel) -> str:
+    """The foot lift, and why where it is below HUBO's scaled one."""
+    scaled = HUBO_FOOT_LIFT * robot.schedule_scale[1]  # [m]
+    words = f"foot lift {robot.foot_lift * 1e3:.1f} mm"
+    if robot.foot_lift < scaled - 1e-9:
+        words += (f" (HUBO's {scaled * 1e3:.1f} mm length-scaled, lowered so that the hip pitch, knee and ankle pitch "
+                  f"keep {LIFT_RANGE_MARGIN:g} rad of their ranges with the foot raised level from the ready posture)")
+    return words

@@ -242,8 +242,10 @@ class MujocoPlant:
         self._reader = _MeasurementReader(self.sensors, None if disturbances is None else disturbances.floor_rotation)
         servos = plant.leg_actuators
         kp, gear = model.actuator_gainprm[servos, 0], model.actuator_gear[servos, 0]
-        self._damping_ratio = -model.actuator_biasprm[servos, 2] / kp
-        self._compliance = 1.0 / (kp * gear**2)
+        driven = kp * gear**2 != 0.0  # a five-joint leg's virtual ankle roll has an actuator of gain and gear 0
+        self._damping_ratio = np.divide(-model.actuator_biasprm[servos, 2], kp, out=np.zeros(len(servos)),
+                                        where=driven)  # [s]
+        self._compliance = np.divide(1.0, kp * gear**2, out=np.zeros(len(servos)), where=driven)  # [rad/(N m)]
         self._ctrl = plant.ctrl_hold.copy()
         self._push_body = int(model.site_bodyid[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "pelvis")])
         self._pelvis, self._quaternion = self.sensors.slices["pelvis_pos"], self.sensors.slices["pelvis_quat"]
