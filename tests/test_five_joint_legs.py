@@ -319,3 +319,34 @@ def test_the_mujoco_plant_drives_the_virtual_column_with_nothing() -> None:
     assert control[[5, 11]].tolist() == angles[[5, 11]].tolist()  # [rad] the virtual columns' angles, nothing added
     real = [0, 1, 2, 3, 4, 6, 7, 8, 9, 10]
     assert np.all(control[real] > angles[real])  # [rad] the real joints' rate and torque terms are added
+
+
+@pytest.mark.parametrize(("ankle_roll", "support", "lateral"), [(1.0, 1, True), (0.0, 0, True), (0.0, 1, False),
+                                                                 (0.0, 2, False)])
+def test_the_com_admittance_leaves_the_sideways_zmp_error_to_the_step_without_an_ankle_roll(
+        ankle_roll: float, support: int, lateral: bool) -> None:
+    """Legs without an ankle roll cannot move the CoP across the stance sole in single support: there the CoM
+    admittance's ZMP term keeps only its part along the pelvis (yaw 0.5 rad here), in double support both parts."""
+    from zmpwalk.stabilizer import loops
+    from zmpwalk.stabilizer.layout import LOG_SIZE, ROBOT_CONSTANTS, STATE_SIZE, P, S, pack_parameters
+    from zmpwalk.stabilizer_gains import StabilizerGains
+
+    constants: dict[str, object] = {name: np.zeros(size) for name, size in ROBOT_CONSTANTS}
+    params = pack_parameters(StabilizerGains(com_damping=0.0, com_stiffness=0.0), **constants)
+    params[P.dt], params[P.ankle_roll] = 0.001, ankle_roll  # [s], [-]
+    state, log, yaw = np.zeros(STATE_SIZE), np.zeros(LOG_SIZE), 0.5
+    error = np.array([0.02, -0.01])  # [m] measured ZMP less the desired, world
+    loops.com_admittance(params, state, log, True, (float(error[0]), float(error[1])), (0.0, 0.0), 0.0, 0.0,
+                         support, yaw)
+    rate = state[S.offset_rate:S.offset_rate + 2] / (20.0 * 0.001)  # [m] the ZMP error the offset's rate answered
+    along = np.array([math.cos(yaw), math.sin(yaw)])
+    expected = error if lateral else along * (error @ along)
+    assert rate == pytest.approx(expected, abs=1e-15)
+
+
+def test_the_stabilizer_knows_which_legs_have_an_ankle_roll() -> None:
+    from zmpwalk.balance import Stabilizer
+    from zmpwalk.stabilizer.layout import P
+
+    assert Stabilizer(load_robot(H1), 1000.0)._params[P.ankle_roll] == 0.0
+    assert Stabilizer(load_robot("hubo"), 1000.0)._params[P.ankle_roll] == 1.0

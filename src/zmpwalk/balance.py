@@ -220,7 +220,8 @@ class Stabilizer:
             ankle_offset=np.concatenate([c.ankle for c in self.chains]), servo_gain=self.servo_gain,
             stiffen=float(self.servo_gain.any()), sole_stiffness=0.0 if sole_law is None else sole_law.stiffness,
             sole_exponent=0.0 if sole_law is None else sole_law.exponent,
-            sole_normal=np.concatenate([c.sole_rotation[:, 2] for c in self.chains]))
+            sole_normal=np.concatenate([c.sole_rotation[:, 2] for c in self.chains]),
+            ankle_roll=float(all(c.virtual is None for c in self.chains)))
         self._chain = chain = chain_table(self.chains)
         self._state = np.zeros(STATE_SIZE)
         self._log = log = np.zeros(LOG_SIZE)

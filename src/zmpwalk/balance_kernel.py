@@ -134,7 +134,7 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
     ex, ey, pdx, pdy = dcm_feedback(params, state, log, com, velocity, (cx, cy), zmp, support, c0, c1, yaw_left,
                                     yaw_right)
     offset = com_admittance(params, state, log, loaded0 or loaded1, (zmx, zmy), (pdx, pdy), -(slope_x + whole_x),
-                            -(slope_y + whole_y))
+                            -(slope_y + whole_y), support, yaw)
     shares = distribute(pdx, pdy, support, c0[0], c0[1], c1[0], c1[1])
     ankle_damping(params, state, log, loaded0, loaded1, shares, (cop0x, cop0y, cop1x, cop1y), yaw_left, yaw_right)
     height = foot_force_difference(params, state, log, support, f0, f1, loaded0, loaded1, shares[0], shares[1])

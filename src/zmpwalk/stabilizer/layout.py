@@ -53,6 +53,7 @@ ROBOT_CONSTANTS: Fields = (  # after the gains in params, (name, size)
     ("sole_stiffness", 1),  # [N/m^e] k of the sole's contact law f = k x^e (0: a rigid sole)
     ("sole_exponent", 1),  # [-] e
     ("sole_normal", 6),  # (2, 3) each sole's normal in the last frame of its leg (the sole frame's z axis) [-]
+    ("ankle_roll", 1),  # 1 when both legs have an ankle roll joint, 0 for five-joint legs (a virtual one)
 )
 GAIN_FIELDS: Fields = tuple((f.name, 1) for f in dataclasses.fields(StabilizerGains))
 

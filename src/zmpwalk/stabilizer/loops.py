@@ -92,19 +92,23 @@ def dcm_feedback(params: np.ndarray, state: np.ndarray, log: np.ndarray, com: np
 
 @njit(cache=True, nogil=True, inline="always")
 def com_admittance(params: np.ndarray, state: np.ndarray, log: np.ndarray, loaded: bool, zmp_measured: Point,
-                   zmp_desired: Point, rest_x: float, rest_y: float) -> Point:
+                   zmp_desired: Point, rest_x: float, rest_y: float, support: int, yaw: float) -> Point:
     r"""CoM admittance (:mod:`zmpwalk.balance`, step 2; Caron et al. 2019): the commanded CoM's offset accelerates
     by
 
     .. math:: \Delta c'' = A (p_{measured} - p_d) - K_v \Delta c' - K_p (\Delta c - \Delta c_{rest})
 
     (gains ``com_admittance``, ``com_damping``, ``com_stiffness``; no ZMP term with no sole ``loaded``), kept within
-    ``com_limit``; it rests at ``(rest_x, rest_y)`` (the slope's and the whole-body CoM's offsets). Returns the
-    offset [m]."""
+    ``com_limit``; it rests at ``(rest_x, rest_y)`` (the slope's and the whole-body CoM's offsets). Legs without an
+    ankle roll cannot move the CoP across the stance sole in single ``support``: the ZMP term's part across the
+    pelvis (yaw ``yaw`` [rad]) is left out there, the sideways balance being the step's. Returns the offset [m]."""
     dt = params[P.dt]
     if loaded:
         ax = params[P.com_admittance] * (zmp_measured[0] - zmp_desired[0])
         ay = params[P.com_admittance] * (zmp_measured[1] - zmp_desired[1])
+        if params[P.ankle_roll] == 0.0 and support != DOUBLE_SUPPORT:
+            along, _ = rotate2(ax, ay, -yaw)
+            ax, ay = rotate2(along, 0.0, yaw)
     else:
         ax = ay = 0.0
     ax -= params[P.com_damping] * state[S.offset_rate] + params[P.com_stiffness] * (state[S.offset] - rest_x)
