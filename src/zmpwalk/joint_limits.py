@@ -9,6 +9,8 @@ range (:func:`zmpwalk.robots.collision.sole_roll_bound`), and leaving it is a :c
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -49,7 +51,10 @@ class JointLimitError(ZmpwalkError, ValueError):
             f"{angle:+.4f} rad there; the bound keeps the rolled sole within 2 mm across its width, a sole). With "
             "five joints, a "
             "flat sole and an upright pelvis fix the hip roll, so the pelvis cannot sway over the stance sole as the "
-            "pattern asks. What is missing: an ankle roll joint")
+            "pattern asks. What is missing: an ankle roll joint. A foot that rolls on its centre line (heel-to-toe "
+            "capsules) may walk with its soles rolled, balanced sideways by its steps: give the robot file "
+            f"(zmpwalk robot MODEL --write FILE) [walking] sole_roll_limit = {math.ceil(sole_roll * 100) / 100:g} "
+            "and let zmpwalk simulate judge the walk")
 
 
 _BOUNDS: dict[int, tuple[dict[str, tuple[float, float]], Array, Array]] = {}  # id(joint_limits) -> bounds

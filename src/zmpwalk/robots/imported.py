@@ -209,7 +209,7 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     # The joint PD layer: gains from the ready posture's inertia; a leg joint holds the robot, m g l.
     pd_joints = pd_layer(model, data, qpos, leg_joint_set, mass * float(np.linalg.norm(model.opt.gravity)) * pendulum,
                           pd_gains or {})
-    leg_joints = _driven_joints(leg_joints, dict(pd_joints), geometry)
+    leg_joints = _driven_joints(leg_joints, dict(pd_joints), geometry, values.get("sole_roll_limit"), source)
     plant = replace(plant, joints=tuple(leg_joints), pd_joints=pd_joints)
     return _robot_model(
         name=robot_name, description=f"imported from {path.name} ({mass:.1f} kg)", mass=mass, height=height_scale,
@@ -275,10 +275,20 @@ def _reference_reach(model: Any, data: Any, qpos_reference: Array, base: int, hi
     return distance, float(np.max(data.geom_xpos[:, 2]) - key_foot_bottom)
 
 
-def _driven_joints(joints: list[LegJoint], driven: dict[str, Actuator], geometry: _Geometry) -> list[LegJoint]:
+def _driven_joints(joints: list[LegJoint], driven: dict[str, Actuator], geometry: _Geometry,
+                   sole_roll_limit: float | None, source: str) -> list[LegJoint]:
     """The leg joints with the PD layer's actuators where it drives them, and a five-joint leg's virtual ankle roll
-    with its range, the sole roll it may leave (:func:`zmpwalk.robots.collision.sole_roll_bound`)."""
-    bound = sole_roll_bound(geometry.sole_box[3] - geometry.sole_box[1])
+    with its range, the sole roll it may leave: :func:`zmpwalk.robots.collision.sole_roll_bound`, or the robot
+    file's ``[walking] sole_roll_limit`` [rad] (a foot that rolls on its centre line, docs/robot-import.md).
+
+    Raises:
+        FileFormatError: ``sole_roll_limit`` for legs that have an ankle roll.
+    """
+    if sole_roll_limit is not None and not any(joint.name.startswith(VIRTUAL_PREFIX) for joint in joints):
+        raise FileFormatError(source, f"[walking] sole_roll_limit = {sole_roll_limit!r} applies to legs of five "
+                              "joints (no ankle roll); this robot's legs have an ankle roll")
+    bound = sole_roll_bound(geometry.sole_box[3] - geometry.sole_box[1]) if sole_roll_limit is None \
+        else sole_roll_limit
     joints = [replace(joint, actuator=driven.get(joint.name, joint.actuator)) for joint in joints]
     return [replace(joint, limits=(-bound, bound)) if joint.name.startswith(VIRTUAL_PREFIX) else joint
             for joint in joints]

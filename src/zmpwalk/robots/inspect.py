@@ -208,6 +208,10 @@ def robot_toml(robot: RobotModel, folder: Path) -> str:
               f"foot_lift = {robot.foot_lift:.6g}   # [m] swing apex height (HUBO's 0.04 m, length-scaled, lowered "
               f"where a pitch joint would come within {LIFT_RANGE_MARGIN:g} rad of its range)",
               f"lateral_velocity = {robot.lateral_velocity:.6g}   # [m] V_y of Eq. 20 (HUBO's 0.1 m, lateral-scaled)"]
+    if robot.legs is not None and robot.legs[0].virtual is not None:  # five-joint legs: the sole roll they may leave
+        bound = robot.joint_limits["left_ankle_roll"][1]
+        lines.append(f"# sole_roll_limit = {bound:.6g}   # [rad] the sole roll a walk may leave (no ankle roll); "
+                     "raise it for a foot that rolls on its centre line (docs/robot-import.md)")
     if robot.plant is not None and robot.plant.pd_joints:
         lines += ["", "[pd]",
                   "# The joint PD layer (the firmware's joint loop) of each torque motor or unactuated joint:",

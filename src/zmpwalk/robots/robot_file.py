@@ -31,7 +31,7 @@ def robot_from_toml(path: Path) -> RobotModel:
 
 _MODEL_OVERRIDES = {"posture": ("pelvis_height",),
                     "walking": ("dsp_time", "foot_lift", "lateral_velocity", "foot_speed_limit",
-                                "foot_acceleration_limit")}
+                                "foot_acceleration_limit", "sole_roll_limit")}
 
 
 def _robot_from_model_table(data: dict[str, Any], path: Path) -> RobotModel:
