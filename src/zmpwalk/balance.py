@@ -82,9 +82,14 @@ centre line, the one motion five joints cannot make at any posture (the sole's r
 position, heading and pitch). No ankle-roll torque is asked for: the ankle damping's roll and the torso roll
 reach the sole only as that dropped twist, and the lateral balance is the hip roll's, moving the CoM sideways
 (the CoM admittance) and placing the swinging foot (landing control); ``tests/test_five_joint_legs.py`` checks
-the split on a five-joint chain. It runs compiled (:mod:`zmpwalk.balance_kernel`, one compiled function per loop
-in :mod:`zmpwalk.stabilizer`, numba, cached on disk after the first compile) on arrays allocated once per
-stabilizer: a tick costs about 3 µs from Python and allocates nothing.
+the split on a five-joint chain. Nor can such a leg move the CoP across the stance sole: in single support the
+CoM admittance's ZMP term keeps only its part along the pelvis (the ZMP error across it would only push the CoM
+further sideways), and the sideways balance is the step's; in double support the load shared between the feet
+moves the CoP across, and both parts act.
+
+It runs compiled (:mod:`zmpwalk.balance_kernel`, one compiled function per loop in :mod:`zmpwalk.stabilizer`,
+numba, cached on disk after the first compile) on arrays allocated once per stabilizer: a tick costs about 3 µs
+from Python and allocates nothing.
 """
 
 from __future__ import annotations
