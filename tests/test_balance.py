@@ -564,3 +564,22 @@ def test_against_a_pelvis_point_the_com_offset_rests_where_the_planned_whole_bod
         assert np.abs(stabilizer.state.whole_body_offset + rest_at).max() < WHOLE_BODY_TOL
         run(stabilizer, turned, 4000)  # 4 s: K_p = 10 /s^2, K_v = 6 /s settle within 2 s
         assert np.abs(stabilizer.state.com_offset - rest_at).max() < 0.01 * np.linalg.norm(expected) + 1e-12
+
+
+def test_a_swinging_sole_that_touches_down_early_does_not_move_the_com() -> None:
+    """In single support the CoM admittance answers the stance sole's CoP once the swinging sole has lifted: one
+    that touches down early (the left carrying 30 % of the weight, 0.17 m aside, while the plan stands on the right)
+    moves the measured ZMP by about 50 mm, and answering that error accelerated the CoM towards the landing foot
+    (Menagerie's earlier G1 fell so in its side steps); the force difference control raises the foot instead. Against
+    the same walk with the left sole bare, the CoM offset differs by under 0.1 mm after 200 ms. A sole that still
+    carries load as it lifts is part of the measured ZMP (the load passes to the stance sole)."""
+    bare, inputs, _ = standing()
+    swing = {**inputs, "support": 2}
+    run(bare, swing, 201, loads=(0.0, 2.0))
+    early = Stabilizer(bare.robot, 1000.0, com_reference=WHOLE_BODY)
+    run(early, swing, 1, loads=(0.0, 2.0))  # lifted
+    run(early, swing, 200, loads=(0.6, 1.4))  # down again
+    assert np.abs(early.state.com_offset - bare.state.com_offset).max() < 1e-4  # [m]
+    lifting = Stabilizer(bare.robot, 1000.0, com_reference=WHOLE_BODY)
+    run(lifting, swing, 201, loads=(0.6, 1.4))  # never lifted: its load counts
+    assert np.abs(lifting.state.com_offset - bare.state.com_offset).max() > 1e-3  # [m]

@@ -217,10 +217,10 @@ T1 = Path(__file__).resolve().parents[2] / "shared" / "robots" / "booster_t1" / 
 @pytest.mark.skipif(not T1.is_file(), reason="../shared/robots is absent")
 def test_booster_t1_on_hubos_scaled_tables_is_not_a_pass(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """10 steps of 0.1 m at 0.9 s on the polynomial generator (docs/robot-import.md): it walks, but its plan's ZMP
-    is 8.6 mm outside the
-    soles (FAIL) and the right ankle roll is held at its 15 N m limit (saturated: WARN). The console, the page
-    and the JSON say so, with
-    the console's warning that the plan needs more than the actuators give."""
+    is 8.6 mm outside the soles (FAIL), its feet end 21.9 mm from the plan (FAIL; 15.3 mm before the CoM admittance
+    answered the stance sole's CoP alone at an early touchdown) and the right ankle roll is held at its 15 N m limit
+    (saturated: WARN). The console, the page and the JSON say so, with the console's warning that the plan needs
+    more than the actuators give."""
     steps = tmp_path / "t1.toml"
     steps.write_text("[[steps]]\nduration = 0.9\nforward = 0.1\nrepeat = 10\n", encoding="utf-8")
     out = tmp_path / "r"
@@ -241,4 +241,6 @@ def test_booster_t1_on_hubos_scaled_tables_is_not_a_pass(tmp_path: Path, capsys:
     page = (out / "index.html").read_text(encoding="utf-8")
     assert "passes every criterion" not in page and "class='good'>passes" not in page
     assert f"<li class='warn'>warning: {warning}" in page
-    assert page.count("<td class='bad'>FAIL</td>") == 1
+    feet = by_name["feet where planned"]
+    assert feet["figure"] == pytest.approx(0.0219, abs=1e-3) and feet["state"] == "FAIL"  # [m]
+    assert page.count("<td class='bad'>FAIL</td>") == 2

@@ -50,7 +50,17 @@ from zmpwalk.stabilizer.estimation import (
 from zmpwalk.stabilizer.freshness import BUILD_KEY, renew_stale
 from zmpwalk.stabilizer.joints import joint_corrections, servo_outer_loop
 from zmpwalk.stabilizer.landing import AIRBORNE_AIM, landing_and_stepping
-from zmpwalk.stabilizer.layout import LOG_SIZE, PARAMETERS, STATE_SIZE, L, P, S, initial_state
+from zmpwalk.stabilizer.layout import (
+    LEFT_SUPPORT,
+    LOG_SIZE,
+    PARAMETERS,
+    RIGHT_SUPPORT,
+    STATE_SIZE,
+    L,
+    P,
+    S,
+    initial_state,
+)
 from zmpwalk.stabilizer.leg import ankle_in_base, factor_pattern_legs, leg_jacobian, leg_kinematics, lu6, lu_solve6
 from zmpwalk.stabilizer.loops import (
     ankle_damping,
@@ -133,6 +143,12 @@ def tick(params: np.ndarray, chain: np.ndarray, state: np.ndarray, log: np.ndarr
     # --- the loops (zmpwalk.balance, steps 1-6), then the corrections onto the joints and the servo loop (8)
     ex, ey, pdx, pdy = dcm_feedback(params, state, log, com, velocity, (cx, cy), zmp, support, c0, c1, yaw_left,
                                     yaw_right)
+    # a swinging sole that touches down early (loaded again after it lifted): the admittance answers the stance
+    # sole's CoP alone
+    if support == LEFT_SUPPORT and loaded0 and state[S.lifted + 1] > 0.0:
+        zmx, zmy = cop0x, cop0y
+    elif support == RIGHT_SUPPORT and loaded1 and state[S.lifted] > 0.0:
+        zmx, zmy = cop1x, cop1y
     offset = com_admittance(params, state, log, loaded0 or loaded1, (zmx, zmy), (pdx, pdy), -(slope_x + whole_x),
                             -(slope_y + whole_y), support, yaw)
     shares = distribute(pdx, pdy, support, c0[0], c0[1], c1[0], c1[1])
