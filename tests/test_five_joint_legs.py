@@ -378,6 +378,8 @@ def test_a_robot_file_raises_the_sole_roll_limit_the_refusal_names(tmp_path: Pat
                      "sole_roll_limit = 0.2\n", encoding="utf-8")
     with pytest.raises(FileFormatError, match="applies to legs of five joints"):
         load_robot(talos)
+    with pytest.raises(FileFormatError, match=r"sole_roll_limit = 1.6 must be below pi/2 rad"):
+        load_robot(_h1_file(tmp_path, 1.6))
 
 
 @pytest.mark.slow

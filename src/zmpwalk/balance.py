@@ -29,10 +29,10 @@ separately tunable loop. ``docs/balance.md`` derives it; in short, with ``omega 
    c_pelvis)``, minus the planned whole-body CoM's offset from that point (the legs at the pattern's angles
    and the rest of the body, the estimate's mass model), so that the whole-body CoM stands where the
    cart-table puts its mass; resting at zero, the pull ``K_p`` held the CoM that far ahead and the DCM loop
-   answered with a desired ZMP ahead of the plan (HUBO's fig27: 14.7 mm on average). In single support
-   ``p_measured`` is the stance sole's CoP: a swinging sole that touches down early carries load the plan does not
-   give it, and answering the ZMP that moves would accelerate the CoM towards the landing foot (Menagerie's earlier
-   Unitree G1 fell so in its side steps); step 4 raises that foot instead.
+   answered with a desired ZMP ahead of the plan (HUBO's fig27: 14.7 mm on average). A swinging sole that touches
+   down early (it carries load again after it has lifted) carries load the plan does not give it: ``p_measured`` is
+   then the stance sole's CoP alone, since answering the ZMP that foot moves would accelerate the CoM towards it
+   (Menagerie's earlier Unitree G1 fell so in its side steps); step 4 raises that foot instead.
 3. **Ankle damping control** (the damping control of Kajita et al. 2010): each loaded sole's centre of
    pressure follows its share of ``p_d`` by turning the foot, ``delta' = -(tau_d - tau) / D - delta / T``,
    written per metre of CoP error.

@@ -282,8 +282,11 @@ def _driven_joints(joints: list[LegJoint], driven: dict[str, Actuator], geometry
     file's ``[walking] sole_roll_limit`` [rad] (a foot that rolls on its centre line, docs/robot-import.md).
 
     Raises:
-        FileFormatError: ``sole_roll_limit`` for legs that have an ankle roll.
+        FileFormatError: ``sole_roll_limit`` for legs that have an ankle roll, or of pi/2 rad or more.
     """
+    if sole_roll_limit is not None and not sole_roll_limit < math.pi / 2:
+        raise FileFormatError(source, f"[walking] sole_roll_limit = {sole_roll_limit!r} must be below pi/2 rad (a "
+                              "sole rolled a right angle stands on its side)")
     if sole_roll_limit is not None and not any(joint.name.startswith(VIRTUAL_PREFIX) for joint in joints):
         raise FileFormatError(source, f"[walking] sole_roll_limit = {sole_roll_limit!r} applies to legs of five "
                               "joints (no ankle roll); this robot's legs have an ankle roll")

@@ -98,8 +98,8 @@ def com_admittance(params: np.ndarray, state: np.ndarray, log: np.ndarray, loade
 
     .. math:: \Delta c'' = A (p_{measured} - p_d) - K_v \Delta c' - K_p (\Delta c - \Delta c_{rest})
 
-    (gains ``com_admittance``, ``com_damping``, ``com_stiffness``; no ZMP term with no sole ``loaded``; in single
-    support ``zmp_measured`` is the stance sole's CoP, the caller's), kept within
+    (gains ``com_admittance``, ``com_damping``, ``com_stiffness``; no ZMP term with no sole ``loaded``; at an early
+    touchdown the caller gives the stance sole's CoP as ``zmp_measured``), kept within
     ``com_limit``; it rests at ``(rest_x, rest_y)`` (the slope's and the whole-body CoM's offsets). Legs without an
     ankle roll cannot move the CoP across the stance sole in single ``support``: the ZMP term's part across the
     pelvis (yaw ``yaw`` [rad]) is left out there, the sideways balance being the step's. Returns the offset [m]."""
