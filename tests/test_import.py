@@ -15,6 +15,7 @@ from zmpwalk.errors import FileFormatError
 from zmpwalk.kinematics import pattern_joint_trajectory, rot_z
 from zmpwalk.patterns.polynomial import generate
 from zmpwalk.robots import load_robot
+from zmpwalk.robots.tree import base_mount, root_from_base
 
 ROBOTS = Path(__file__).resolve().parents[2] / "shared" / "robots"
 TALOS = ROBOTS / "pal_talos" / "scene_position.xml"
@@ -66,7 +67,10 @@ def test_ready_posture_puts_the_com_over_the_feet() -> None:
         data = mujoco.MjData(model)
         assert robot.plant is not None and joints.position_base_in_world is not None
         data.qpos[:] = robot.plant.qpos_reference
-        data.qpos[0:3] = joints.position_base_in_world[0]
+        base = model.body(robot.plant.base_body).id  # T1's Waist, below its floating Trunk
+        mount = base_mount(model, data.qpos, 1, base)
+        data.qpos[0:3], rotation = root_from_base(mount, joints.position_base_in_world[0], np.eye(3))
+        assert rotation == pytest.approx(np.eye(3), abs=1e-12)  # the waist straight in the keyframe
         data.qpos[3:7] = (1, 0, 0, 0)
         for column, joint in enumerate(robot.plant.joints):
             data.qpos[model.joint(joint.name).qposadr[0]] = joints.angles[0, column]

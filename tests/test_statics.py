@@ -68,14 +68,35 @@ def test_one_foot_torques_are_the_moment_of_what_each_joint_holds(path: Path) ->
 
 
 @needs_robots
+@pytest.mark.parametrize("path", [TALOS, T1], ids=["talos", "t1"])
+def test_both_feet_is_the_ready_posture(path: Path) -> None:
+    """Standing, the base is at the ready posture's height and the knees bent as in it (the CoM over the soles'
+    centres rather than the ankles moves the others by a few hundredths of a radian)."""
+    robot = load_robot(path)
+    assert robot.plant is not None and robot.legs is not None
+    statics = static_torques(robot)
+    plant = build_plant(robot)
+    data = mujoco.MjData(plant.model)
+    data.qpos[:] = statics.poses[0]
+    mujoco.mj_kinematics(plant.model, data)
+    pelvis = mujoco.mj_name2id(plant.model, mujoco.mjtObj.mjOBJ_SITE, "pelvis")
+    assert data.site_xpos[pelvis][2] == pytest.approx(robot.pelvis_height, abs=1e-9)  # [m]
+    columns = list(plant.leg_columns)
+    knees = [statics.poses[0][plant.leg_qpos[columns.index(c)]] for c in (3, 9)]  # [rad] the knee columns
+    ready = [chain.reference[3] for chain in robot.legs]  # [rad] a chain's fourth joint is its knee
+    assert knees == pytest.approx(ready, abs=0.01)  # [rad]
+
+
+@needs_robots
 def test_t1_one_foot_torques_and_limits() -> None:
     statics = static_torques(load_robot(T1))
     column = {name: i for i, name in enumerate(JOINT_COLUMNS)}
-    # Booster T1's pitch-roll-yaw hip: the sideways moment of ~26 kg lands on its 30 N m hip roll and yaw.
-    assert abs(statics.on_right[column["right_hip_roll"]]) == pytest.approx(24.75, abs=0.05)
-    assert abs(statics.on_right[column["right_hip_yaw"]]) == pytest.approx(25.40, abs=0.05)
+    # Booster T1's pitch-roll-yaw hip in its ready posture: the sideways moment of ~26 kg over one sole needs
+    # 33 N m of its 30 N m hip roll (a walk's sway keeps the CoM inside of the sole's centre).
+    assert abs(statics.on_right[column["right_hip_roll"]]) == pytest.approx(32.90, abs=0.05)
+    assert abs(statics.on_right[column["right_hip_yaw"]]) == pytest.approx(14.18, abs=0.05)
     assert statics.limits[column["right_hip_roll"]] == pytest.approx(30.0)
-    assert statics.over_limit == []
+    assert statics.over_limit == ["left_hip_roll", "right_hip_roll"]
     assert statics.one_foot == pytest.approx(np.maximum(np.abs(statics.on_left), np.abs(statics.on_right)))
 
 
@@ -92,10 +113,11 @@ def test_zmpwalk_robot_prints_the_static_torques_and_flags_what_exceeds(capsys: 
 
     assert main(["robot", str(T1)]) == 0
     out = capsys.readouterr().out
-    assert "2 feet" in out and "1 foot" in out and "over the actuator's limit standing still: none" in out
+    assert "2 feet" in out and "1 foot" in out
+    assert "over the actuator's limit standing still: left_hip_roll, right_hip_roll" in out
     assert main(["robot", str(T1), "--json"]) == 0
     joints = {j["column"]: j for j in json.loads(capsys.readouterr().out)["joints"]}
-    assert abs(joints["right_hip_roll"]["static_torque"]["on_right"]) == pytest.approx(24.75, abs=0.05)
+    assert abs(joints["right_hip_roll"]["static_torque"]["on_right"]) == pytest.approx(32.90, abs=0.05)
 
 
 def test_a_limit_below_the_static_torque_is_named() -> None:

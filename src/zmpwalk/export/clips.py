@@ -36,7 +36,8 @@ from zmpwalk.online import START_DELAY
 from zmpwalk.robots.collision import collision_points, rigid_bodies
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sim.loop import ControllerRun, simulate_controller, simulated_clock
-from zmpwalk.sim.mujoco_plant import MujocoPlant, _ankle_sites, _base_position, _upright
+from zmpwalk.sim.mujoco_plant import MujocoPlant, _ankle_sites, _base_position
+from zmpwalk.sim.plant import set_base_pose
 
 Array = NDArray[np.float64]
 
@@ -103,8 +104,8 @@ class _RecordingPlant(MujocoPlant):
         if round(frame * self.every) == self._ticks and targets.sample.joint_angles is not None:
             sample, angles = targets.sample, targets.sample.joint_angles
             qpos = self.plant.qpos_hold.copy()
-            qpos[0:3] = _base_position(self.plant, self._scratch, sample, angles, self._sites)
-            _upright(qpos, sample.yaw_pelvis_in_world)
+            set_base_pose(self.plant, qpos, _base_position(self.plant, self._scratch, sample, angles, self._sites),
+                          sample.yaw_pelvis_in_world)
             qpos[self.plant.leg_qpos] = angles[self.plant.leg_columns]
             self.planned.append(qpos)
 

@@ -9,6 +9,7 @@ from collections.abc import Callable
 import numpy as np
 
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.sim.plant import set_base_pose
 from zmpwalk.sim.run import SimulationResult
 
 FPS = 12  # [1/s] frames of the GIF
@@ -48,8 +49,7 @@ def render_gif(robot: RobotModel, result: SimulationResult, fps: int = FPS,
     for i in range(0, len(result.time), step):
         if progress is not None and (i // step) % 20 == 0:
             progress(i / len(result.time))
-        data.qpos[0:3] = result.torso_position[i]
-        data.qpos[3:7] = rotation[i]
+        set_base_pose(plant, data.qpos, result.torso_position[i], 0.0, rotation[i])
         data.qpos[plant.leg_qpos] = result.joint_angles[i][plant.leg_columns]
         mujoco.mj_kinematics(model, data)
         views = []

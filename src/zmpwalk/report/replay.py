@@ -22,6 +22,7 @@ from zmpwalk.footsteps import Pose2D, foot_corners
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sim.contact import LOADED_FRACTION
+from zmpwalk.sim.plant import set_base_pose
 from zmpwalk.sim.run import SimulationResult
 
 FPS = 40  # [1/s] frames of the replay
@@ -117,8 +118,7 @@ def _frames(plant: Any, result: SimulationResult, bodies: list[int]) -> dict[str
 def _pose(plant: Any, data: mujoco.MjData, result: SimulationResult, rotation: np.ndarray, i: int) -> None:
     """Set ``data`` to the recorded pose at row ``i`` (world poses computed)."""
     data.qpos[:] = plant.qpos_hold
-    data.qpos[0:3] = result.torso_position[i]
-    data.qpos[3:7] = rotation[i]
+    set_base_pose(plant, data.qpos, result.torso_position[i], 0.0, rotation[i])
     data.qpos[plant.leg_qpos] = result.joint_angles[i][plant.leg_columns]
     mujoco.mj_kinematics(plant.model, data)
 

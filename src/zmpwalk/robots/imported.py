@@ -4,7 +4,10 @@
 zmpwalk needs (the builder's model is the single source of truth):
 
 * **Floating base**: the body with the free joint (a URDF gets one at its root
-  link). Its frame is the **pelvis frame** of zmpwalk (x forward, y left, z up).
+  link). The legs' base is the body where the two feet's paths part: the root
+  itself where the legs hang from it, else the pelvis below a waist (whose joints
+  are then held). Its frame is the **pelvis frame** of zmpwalk (x forward, y
+  left, z up), and the simulator's sensors (attitude, gyro) sit on it.
 * **Feet**: with no mapping, the two bodies whose collision geoms reach lowest in
   the reference pose (the model's keyframe, or its zero pose), one each side of
   the base (``y > 0`` left). Two candidates within
@@ -63,7 +66,15 @@ from zmpwalk.robots.description import HUBO_FOOT_LIFT, LIFT_RANGE_MARGIN, Actuat
 from zmpwalk.robots.legs import VIRTUAL_PREFIX, FootAtReference, Segments, build_leg, leg_joint_ids, segments
 from zmpwalk.robots.model import RobotModel, schedule_scale
 from zmpwalk.robots.pd import element_name, pd_layer
-from zmpwalk.robots.tree import find_feet, floating_base, keyframe_index
+from zmpwalk.robots.tree import (
+    Mount,
+    base_mount,
+    find_feet,
+    floating_base,
+    keyframe_index,
+    legs_base,
+    root_from_base,
+)
 
 Array = NDArray[np.float64]
 
@@ -166,18 +177,20 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     source = str(path)
     model = load_model(path, package_paths)
     data = mujoco.MjData(model)
-    base = floating_base(model, source)
+    root = floating_base(model, source)
     key_id = keyframe_index(model, keyframe, source)
     qpos_reference = model.key_qpos[key_id].copy() if key_id >= 0 else model.qpos0.copy()
     data.qpos[:] = qpos_reference
     mujoco.mj_kinematics(model, data)
-    foot_ids = find_feet(model, data, base, feet, source)
+    foot_ids = find_feet(model, data, root, feet, source)
     feet_at_reference = [_foot_at_reference(model, data, foot, label, source)
                          for foot, label in zip(foot_ids, ("left", "right"), strict=True)]
+    base = legs_base(model, root, foot_ids)  # the pelvis: below a waist, not the floating root
+    mount = base_mount(model, qpos_reference, root, base)
     legs = leg_joint_ids(model, base, foot_ids, source)
     leg_joint_set = {j for leg in legs for j in leg}
-    base_joint = int(model.body_jntadr[base])
-    adr = int(model.jnt_qposadr[base_joint])
+    root_joint = int(model.body_jntadr[root])
+    adr = int(model.jnt_qposadr[root_joint])
     base_rotation, base_origin = _zero_pose(model, data, qpos_reference, leg_joint_set, base, adr)
 
     def in_pelvis(point: Array) -> Array:
@@ -199,10 +212,10 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
                                               ankle_height, thigh + shank)
     model_name = model.names[:model.names.find(b"\0")].decode()
     robot_name = name or re.sub(r"[^A-Za-z0-9_.-]+", "-", model_name).strip("-") or path.stem
-    plant = _model_plant(model, path, base, foot_ids, key_id, leg_joint_set | {base_joint}, masses, polygon,
+    plant = _model_plant(model, path, base, foot_ids, key_id, leg_joint_set | {root_joint}, masses, polygon,
                          package_paths)
-    ready = _ready_posture(model, data, chains, legs, qpos_reference, adr, distance, hip_x, hip_spacing, hip_drop,
-                           ankle_height, values.get("pelvis_height"), source)
+    ready = _ready_posture(model, data, chains, legs, qpos_reference, (adr, mount), distance, hip_x, hip_spacing,
+                           hip_drop, ankle_height, values.get("pelvis_height"), source)
     pelvis_height, pendulum, com_offset, chains_ready, qpos = ready
     length_scale = schedule_scale(pendulum, thigh + shank, hip_spacing)[1]
     lift = _foot_lift(chains_ready, leg_joints, HUBO_FOOT_LIFT * length_scale)  # [m]
@@ -408,12 +421,13 @@ def _foot_at_reference(model: object, data: object, foot: int, label: str, sourc
 
 
 def _ready_posture(model: Any, data: Any, chains: list[LegChain], legs: list[list[int]], qpos_reference: Array,
-                   adr: int, distance: float, hip_x: float, hip_spacing: float, hip_drop: float, ankle_height: float,
-                   pelvis_height_override: float | None, source: str
+                   root: tuple[int, Mount | None], distance: float, hip_x: float, hip_spacing: float,
+                   hip_drop: float, ankle_height: float, pelvis_height_override: float | None, source: str
                    ) -> tuple[float, float, Array, list[LegChain], Array]:
     """The ready posture: the ankles ``hip_spacing`` apart below the pattern's point with the soles level, the
     hip-to-ankle distance ``distance`` [m]. The pattern moves the CoM: its offset from the base origin moves the
-    posture, which moves the CoM, to a fixed point (within 1e-7 m).
+    posture, which moves the CoM, to a fixed point (within 1e-7 m). ``root``: the floating root's ``qpos`` address
+    and where the legs' base sits on it (:func:`~zmpwalk.robots.tree.base_mount`).
 
     Returns:
         The pelvis height [m], the pendulum length (the CoM's height) [m], the CoM offset from the base origin
@@ -428,6 +442,7 @@ def _ready_posture(model: Any, data: Any, chains: list[LegChain], legs: list[lis
     pelvis_height = pendulum = 0.0
     chains_ready = chains
     qpos = qpos_reference.copy()
+    adr, mount = root
     for _ in range(8):  # fixed point: posture -> CoM offset -> posture
         dx = hip_x - com_offset[0]
         vertical = math.sqrt(max(distance * distance - dx * dx, 1e-12))
@@ -435,7 +450,9 @@ def _ready_posture(model: Any, data: Any, chains: list[LegChain], legs: list[lis
                               else pelvis_height_override)
         chains_ready = []
         qpos = qpos_reference.copy()
-        qpos[adr:adr + 7] = (0, 0, pelvis_height, 1, 0, 0, 0)
+        position_root, rotation_root = root_from_base(mount, np.array([0.0, 0.0, pelvis_height]), np.eye(3))
+        qpos[adr:adr + 3] = position_root
+        mujoco.mju_mat2Quat(qpos[adr + 3:adr + 7], rotation_root.flatten())
         for chain, side, leg in zip(chains, (1, -1), legs, strict=True):
             # the ankle below the pattern point, which is the CoM offset from the base origin; the sole level
             target = np.array([[com_offset[0], side * hip_spacing / 2 + com_offset[1], ankle_height - pelvis_height]])

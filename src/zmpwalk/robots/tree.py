@@ -1,13 +1,20 @@
 """The kinematic tree of a robot's own model: its floating base, its keyframe, the paths from the base to a body,
-and its two feet (the lowest bodies with collision geoms, one each side of the base)."""
+its two feet (the lowest bodies with collision geoms, one each side of the base) and the legs' base (the body where
+the feet's paths part) with its place on the floating base."""
 
 from __future__ import annotations
 
 import re
 
+import numpy as np
+from numpy.typing import NDArray
+
 from zmpwalk.errors import FileFormatError
 from zmpwalk.robots.collision import collision_points
 from zmpwalk.robots.pd import element_name
+
+Array = NDArray[np.float64]
+Mount = tuple[Array, Array]  # the legs' base in the root body's frame: origin [m] (3,), rotation (3, 3)
 
 FOOT_TIE = 0.005  # [m] two foot candidates this close in height on one side are ambiguous
 
@@ -125,3 +132,39 @@ def ancestors(model: object, body: int) -> list[int]:
         body = int(model.body_parentid[body])  # type: ignore[attr-defined]
         result.append(body)
     return result
+
+
+def legs_base(model: object, root: int, feet: list[int]) -> int:
+    """The legs' base: the last body on both feet's paths from ``root`` (the pelvis, below a waist whose joints are
+    then held, not legs), or ``root`` itself where the legs hang from it."""
+    base = root
+    for left, right in zip(body_path(model, root, feet[0]), body_path(model, root, feet[1]), strict=False):
+        if left != right:
+            break
+        base = left
+    return base
+
+
+def base_mount(model: object, qpos: Array, root: int, base: int) -> Mount | None:
+    """Where the legs' ``base`` sits on the floating ``root`` with the model at ``qpos`` (the held joints between
+    them at the reference pose): its origin [m] and rotation in the root's frame; None where it is the root."""
+    import mujoco
+
+    if base == root:
+        return None
+    data = mujoco.MjData(model)
+    data.qpos[:] = qpos
+    mujoco.mj_kinematics(model, data)
+    rotation_root = data.xmat[root].reshape(3, 3)
+    return (rotation_root.T @ (data.xpos[base] - data.xpos[root]),
+            rotation_root.T @ data.xmat[base].reshape(3, 3))
+
+
+def root_from_base(mount: Mount | None, position_base: Array, rotation_base: Array) -> tuple[Array, Array]:
+    """The floating root's position [m] and rotation in world that put the legs' base at ``position_base`` [m]
+    with ``rotation_base`` (:func:`base_mount`'s ``mount``)."""
+    if mount is None:
+        return np.asarray(position_base, dtype=np.float64), np.asarray(rotation_base, dtype=np.float64)
+    offset, rotation = mount
+    rotation_root = rotation_base @ rotation.T
+    return position_base - rotation_root @ offset, rotation_root

@@ -12,6 +12,7 @@ for one sample at a time (:class:`zmpwalk.control.controller.Feedforward`).
 from __future__ import annotations
 
 import copy
+import dataclasses
 import math
 
 import mujoco
@@ -27,7 +28,7 @@ from zmpwalk.sample import WalkingSample
 from zmpwalk.sim.disturbances import NOSLIP_ITERATIONS, SensorNoise
 from zmpwalk.sim.mjcf import contact_mapping
 from zmpwalk.sim.plant import Plant as SimPlant
-from zmpwalk.sim.plant import build_plant, passive_torques, set_initial_state, static_feedforward
+from zmpwalk.sim.plant import build_plant, passive_torques, set_base_pose, set_initial_state, static_feedforward
 from zmpwalk.sim.ranges import check_range
 from zmpwalk.sim.run import FALL_HEIGHT_FRACTION, FALL_TILT, Disturbances, _MeasurementReader
 from zmpwalk.sim.soles import SensorSlices
@@ -35,11 +36,6 @@ from zmpwalk.sim.soles import SensorSlices
 Array = NDArray[np.float64]
 
 _STEPS_IN_ONE_CALL = "nstep" in (mujoco.mj_step.__doc__ or "")  # mj_step(m, d, nstep): the steps of a tick in one call
-
-
-def _upright(qpos: Array, yaw: float) -> None:
-    """Set the free base's orientation in ``qpos`` to upright at ``yaw`` [rad]."""
-    qpos[3:7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
 
 
 def _ankle_sites(model: mujoco.MjModel) -> tuple[int, int]:
@@ -58,12 +54,12 @@ def _held_angles(plant: SimPlant) -> Array:
 def _base_position(plant: SimPlant, data: mujoco.MjData, sample: WalkingSample, angles: Array,
                    sites: tuple[int, int]) -> Array:
     """The base origin [m] (3,) of a sample's pose: the pelvis point on a box model; on a robot's own model, where
-    the leg angles put the ankles at the sample's (on average; the walker's pelvis point is its whole-body CoM)."""
+    the leg angles put the ankles at the sample's (on average; the walker's pelvis point is its whole-body CoM),
+    the base upright at the sample's yaw."""
     if not plant.imported:
         return np.array(sample.position_pelvis_in_world, dtype=np.float64)
     data.qpos[:] = plant.qpos_hold
-    data.qpos[0:3] = 0.0
-    _upright(data.qpos, sample.yaw_pelvis_in_world)
+    set_base_pose(plant, data.qpos, np.zeros(3), sample.yaw_pelvis_in_world)
     data.qpos[plant.leg_qpos] = angles[plant.leg_columns]
     mujoco.mj_kinematics(plant.model, data)
     planned = (sample.position_left_ankle_in_world, sample.position_right_ankle_in_world)
@@ -126,12 +122,15 @@ class ModelFeedforward:
         plant, model, data = self.plant, self.plant.model, self._data
         angles = sample.joint_angles if sample.joint_angles is not None else _held_angles(plant)
         qpos = self._qpos
-        if plant.imported:
-            qpos[0:3] = _base_position(plant, self._scratch, sample, angles, self._sites)
-        else:  # the box model's base is the pelvis point
-            qpos[0:3] = sample.position_pelvis_in_world
         yaw = sample.yaw_pelvis_in_world
-        qpos[3], qpos[6] = math.cos(yaw / 2), math.sin(yaw / 2)  # upright: qpos[4:6] stay 0
+        if plant.mount is not None:  # the legs' base below a waist: the root placed from it
+            set_base_pose(plant, qpos, _base_position(plant, self._scratch, sample, angles, self._sites), yaw)
+        else:
+            if plant.imported:
+                qpos[0:3] = _base_position(plant, self._scratch, sample, angles, self._sites)
+            else:  # the box model's base is the pelvis point
+                qpos[0:3] = sample.position_pelvis_in_world
+            qpos[3], qpos[6] = math.cos(yaw / 2), math.sin(yaw / 2)  # upright: qpos[4:6] stay 0
         if self._leg_slice is not None:
             qpos[self._leg_slice] = angles
         else:
@@ -232,8 +231,7 @@ class MujocoPlant:
                                         f"{model.opt.timestep:g} s time steps (at most {1 / model.opt.timestep:g} Hz)")
         self.robot, self.plant, self.rate = robot, plant, float(rate)
         self.steps_per_tick = round(steps)
-        self._nominal = SimPlant(copy.deepcopy(model), plant.leg_actuators, plant.leg_qpos, plant.ctrl_hold,
-                                 plant.qpos_hold, plant.imported, plant.leg_columns)
+        self._nominal = dataclasses.replace(plant, model=copy.deepcopy(model))
         self.disturbances = disturbances
         if disturbances is not None:
             disturbances.apply(model)

@@ -45,6 +45,7 @@ from zmpwalk.robots.description import PHYSICS_STEP, ModelPlant
 from zmpwalk.robots.imported import load_model_spec
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.robots.pd import is_position_servo
+from zmpwalk.robots.tree import Mount, base_mount, floating_base, root_from_base
 from zmpwalk.sides import Support
 
 LEFT_SUPPORT, RIGHT_SUPPORT = int(Support.LEFT), int(Support.RIGHT)  # plain ints: a numpy integer compares with
@@ -68,6 +69,8 @@ class Plant:
         ctrl_hold: Controls of the reference pose (the other actuators keep them), (nu,).
         qpos_hold: The reference pose, (nq,).
         imported: True for the robot's own model, False for the box model.
+        mount: Where the legs' base (the pelvis, whose pose the plan gives and the sensors read) sits on the
+            floating root below a waist (:func:`~zmpwalk.robots.tree.base_mount`); None where it is the root.
     """
 
     model: mujoco.MjModel
@@ -77,6 +80,7 @@ class Plant:
     qpos_hold: Array
     imported: bool
     leg_columns: NDArray[np.intp] = field(default_factory=lambda: np.arange(12))
+    mount: Mount | None = None
 
 
 def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
@@ -102,6 +106,9 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
         spec.option.timestep = MAX_TIMESTEP
     if not any(g.type == mujoco.mjtGeom.mjGEOM_PLANE for g in spec.worldbody.geoms):
         spec.worldbody.add_geom(name="zmpwalk_floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 0.05])
+    for index, actuator in enumerate(spec.actuators):  # the names the robot gives them (robots.pd.element_name)
+        if not actuator.name:
+            actuator.name = f"#{index}"
     add_pd_layer(spec, plant)
     lift_control_ranges(spec, model)
     qpos = np.array(plant.qpos_reference)
@@ -113,7 +120,9 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
     columns = np.array([i for i in range(12) if i not in virtual], dtype=np.intp)
     leg_qpos = np.array([model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, plant.joints[i].name)]
                          for i in columns])
-    return Plant(model, np.array(actuators), leg_qpos, _held_controls(model, plant), qpos, True, columns)
+    root = floating_base(model, str(plant.path))
+    mount = base_mount(model, qpos, root, mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, plant.base_body))
+    return Plant(model, np.array(actuators), leg_qpos, _held_controls(model, plant), qpos, True, columns, mount)
 
 
 def _add_sites(spec: mujoco.MjSpec, model: mujoco.MjModel, robot: RobotModel, plant: ModelPlant,
@@ -126,9 +135,12 @@ def _add_sites(spec: mujoco.MjSpec, model: mujoco.MjModel, robot: RobotModel, pl
     zero = qpos.copy()
     for j in joint_ids:
         zero[model.jnt_qposadr[j]] = 0.0
-    base = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, plant.base_body)
-    base_adr = int(model.jnt_qposadr[model.body_jntadr[base]])
-    zero[base_adr:base_adr + 7] = (0, 0, 0, 1, 0, 0, 0)
+    root = floating_base(model, str(plant.path))
+    root_adr = int(model.jnt_qposadr[model.body_jntadr[root]])
+    mount = base_mount(model, qpos, root, mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, plant.base_body))
+    position_root, rotation_root = root_from_base(mount, np.zeros(3), np.eye(3))  # the base at the origin
+    zero[root_adr:root_adr + 3] = position_root
+    mujoco.mju_mat2Quat(zero[root_adr + 3:root_adr + 7], rotation_root.flatten())
     data.qpos[:] = zero
     mujoco.mj_kinematics(model, data)
     if robot.legs is None:
@@ -265,14 +277,32 @@ def _held_controls(model: mujoco.MjModel, plant: ModelPlant) -> Array:
     return controls
 
 
+def set_base_pose(plant: Plant, qpos: Array, position_base: Array, yaw: float,
+                  quaternion_base: Array | None = None) -> None:
+    """Write the floating root's pose into ``qpos`` (its first 7 values) that puts the legs' base at
+    ``position_base`` [m], upright at ``yaw`` [rad] (or turned by ``quaternion_base`` (w, x, y, z), where given)."""
+    if plant.mount is None:
+        qpos[0:3] = position_base
+        qpos[3:7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)) if quaternion_base is None else quaternion_base
+        return
+    quaternion = np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)] if quaternion_base is None
+                          else quaternion_base, dtype=np.float64)  # a copy: the caller's stays as given
+    rotation_base = np.empty(9)
+    mujoco.mju_quat2Mat(rotation_base, quaternion)
+    position_root, rotation_root = root_from_base(plant.mount, np.asarray(position_base, dtype=np.float64),
+                                                  rotation_base.reshape(3, 3))
+    qpos[0:3] = position_root
+    mujoco.mju_mat2Quat(quaternion, rotation_root.flatten())
+    qpos[3:7] = quaternion
+
+
 def set_initial_state(plant: Plant, data: mujoco.MjData, position_base: Array, yaw: float, angles: Array,
                       penetration: float = 0.0) -> None:
     """Stand the plant in the first pose at rest: the base origin [m] and yaw [rad], the leg angles (12,)
     [rad], the other joints at the reference pose, the lowest sole ``penetration`` [m] into the ground."""
     model = plant.model
     data.qpos[:] = plant.qpos_hold
-    data.qpos[0:3] = position_base
-    data.qpos[3:7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
+    set_base_pose(plant, data.qpos, position_base, yaw)
     data.qpos[plant.leg_qpos] = angles[plant.leg_columns]
     data.qvel[:] = 0.0
     data.ctrl[:] = plant.ctrl_hold
@@ -308,8 +338,12 @@ def plant_qpos(plant: Plant, position_base: Array, yaw: Array, angles: Array) ->
     leg joint columns (n, 12), the other joints at the reference pose."""
     n = len(yaw)
     qpos = np.repeat(plant.qpos_hold[None, :], n, axis=0)
-    qpos[:, 0:3] = position_base
-    qpos[:, 3:7] = np.column_stack([np.cos(yaw / 2), np.zeros(n), np.zeros(n), np.sin(yaw / 2)])
+    if plant.mount is None:
+        qpos[:, 0:3] = position_base
+        qpos[:, 3:7] = np.column_stack([np.cos(yaw / 2), np.zeros(n), np.zeros(n), np.sin(yaw / 2)])
+    else:
+        for row, position, angle in zip(qpos, position_base, yaw, strict=True):
+            set_base_pose(plant, row, position, float(angle))
     qpos[:, plant.leg_qpos] = angles[:, plant.leg_columns]
     return qpos
 

@@ -8,9 +8,12 @@ it (the foot is the root of the chain):
 .. math:: \tau_k = a_k \cdot \sum_{b \notin \mathrm{sub}(k)} (x_b - o_k) \times m_b\, g
 
 with ``a_k`` and ``o_k`` the joint's axis and anchor and ``sub(k)`` the bodies between the joint and the
-foot; with an upright torso it depends on the posture only, not on where the feet are. Booster T1 in its
-walking posture, for one, needs 24.9 N m at the stance hip roll and 25.5 N m at the hip yaw (its
-pitch-roll-yaw hip shares the sideways moment between them), each of a 30 N m limit, before any motion.
+foot; with an upright torso it depends on the posture only, not on where the feet are. The posture is the
+ready posture's (the pattern's point at the base height, the legs' reference bend); on one foot the other foot
+is raised by the robot's foot lift (the apex of a step in place), so that a leg that cannot reach the floor
+beside a base moved over the other sole still has a posture. Booster T1, for one, needs 33.1 N m at the stance
+hip roll (of a 30 N m limit) and 14.2 N m at its hip yaw (its pitch-roll-yaw hip shares the sideways moment
+between them) to hold the centre of mass over one sole: a walk's sway keeps it inside the sole's centre.
 
 The torques come from the same inverse dynamics as the simulation's feedforward
 (:func:`zmpwalk.sim.plant.servo_torques`, ``dynamic=False``): gravity minus the planned ground
@@ -38,7 +41,8 @@ class StaticTorques:
 
     Attributes:
         both_feet: Standing on both feet, the centre of mass midway between the soles' centres.
-        on_left: All weight on the left sole, the centre of mass over its centre, the right foot unloaded.
+        on_left: All weight on the left sole, the centre of mass over its centre, the right foot raised by the
+            foot lift.
         on_right: The same on the right foot.
         limits: Each joint's actuator torque limit [N m] (inf where unlimited).
         poses: The model's ``qpos`` of the three postures (both feet, on the left, on the right), (3, nq).
@@ -80,10 +84,12 @@ def static_torques(robot: RobotModel) -> StaticTorques:
     plant = build_plant(robot)
     half = robot.hip_spacing / 2
     ankles = [np.array([[0.0, side * half, robot.ankle_height]] * 3) for side in (1, -1)]
+    ankles[1][1, 2] += robot.foot_lift  # [m] on the left sole the right foot is raised, and the other way round
+    ankles[0][2, 2] += robot.foot_lift
     sole = np.array([robot.sole_center_x, half + robot.sole_center_y])
     # rows: both feet, on the left sole, on the right sole
     com_xy = np.array([[robot.sole_center_x, 0.0], sole, sole * (1.0, -1.0)])
-    com = np.column_stack([com_xy, np.full(3, robot.pendulum_length)])
+    com = np.column_stack([com_xy, np.full(3, robot.pelvis_height)])  # the pattern's point: the base's height
     zero, still = np.zeros(3), np.zeros((3, 3))
     legs = joint_trajectory(np.arange(3.0), com, zero, still, zero,
                             ((ankles[0], zero, still, zero), (ankles[1], zero, still, zero)),

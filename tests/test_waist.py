@@ -1,0 +1,211 @@
+"""Legs below a waist: a model whose floating root is the torso, the legs hanging from a pelvis under waist joints
+(ToddlerBot's class). The legs' base is the pelvis: the import's frame, the plant's sensors and the pose the plan
+gives, the root placed from it (zmpwalk.robots.tree)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from zmpwalk.online import OnlineWalker
+from zmpwalk.robots import load_robot
+from zmpwalk.robots.tree import base_mount, root_from_base
+from zmpwalk.sim.mujoco_plant import MujocoPlant
+from zmpwalk.sim.plant import build_plant, set_base_pose
+
+TORSO_MASS = 8.0  # [kg]
+TORSO_COM = (0.02, 0.0, 0.25)  # [m] in the pelvis frame at the reference pose
+WAIST = (0.0, 0.0, 0.12)  # [m] the waist joints' place in the pelvis frame
+
+
+def _inertia(mass: float, x: float, y: float, z: float) -> str:
+    return f"{mass / 12 * (y * y + z * z):.6g} {mass / 12 * (x * x + z * z):.6g} {mass / 12 * (x * x + y * y):.6g}"
+
+
+def _legs() -> str:
+    """Two six-joint legs (hip yaw, roll, pitch, knee, ankle pitch, roll), 0.2 m apart, torque motors."""
+    spec = (("hip_yaw", "0 0 1", 0.5, "0 0 0", "0.001 0.001 0.001", "-0.8 0.8", "0 {y} -0.1"),
+            ("hip_roll", "1 0 0", 0.5, "0 0 0", "0.001 0.001 0.001", "-0.6 0.6", "0 0 0"),
+            ("hip_pitch", "0 1 0", 1.5, "0 0 -0.15", _inertia(1.5, 0.06, 0.06, 0.3), "-1.6 1.0", "0 0 0"),
+            ("knee", "0 1 0", 1.0, "0 0 -0.15", _inertia(1.0, 0.05, 0.05, 0.3), "0 2.4", "0 0 -0.3"),
+            ("ankle_pitch", "0 1 0", 0.1, "0 0 0", "0.0001 0.0001 0.0001", "-1.0 1.0", "0 0 -0.3"),
+            ("ankle_roll", "1 0 0", 0.8, "0.02 0 -0.05", _inertia(0.8, 0.22, 0.14, 0.02), "-0.5 0.5", "0 0 0"))
+    legs = ""
+    for side, y in (("l", 0.1), ("r", -0.1)):
+        inner = '<geom type="box" size="0.11 0.07 0.01" pos="0.02 0 -0.05" mass="0"/>'
+        for name, axis, mass, com, inertia, limits, pos in reversed(spec):
+            inner = (f'<body name="{side}_{name}_link" pos="{pos.format(y=y)}"><joint name="{side}_{name}" '
+                     f'axis="{axis}" range="{limits}"/><inertial pos="{com}" mass="{mass}" diaginertia="{inertia}"/>'
+                     f"{inner}</body>")
+        legs += inner
+    return legs
+
+
+def _motors(named: bool = True) -> str:
+    joints = [f"{side}_{name}" for side in "lr"
+              for name in ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll")]
+    return "".join(f'<motor {f"name={joint!r} " if named else ""}joint="{joint}" ctrlrange="-80 80"/>'
+                   for joint in joints)
+
+
+def waisted_biped(slack: float = 0.0, waist_roll: float = 0.0) -> str:
+    """A 19.6 kg biped whose floating root is an 8 kg torso on a waist (yaw, then roll) above the pelvis the legs
+    hang from (torque motors). The waist roll is driven through a gear joint on the pelvis (``waist_act``, a
+    position servo), coupled by a tendon that leaves it ``slack`` [rad] either way, as ToddlerBot's; the keyframe
+    rolls the waist by ``waist_roll`` [rad]."""
+    wx, wy, wz = WAIST
+    tx, ty, tz = TORSO_COM
+    limited = f'limited="true" range="{-slack - 1e-6} {slack + 1e-6}"'
+    return f"""<mujoco model="waisted"><compiler angle="radian"/>
+<default><joint armature="0.01" damping="0.1"/></default>
+<worldbody><geom name="floor" type="plane" size="5 5 .1"/>
+<body name="torso" pos="{wx} {wy} {0.7 + wz}"><freejoint/>
+ <inertial pos="{tx - wx} {ty - wy} {tz - wz}" mass="{TORSO_MASS}" diaginertia="{_inertia(TORSO_MASS, .2, .3, .3)}"/>
+ <body name="waist_link"><joint name="waist_yaw" axis="0 0 1" range="-1 1"/>
+  <inertial pos="0 0 0" mass="0.05" diaginertia="0.0001 0.0001 0.0001"/>
+  <body name="pelvis" pos="{-wx} {-wy} {-wz}"><joint name="waist_roll" axis="1 0 0" pos="{wx} {wy} {wz}" range="-1 1"/>
+   <inertial pos="0 0 0" mass="2" diaginertia="0.02 0.02 0.02"/>
+   <body name="waist_gear"><joint name="waist_act" axis="0 1 0" range="-3 3"/>
+    <inertial pos="0 0 0" mass="0.01" diaginertia="0.00001 0.00001 0.00001"/></body>
+   {_legs()}
+  </body>
+ </body>
+</body></worldbody>
+<tendon><fixed name="waist_coupling" {limited}><joint joint="waist_roll" coef="1"/><joint joint="waist_act" coef="-1"/>
+</fixed></tendon>
+<actuator>{_motors()}<position joint="waist_act" kp="400" kv="20"/><position joint="waist_yaw" kp="400" kv="20"/>
+</actuator>
+<keyframe><key name="home" qpos="{wx} {wy} {0.7 + wz} 1 0 0 0 0 {waist_roll} {waist_roll} {'0 ' * 12}"/></keyframe>
+</mujoco>"""
+
+
+def pelvis_rooted_biped(named: bool = True) -> str:
+    """The same masses with the pelvis as the floating root and the torso welded above it; its motors ``named``
+    or not."""
+    wx, wy, wz = WAIST
+    tx, ty, tz = TORSO_COM
+    return f"""<mujoco model="rooted"><compiler angle="radian"/>
+<default><joint armature="0.01" damping="0.1"/></default>
+<worldbody><geom name="floor" type="plane" size="5 5 .1"/>
+<body name="pelvis" pos="0 0 0.7"><freejoint/><inertial pos="0 0 0" mass="2" diaginertia="0.02 0.02 0.02"/>
+ <body name="torso"><inertial pos="{tx} {ty} {tz}" mass="{TORSO_MASS}" diaginertia="0.1 0.1 0.1"/></body>
+ <body name="waist_link" pos="{wx} {wy} {wz}"><inertial pos="0 0 0" mass="0.05" diaginertia="0.0001 0.0001 0.0001"/>
+ </body>
+ <body name="waist_gear"><inertial pos="0 0 0" mass="0.01" diaginertia="0.00001 0.00001 0.00001"/></body>
+ {_legs()}
+</body></worldbody>
+<actuator>{_motors(named)}</actuator>
+</mujoco>"""
+
+
+def write(tmp_path: Path, name: str, text: str) -> Path:
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_the_legs_base_is_the_pelvis_below_the_waist(tmp_path: Path) -> None:
+    """The pelvis's frame is the robot's: the hips, the sole, the ready posture and the CoM offset are those of the
+    same masses with the pelvis as the root (the torso's inertia about its own CoM aside, which no figure uses);
+    the waist joints are held."""
+    waisted = load_robot(write(tmp_path, "waisted.xml", waisted_biped()))
+    rooted = load_robot(write(tmp_path, "rooted.xml", pelvis_rooted_biped()))
+    assert waisted.plant is not None and waisted.plant.base_body == "pelvis"
+    assert {"waist_yaw", "waist_roll", "waist_act"} <= set(waisted.plant.held_joints)
+    assert waisted.legs is not None and rooted.legs is not None
+    for mine, theirs in zip(waisted.legs, rooted.legs, strict=True):
+        assert mine.hip == pytest.approx(theirs.hip, abs=1e-12)  # [m]
+        assert mine.reference == pytest.approx(theirs.reference, abs=1e-9)  # [rad] the ready posture
+    for field in ("pelvis_height", "pendulum_length", "ankle_height", "hip_spacing"):
+        assert getattr(waisted, field) == pytest.approx(getattr(rooted, field), abs=1e-9), field  # [m]
+    assert waisted.com_offset == pytest.approx(rooted.com_offset, abs=1e-9)  # [m]
+    assert waisted.mass == pytest.approx(rooted.mass, abs=1e-12)  # [kg]
+
+
+@pytest.mark.parametrize("waist_roll", [0.0, 0.1])
+def test_the_root_is_placed_from_the_pelvis(tmp_path: Path, waist_roll: float) -> None:
+    """The plant writes the root's pose that puts the pelvis where the plan puts it, upright at its yaw or turned
+    by a given quaternion, with the waist rolled in the keyframe (the pelvis then turned on the root)."""
+    robot = load_robot(write(tmp_path, "waisted.xml", waisted_biped(waist_roll=waist_roll)))
+    plant = build_plant(robot)
+    model, data = plant.model, mujoco.MjData(plant.model)
+    pelvis = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "pelvis")
+    assert plant.mount is not None
+    offset, rotation = plant.mount
+    assert offset == pytest.approx(-rot_x(waist_roll) @ np.array(WAIST), abs=1e-12)  # [m] turned about the waist
+    assert rotation == pytest.approx(rot_x(waist_roll), abs=1e-12)
+    position, yaw = np.array([0.3, -0.2, 0.65]), 0.7  # [m], [rad]
+    data.qpos[:] = plant.qpos_hold
+    set_base_pose(plant, data.qpos, position, yaw)
+    mujoco.mj_kinematics(model, data)
+    assert data.xpos[pelvis] == pytest.approx(position, abs=1e-12)
+    assert data.xmat[pelvis].reshape(3, 3) == pytest.approx(rot_z(yaw), abs=1e-12)
+    quaternion = np.array([0.9, 0.1, -0.2, 0.3]) / np.linalg.norm([0.9, 0.1, -0.2, 0.3])
+    set_base_pose(plant, data.qpos, position, 0.0, quaternion)
+    mujoco.mj_kinematics(model, data)
+    assert data.xquat[pelvis] == pytest.approx(quaternion, abs=1e-12)
+    assert data.xpos[pelvis] == pytest.approx(position, abs=1e-12)
+    root, turned = root_from_base(base_mount(model, plant.qpos_hold, 1, pelvis), position, np.eye(3))
+    assert root == pytest.approx(position + np.array(WAIST), abs=1e-12)  # [m] the root's origin: the waist point
+    assert turned == pytest.approx(rot_x(-waist_roll), abs=1e-12)
+
+
+def test_the_plant_stands_the_pelvis_and_ankles_where_planned(tmp_path: Path) -> None:
+    """Stood at the walker's first sample, the ankle sites are at the planned ankles and the pelvis sensor reads
+    the pose the legs' angles put it in (the root placed from it)."""
+    robot = load_robot(write(tmp_path, "waisted.xml", waisted_biped()))
+    plant = MujocoPlant(robot, 1000.0)
+    sample = OnlineWalker(robot, rate=1000.0, joints=True).tick()
+    plant.stand(sample)
+    model, data = plant.model, plant.data
+    for label, planned in (("left", sample.position_left_ankle_in_world),
+                           ("right", sample.position_right_ankle_in_world)):
+        site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, f"{label}_ankle")
+        assert data.site_xpos[site][:2] == pytest.approx(planned[:2], abs=1e-9)  # [m]
+    measured = plant.measure()
+    assert measured.attitude == pytest.approx([0.0, 0.0], abs=1e-12)  # [rad] the pelvis upright
+    pelvis = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "pelvis")
+    assert data.xpos[pelvis][2] == pytest.approx(robot.pelvis_height, abs=2e-3)  # [m] the soles on the floor
+
+
+@pytest.mark.slow
+def test_a_biped_on_a_slack_waist_walks_its_side_steps(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """ToddlerBot's waist roll is coupled to its motor with 0.03 rad of slack either way: the torso rolls within
+    it, and a stabilizer that measured the torso for the pelvis leaned the legs by it (ToddlerBot fell at its
+    first side steps). Measured on the pelvis, 4 side steps of 5 cm pass."""
+    from zmpwalk.cli import main
+
+    path = write(tmp_path, "slack.xml", waisted_biped(slack=0.03))
+    steps = write(tmp_path, "side.toml", "[[steps]]\nduration = 0.8\nside = 0.05\nrepeat = 4\n")
+    code = main(["simulate", "--robot", str(path), str(steps), "--json"])
+    summary = json.loads(capsys.readouterr().out)
+    assert code == 0 and summary["verdict"]["state"] == "PASS" and not summary["fell"]
+    assert summary["distance"] == pytest.approx(0.2, abs=0.02)  # [m] four 5 cm steps
+
+
+def rot_x(angle: float) -> np.ndarray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def rot_z(angle: float) -> np.ndarray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def test_unnamed_motors_get_the_pd_layer(tmp_path: Path) -> None:
+    """A model whose motors have no names: the plant finds each by its index (``#index``, as the robot lists it)
+    and makes it the PD layer's position servo, with the gains the robot gives it."""
+    robot = load_robot(write(tmp_path, "unnamed.xml", pelvis_rooted_biped(named=False)))
+    assert robot.plant is not None
+    plant = build_plant(robot)
+    for (joint, actuator), index in zip(robot.plant.pd_joints, range(12), strict=False):
+        assert actuator.name == f"#{index}" and actuator.kind == "motor"
+        servo = mujoco.mj_name2id(plant.model, mujoco.mjtObj.mjOBJ_ACTUATOR, actuator.name)
+        assert servo == index and plant.model.actuator_trnid[servo][0] == plant.model.joint(joint).id
+        assert plant.model.actuator_gainprm[servo][0] == pytest.approx(actuator.kp, rel=1e-12)  # [N m/rad]
