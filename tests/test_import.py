@@ -67,10 +67,10 @@ def test_ready_posture_puts_the_com_over_the_feet() -> None:
         data = mujoco.MjData(model)
         assert robot.plant is not None and joints.position_base_in_world is not None
         data.qpos[:] = robot.plant.qpos_reference
-        base = model.body(robot.plant.base_body).id  # T1's Waist, below its floating Trunk
+        base = model.body(robot.plant.base_body).id  # the legs' base: here the floating base itself
         mount = base_mount(model, data.qpos, 1, base)
         data.qpos[0:3], rotation = root_from_base(mount, joints.position_base_in_world[0], np.eye(3))
-        assert rotation == pytest.approx(np.eye(3), abs=1e-12)  # the waist straight in the keyframe
+        assert mount is None and rotation == pytest.approx(np.eye(3), abs=1e-12)  # T1's waist yaw: its own servo
         data.qpos[3:7] = (1, 0, 0, 0)
         for column, joint in enumerate(robot.plant.joints):
             data.qpos[model.joint(joint.name).qposadr[0]] = joints.angles[0, column]

@@ -1,6 +1,7 @@
 """Legs below a waist: a model whose floating root is the torso, the legs hanging from a pelvis under waist joints
-(ToddlerBot's class). The legs' base is the pelvis: the import's frame, the plant's sensors and the pose the plan
-gives, the root placed from it (zmpwalk.robots.tree)."""
+(ToddlerBot's class). Below a waist that no actuator of its own drives (tied to its motor by a tendon), the legs'
+base is the pelvis: the import's frame, the plant's sensors and the pose the plan gives, the root placed from it;
+below a servo-held waist, the floating torso (zmpwalk.robots.tree)."""
 
 from __future__ import annotations
 
@@ -53,14 +54,18 @@ def _motors(named: bool = True) -> str:
                    for joint in joints)
 
 
-def waisted_biped(slack: float = 0.0, waist_roll: float = 0.0) -> str:
+def waisted_biped(slack: float = 0.0, waist_roll: float = 0.0, servo: bool = False) -> str:
     """A 19.6 kg biped whose floating root is an 8 kg torso on a waist (yaw, then roll) above the pelvis the legs
     hang from (torque motors). The waist roll is driven through a gear joint on the pelvis (``waist_act``, a
     position servo), coupled by a tendon that leaves it ``slack`` [rad] either way, as ToddlerBot's; the keyframe
-    rolls the waist by ``waist_roll`` [rad]."""
+    rolls the waist by ``waist_roll`` [rad]. With ``servo`` the waist roll has a position servo of its own instead
+    of the tendon."""
     wx, wy, wz = WAIST
     tx, ty, tz = TORSO_COM
     limited = f'limited="true" range="{-slack - 1e-6} {slack + 1e-6}"'
+    coupling = ('<tendon><fixed name="waist_coupling" ' + limited + '><joint joint="waist_roll" coef="1"/>'
+                '<joint joint="waist_act" coef="-1"/></fixed></tendon>')
+    own = '<position joint="waist_roll" kp="400" kv="20"/>' if servo else ""
     return f"""<mujoco model="waisted"><compiler angle="radian"/>
 <default><joint armature="0.01" damping="0.1"/></default>
 <worldbody><geom name="floor" type="plane" size="5 5 .1"/>
@@ -76,9 +81,8 @@ def waisted_biped(slack: float = 0.0, waist_roll: float = 0.0) -> str:
   </body>
  </body>
 </body></worldbody>
-<tendon><fixed name="waist_coupling" {limited}><joint joint="waist_roll" coef="1"/><joint joint="waist_act" coef="-1"/>
-</fixed></tendon>
-<actuator>{_motors()}<position joint="waist_act" kp="400" kv="20"/><position joint="waist_yaw" kp="400" kv="20"/>
+{"" if servo else coupling}
+<actuator>{_motors()}<position joint="waist_act" kp="400" kv="20"/><position joint="waist_yaw" kp="400" kv="20"/>{own}
 </actuator>
 <keyframe><key name="home" qpos="{wx} {wy} {0.7 + wz} 1 0 0 0 0 {waist_roll} {waist_roll} {'0 ' * 12}"/></keyframe>
 </mujoco>"""
@@ -125,6 +129,16 @@ def test_the_legs_base_is_the_pelvis_below_the_waist(tmp_path: Path) -> None:
         assert getattr(waisted, field) == pytest.approx(getattr(rooted, field), abs=1e-9), field  # [m]
     assert waisted.com_offset == pytest.approx(rooted.com_offset, abs=1e-9)  # [m]
     assert waisted.mass == pytest.approx(rooted.mass, abs=1e-12)  # [kg]
+
+
+def test_a_waist_held_by_its_own_servos_is_rigid_with_the_floating_base(tmp_path: Path) -> None:
+    """Every waist joint driven by its own actuator (Booster T1's waist yaw): the floating torso stays the legs'
+    base, as the arms it carries; the hips are then seen from it."""
+    robot = load_robot(write(tmp_path, "servo.xml", waisted_biped(servo=True)))
+    assert robot.plant is not None and robot.plant.base_body == "torso"
+    assert build_plant(robot).mount is None
+    assert robot.legs is not None
+    assert robot.legs[0].hip == pytest.approx(np.array([0.0, 0.1, -0.1]) - np.array(WAIST), abs=1e-12)  # [m]
 
 
 @pytest.mark.parametrize("waist_roll", [0.0, 0.1])

@@ -4,10 +4,12 @@
 zmpwalk needs (the builder's model is the single source of truth):
 
 * **Floating base**: the body with the free joint (a URDF gets one at its root
-  link). The legs' base is the body where the two feet's paths part: the root
-  itself where the legs hang from it, else the pelvis below a waist (whose joints
-  are then held). Its frame is the **pelvis frame** of zmpwalk (x forward, y
-  left, z up), and the simulator's sensors (attitude, gyro) sit on it.
+  link). It is the legs' base unless a joint between it and the body where the
+  two feet's paths part is driven by no actuator of its own (a waist tied to its
+  motors by a tendon or an equality, maybe with slack): then that body, the
+  pelvis (:func:`~zmpwalk.robots.tree.legs_base`). The legs' base's frame is the
+  **pelvis frame** of zmpwalk (x forward, y left, z up), and the simulator's
+  sensors (attitude, gyro) sit on it.
 * **Feet**: with no mapping, the two bodies whose collision geoms reach lowest in
   the reference pose (the model's keyframe, or its zero pose), one each side of
   the base (``y > 0`` left). Two candidates within

@@ -135,14 +135,21 @@ def ancestors(model: object, body: int) -> list[int]:
 
 
 def legs_base(model: object, root: int, feet: list[int]) -> int:
-    """The legs' base: the last body on both feet's paths from ``root`` (the pelvis, below a waist whose joints are
-    then held, not legs), or ``root`` itself where the legs hang from it."""
-    base = root
-    for left, right in zip(body_path(model, root, feet[0]), body_path(model, root, feet[1]), strict=False):
+    """The legs' base: the floating ``root``, unless a joint between it and the last body on both feet's paths (the
+    pelvis, below a waist) is driven by no actuator of its own (a waist tied to its motors by a tendon or an
+    equality, which may leave it slack): then that pelvis, whose waist the simulation holds. A joint held by its
+    own servo at the reference pose is taken as rigid, as the arms are (Booster T1's waist yaw)."""
+    import mujoco
+
+    m = model
+    split = root
+    for left, right in zip(body_path(m, root, feet[0]), body_path(m, root, feet[1]), strict=False):
         if left != right:
             break
-        base = left
-    return base
+        split = left
+    driven = {int(m.actuator_trnid[a][0]) for a in range(m.nu)  # type: ignore[attr-defined]
+              if m.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT}  # type: ignore[attr-defined]
+    return split if any(j not in driven for j in joint_path(m, root, split)) else root
 
 
 def base_mount(model: object, qpos: Array, root: int, base: int) -> Mount | None:
