@@ -82,7 +82,7 @@ def waisted_biped(slack: float = 0.0, waist_roll: float = 0.0, servo: bool = Fal
  </body>
 </body></worldbody>
 {"" if servo else coupling}
-<actuator>{_motors()}<position joint="waist_act" kp="400" kv="20"/><position joint="waist_yaw" kp="400" kv="20"/>{own}
+<actuator>{_motors()}<position joint="waist_act" kp="400" kv="10"/><position joint="waist_yaw" kp="400" kv="20"/>{own}
 </actuator>
 <keyframe><key name="home" qpos="{wx} {wy} {0.7 + wz} 1 0 0 0 0 {waist_roll} {waist_roll} {'0 ' * 12}"/></keyframe>
 </mujoco>"""

@@ -150,6 +150,23 @@ class FileFormatError(ZmpwalkError, ValueError):
         super().__init__(f"{path}: {message}")
 
 
+class SimulationError(ZmpwalkError, RuntimeError):
+    """The physics simulation diverged: MuJoCo found a non-finite or huge position, velocity or acceleration and
+    reset its state, so what the run would measure after it is not the robot's.
+
+    Attributes:
+        time: Simulated time of the first such step [s] (MuJoCo's clock: from the stand).
+        joint: The joint of the degree of freedom MuJoCo named.
+    """
+
+    def __init__(self, time: float, joint: str, detail: str = "") -> None:
+        self.time = time
+        self.joint = joint
+        extra = f"; {detail}" if detail else ""
+        super().__init__(f"the simulation diverged at t = {time:.3f} s (MuJoCo: a non-finite or huge value at joint "
+                         f"{joint!r}){extra}")
+
+
 class InfeasiblePatternError(ZmpwalkError, ValueError):
     """A pattern's own feasibility condition does not hold (names the condition)."""
 

@@ -64,6 +64,8 @@ def actuator_table(result: SimulationResult, skip: float = 0.0) -> list[Actuator
     by current over milliseconds, not by one sample); the largest single-sample torque is reported apart.
     """
     keep = result.time >= skip
+    if not keep.any():  # nothing measured from there on (a walk that fell before): every figure not measured
+        keep = np.ones(len(result.time), dtype=bool)
     torque = np.abs(result.joint_torques[keep])
     velocity = result.joint_velocities[keep]
     power = np.abs(result.joint_power[keep])

@@ -116,6 +116,9 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
     virtual = _virtual_columns(robot)
     _add_sensors(spec, plant, virtual)
     model = spec.compile()
+    if model.opt.integrator == mujoco.mjtIntegrator.mjINT_EULER and explicit_damping_ratio(model, qpos) >= 2.0:
+        spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+        model = spec.compile()
     actuators = _leg_actuators(model, plant, virtual)
     columns = np.array([i for i in range(12) if i not in virtual], dtype=np.intp)
     leg_qpos = np.array([model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, plant.joints[i].name)]
@@ -177,6 +180,31 @@ def _add_sensors(spec: mujoco.MjSpec, plant: ModelPlant, virtual: set[int]) -> N
                              ("tau", mujoco.mjtSensor.mjSENS_JOINTACTFRC)):
             sensor = spec.add_sensor(name=f"{column}_{suffix}", type=kind, objname=joint.name)
             sensor.objtype = mujoco.mjtObj.mjOBJ_JOINT
+
+
+def explicit_damping_ratio(model: mujoco.MjModel, qpos: Array) -> float:
+    r"""The largest ``kv h / I`` over the model's servos on a joint at ``qpos``: ``kv`` a servo's damping on its
+    joint [N m s/rad] (``-biasprm[2] gear^2``), ``h`` the time step [s], ``I = 1 / (M^{-1})_{jj}`` the inertia the
+    joint's degree of freedom moves with everything else free [kg m^2].
+
+    MuJoCo's Euler integrator applies an actuator's damping explicitly: on one degree of freedom ``v' = -(kv / I)
+    v`` steps as ``v_{k+1} = (1 - kv h / I) v_k``, which grows once ``kv h / I >= 2``. :func:`build_plant` then
+    integrates with ``implicitfast`` (the damping implicit), as MuJoCo advises for such models; a servo's stiffness
+    ``kp h^2 / I`` is far inside its own bound (4) wherever the damping is critical (``kv = 2 sqrt(kp I)``)."""
+    data = mujoco.MjData(model)
+    data.qpos[:] = qpos
+    mujoco.mj_forward(model, data)
+    mass = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, mass)
+    inverse_diagonal = np.diag(np.linalg.inv(mass))
+    largest = 0.0
+    for actuator in range(model.nu):
+        if model.actuator_trntype[actuator] != mujoco.mjtTrn.mjTRN_JOINT:
+            continue
+        damping = -float(model.actuator_biasprm[actuator][2]) * float(model.actuator_gear[actuator][0]) ** 2
+        dof = int(model.jnt_dofadr[model.actuator_trnid[actuator][0]])
+        largest = max(largest, damping * float(model.opt.timestep) * float(inverse_diagonal[dof]))
+    return largest
 
 
 def _leg_actuators(model: mujoco.MjModel, plant: ModelPlant, virtual: set[int]) -> list[int]:
