@@ -205,7 +205,7 @@ def _every_error_class() -> set[type[ZmpwalkError]]:
 
 
 def _error_examples() -> list[ZmpwalkError]:
-    from zmpwalk.errors import InfeasiblePatternError
+    from zmpwalk.errors import InfeasiblePatternError, SimulationError
     from zmpwalk.kinematics import JointLimitError
 
     reach = UnreachableError("left", 1.25, 0.012, "stage 3")
@@ -220,6 +220,7 @@ def _error_examples() -> list[ZmpwalkError]:
         FileFormatError("steps.toml", "[[steps]] 2: missing field 'duration'"),
         InfeasiblePatternError("the sway cubic reverses"),
         JointLimitError("left_knee", 2.7, 1.5, (0.0, 2.6)),
+        SimulationError(0.009, "back_bky", "a stiffer joint than the time step integrates"),
     ]
 
 
