@@ -15,6 +15,7 @@ import pytest
 
 from zmpwalk.online import OnlineWalker
 from zmpwalk.robots import load_robot
+from zmpwalk.robots.inspect import robot_table
 from zmpwalk.robots.tree import base_mount, root_from_base
 from zmpwalk.sim.mujoco_plant import MujocoPlant
 from zmpwalk.sim.plant import build_plant, set_base_pose
@@ -119,7 +120,9 @@ def test_the_legs_base_is_the_pelvis_below_the_waist(tmp_path: Path) -> None:
     the waist joints are held."""
     waisted = load_robot(write(tmp_path, "waisted.xml", waisted_biped()))
     rooted = load_robot(write(tmp_path, "rooted.xml", pelvis_rooted_biped()))
-    assert waisted.plant is not None and waisted.plant.base_body == "pelvis"
+    assert waisted.plant is not None and waisted.plant.base_body == "pelvis" and waisted.plant.root_body == "torso"
+    assert rooted.plant is not None and rooted.plant.root_body == ""
+    assert "base 'pelvis' (below the floating 'torso', its waist held" in robot_table(waisted)
     assert {"waist_yaw", "waist_roll", "waist_act"} <= set(waisted.plant.held_joints)
     assert waisted.legs is not None and rooted.legs is not None
     for mine, theirs in zip(waisted.legs, rooted.legs, strict=True):

@@ -105,7 +105,8 @@ class ModelPlant:
 
     Attributes:
         path: The model file.
-        base_body: Name of the floating base.
+        base_body: Name of the legs' base (the pelvis frame): the floating base, or the pelvis below a waist that no
+            actuator of its own drives (:func:`zmpwalk.robots.tree.legs_base`).
         feet: Foot body names (left, right).
         joints: The 12 leg joints (left then right, role order).
         qpos_reference: The reference pose (keyframe or zero pose), ``nq`` values.
@@ -117,6 +118,7 @@ class ModelPlant:
         rest_mass: Mass of everything but the leg segments (rigid with the base) [kg].
         rest_com: Its centre of mass in the pelvis frame [m].
         pd_joints: Every joint driven by the joint PD layer, leg joints included: (joint name, its actuator).
+        root_body: Name of the floating base where it is not ``base_body``, else empty.
     """
 
     path: Path
@@ -132,3 +134,4 @@ class ModelPlant:
     rest_mass: float = 0.0  # [kg]
     rest_com: tuple[float, float, float] = (0.0, 0.0, 0.0)  # [m]
     pd_joints: tuple[tuple[str, Actuator], ...] = ()
+    root_body: str = ""

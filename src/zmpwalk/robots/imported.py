@@ -216,6 +216,8 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     robot_name = name or re.sub(r"[^A-Za-z0-9_.-]+", "-", model_name).strip("-") or path.stem
     plant = _model_plant(model, path, base, foot_ids, key_id, leg_joint_set | {root_joint}, masses, polygon,
                          package_paths)
+    if base != root:
+        plant = replace(plant, root_body=element_name(model, mujoco.mjtObj.mjOBJ_BODY, root))
     ready = _ready_posture(model, data, chains, legs, qpos_reference, (adr, mount), distance, hip_x, hip_spacing,
                            hip_drop, ankle_height, values.get("pelvis_height"), source)
     pelvis_height, pendulum, com_offset, chains_ready, qpos = ready

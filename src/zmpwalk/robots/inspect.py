@@ -50,6 +50,7 @@ def robot_summary(robot: RobotModel, statics: StaticTorques | None = None) -> di
         plant = robot.plant
         summary["model"] = str(plant.path)
         summary["base_body"] = plant.base_body
+        summary["root_body"] = plant.root_body or plant.base_body
         summary["feet"] = list(plant.feet)
         summary["keyframe"] = plant.keyframe
         summary["held_joints"] = list(plant.held_joints)
@@ -117,7 +118,9 @@ def robot_table(robot: RobotModel, statics: StaticTorques | None = None) -> str:
     s = robot_summary(robot, statics)
     lines = [f"{robot.name}: {robot.description}"]
     if "model" in s:
-        lines.append(f"model {s['model']}; base {s['base_body']!r}; feet {s['feet'][0]!r}, {s['feet'][1]!r}; "
+        below = (f" (below the floating {s['root_body']!r}, its waist held at the reference pose)"
+                 if s["root_body"] != s["base_body"] else "")
+        lines.append(f"model {s['model']}; base {s['base_body']!r}{below}; feet {s['feet'][0]!r}, {s['feet'][1]!r}; "
                      f"reference pose: {s['keyframe'] or 'zero pose'}")
     lines += [
         f"mass {robot.mass:.3f} kg, height {robot.height:.3f} m",
