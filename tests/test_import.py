@@ -309,3 +309,21 @@ def test_the_default_foot_lift_keeps_the_pitch_joints_off_their_limits(tmp_path:
         low, high = ((low + high) / 2, high) if ankle_at((low + high) / 2) > bound else (low, (low + high) / 2)
     assert tight.foot_lift == pytest.approx(low, abs=1e-6)  # [m] 11.5 mm
     assert tight.foot_lift < 0.5 * free.foot_lift  # [m] of the scaled 40 mm
+
+
+def test_a_stride_the_whole_body_legs_cannot_follow_names_its_command(tmp_path: Path,
+                                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    """The pattern's own reach check (from its CoM point) passes 0.315 m strides of the 0.3 + 0.3 m biped, its legs
+    placed under the whole-body CoM do not: the error is the walker's check of the command, naming its table and
+    the stride that fits, not a sample's time alone."""
+    from zmpwalk.cli import main
+
+    path = write(tmp_path, "free.xml", biped(leg("l", 0.1) + leg("r", -0.1)))
+    steps = write(tmp_path, "long.toml", "[[steps]]\nduration = 0.8\nforward = 0.315\nrepeat = 3\n")
+    assert main(["plan", "--robot", str(path), str(steps)]) == 0  # the pattern's check passes
+    capsys.readouterr()
+    assert main(["simulate", "--robot", str(path), str(steps)]) == 2
+    error = capsys.readouterr().err
+    assert "long.toml: [[steps]] 1, repeat 1 of 3: forward = 0.315 is not allowed" in error
+    fits = float(error.split("at most ")[1].split(" m forward")[0])
+    assert 0.30 < fits < 0.315  # [m] (0.313 measured)

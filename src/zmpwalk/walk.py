@@ -240,6 +240,23 @@ def _joints(spec: WalkSpec, pattern: WalkingPattern) -> JointTrajectory:
     return pattern_joint_trajectory(pattern, check_limits=spec.check_limits)
 
 
+def _named_joints(spec: WalkSpec, pattern: WalkingPattern) -> JointTrajectory:
+    """:func:`_joints`; where the legs cannot follow the pattern of a walk the controller runs, the error is the
+    walker's own check of the commands, which names the command and the stride that fits (the pattern's leg check
+    knows a sample's time only).
+
+    Raises:
+        ZmpwalkError: The walker's refusal of the first command it cannot walk; else the pattern's own error.
+    """
+    try:
+        return _joints(spec, pattern)
+    except ZmpwalkError:
+        if not through_controller(spec):
+            raise
+        _controller_walk(spec, None)  # raises the first refusal, in spec.source's words
+        raise
+
+
 def run_walk(spec: WalkSpec, progress: Progress | None = None, planned: PlannedWalk | None = None) -> WalkOutcome:
     """Plan ``spec``'s walk, walk it in MuJoCo and judge it.
 
@@ -278,7 +295,7 @@ def run_walk(spec: WalkSpec, progress: Progress | None = None, planned: PlannedW
     if planned is None:
         pattern, correction = walk_pattern(spec)
         stage("joints")
-        planned = PlannedWalk(pattern, correction, _joints(spec, pattern))
+        planned = PlannedWalk(pattern, correction, _named_joints(spec, pattern))
     else:
         stage("joints")
     stage("simulation")
