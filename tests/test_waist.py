@@ -226,3 +226,47 @@ def test_unnamed_motors_get_the_pd_layer(tmp_path: Path) -> None:
         servo = mujoco.mj_name2id(plant.model, mujoco.mjtObj.mjOBJ_ACTUATOR, actuator.name)
         assert servo == index and plant.model.actuator_trnid[servo][0] == plant.model.joint(joint).id
         assert plant.model.actuator_gainprm[servo][0] == pytest.approx(actuator.kp, rel=1e-12)  # [N m/rad]
+
+
+def geared_hip_yaw_biped() -> str:
+    """The pelvis-rooted biped whose hip yaws are passive joints turned by a motor's gear on the pelvis through a
+    joint equality (``hip_yaw = -0.8 drive``), as ToddlerBot's."""
+    text = pelvis_rooted_biped()
+    for side in "lr":
+        gear = (f'<body name="{side}_gear"><joint name="{side}_hip_yaw_drive" axis="0 0 1" range="-3 3"/>'
+                '<inertial pos="0 0 0" mass="0.01" diaginertia="0.00001 0.00001 0.00001"/></body>')
+        text = text.replace(f'<body name="{side}_hip_yaw_link"', gear + f'<body name="{side}_hip_yaw_link"', 1)
+        text = text.replace(f"<motor name='{side}_hip_yaw' joint=\"{side}_hip_yaw\" ctrlrange=\"-80 80\"/>",
+                            f'<motor name="{side}_hip_yaw_drive" joint="{side}_hip_yaw_drive" ctrlrange="-80 80"/>')
+    equalities = "".join(f'<joint joint1="{s}_hip_yaw" joint2="{s}_hip_yaw_drive" polycoef="0 -0.8 0 0 0"/>'
+                         for s in "lr")
+    return text.replace("</mujoco>", f"<equality>{equalities}</equality></mujoco>")
+
+
+def test_a_hip_yaw_turned_through_a_joint_equality_is_driven_by_the_leg_alone(tmp_path: Path) -> None:
+    """The gear's joint is neither held at its keyframe angle nor driven (its motor made to do nothing): the leg
+    joint's PD loop turns it through the equality, with no second loop pulling against it."""
+    robot = load_robot(write(tmp_path, "geared.xml", geared_hip_yaw_biped()))
+    assert robot.plant is not None
+    assert robot.plant.coupled_joints == ("l_hip_yaw_drive", "r_hip_yaw_drive")
+    assert not {"l_hip_yaw_drive", "r_hip_yaw_drive"} & set(robot.plant.held_joints)
+    driven = dict(robot.plant.pd_joints)
+    assert "l_hip_yaw_drive" not in driven and driven["l_hip_yaw"].kind == "none"  # the PD layer's own servo
+    plant = build_plant(robot)
+    motor = mujoco.mj_name2id(plant.model, mujoco.mjtObj.mjOBJ_ACTUATOR, "l_hip_yaw_drive")
+    assert motor >= 0
+    assert not plant.model.actuator_gainprm[motor].any() and not plant.model.actuator_biasprm[motor].any()
+    assert "moved by a leg joint through a joint equality" in robot_table(robot)
+
+
+@pytest.mark.slow
+def test_a_biped_with_geared_hip_yaws_turns(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Three 15 degree turns on the geared hip yaws pass, the feet turned as planned."""
+    from zmpwalk.cli import main
+
+    path = write(tmp_path, "geared.xml", geared_hip_yaw_biped())
+    steps = write(tmp_path, "turn.toml", "[[steps]]\nduration = 0.8\nturn = 0.2618\nrepeat = 3\n")
+    code = main(["simulate", "--robot", str(path), str(steps), "--json"])
+    summary = json.loads(capsys.readouterr().out)
+    assert code == 0 and summary["verdict"]["state"] == "PASS"
+    assert summary["final_feet_yaw_error"] < 0.01  # [rad]

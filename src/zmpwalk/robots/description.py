@@ -119,6 +119,8 @@ class ModelPlant:
         rest_com: Its centre of mass in the pelvis frame [m].
         pd_joints: Every joint driven by the joint PD layer, leg joints included: (joint name, its actuator).
         root_body: Name of the floating base where it is not ``base_body``, else empty.
+        coupled_joints: Joints a leg joint moves through a joint equality (names): neither held nor driven (their
+            actuators' controls 0).
     """
 
     path: Path
@@ -135,3 +137,4 @@ class ModelPlant:
     rest_com: tuple[float, float, float] = (0.0, 0.0, 0.0)  # [m]
     pd_joints: tuple[tuple[str, Actuator], ...] = ()
     root_body: str = ""
+    coupled_joints: tuple[str, ...] = ()

@@ -67,7 +67,7 @@ from zmpwalk.robots.collision import Sole, collision_points, rigid_bodies, sole_
 from zmpwalk.robots.description import HUBO_FOOT_LIFT, LIFT_RANGE_MARGIN, Actuator, LegJoint, ModelPlant
 from zmpwalk.robots.legs import VIRTUAL_PREFIX, FootAtReference, Segments, build_leg, leg_joint_ids, segments
 from zmpwalk.robots.model import RobotModel, schedule_scale
-from zmpwalk.robots.pd import element_name, pd_layer
+from zmpwalk.robots.pd import coupled_joints, element_name, pd_layer
 from zmpwalk.robots.tree import (
     Mount,
     base_mount,
@@ -224,10 +224,13 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     length_scale = schedule_scale(pendulum, thigh + shank, hip_spacing)[1]
     lift = _foot_lift(chains_ready, leg_joints, HUBO_FOOT_LIFT * length_scale)  # [m]
     # The joint PD layer: gains from the ready posture's inertia; a leg joint holds the robot, m g l.
+    coupled = coupled_joints(model, leg_joint_set)
     pd_joints = pd_layer(model, data, qpos, leg_joint_set, mass * float(np.linalg.norm(model.opt.gravity)) * pendulum,
-                          pd_gains or {})
+                          pd_gains or {}, coupled)
     leg_joints = _driven_joints(leg_joints, dict(pd_joints), geometry, values.get("sole_roll_limit"), source)
-    plant = replace(plant, joints=tuple(leg_joints), pd_joints=pd_joints)
+    names = {j: element_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in coupled}
+    plant = replace(plant, joints=tuple(leg_joints), pd_joints=pd_joints, coupled_joints=tuple(sorted(names.values())),
+                    held_joints=tuple(n for n in plant.held_joints if n not in names.values()))
     return _robot_model(
         name=robot_name, description=f"imported from {path.name} ({mass:.1f} kg)", mass=mass, height=height_scale,
         geometry=geometry, pelvis_height=pelvis_height, pendulum=pendulum, gravity=float(-model.opt.gravity[2]),

@@ -54,6 +54,7 @@ def robot_summary(robot: RobotModel, statics: StaticTorques | None = None) -> di
         summary["feet"] = list(plant.feet)
         summary["keyframe"] = plant.keyframe
         summary["held_joints"] = list(plant.held_joints)
+        summary["coupled_joints"] = list(plant.coupled_joints)
         summary["sole_polygon"] = [list(p) for p in plant.sole_polygon]
         summary["ik"] = {chain.label: ("closed form" if chain.closed_form else "numeric") for chain in robot.legs}
         summary["sole_tilt"] = {chain.label: {"zero": list(tilt_of(chain.sole_rotation[:, 2])),
@@ -158,6 +159,9 @@ def robot_table(robot: RobotModel, statics: StaticTorques | None = None) -> str:
             lines.append("over the actuator's limit standing still: " + (", ".join(over) if over else "none"))
         if s["held_joints"]:
             lines.append(f"held at the reference pose: {', '.join(s['held_joints'])}")
+        if s["coupled_joints"]:
+            lines.append("moved by a leg joint through a joint equality (its PD loop drives them; not held): "
+                         + ", ".join(s["coupled_joints"]))
     return "\n".join(lines)
 
 

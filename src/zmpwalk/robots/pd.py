@@ -136,11 +136,30 @@ def _weight_moment(model: Any, data: Any, joint: int) -> float:
     return float(model.body_subtreemass[body]) * float(np.linalg.norm(model.opt.gravity)) * distance
 
 
+def coupled_joints(model: Any, leg_joints: set[int]) -> frozenset[int]:
+    """Joints tied to a leg joint by an active joint equality (ToddlerBot's hip yaw motor, whose gear turns the
+    passive joint in the leg): the leg joint's PD loop moves them through the equality, and nothing holds them
+    at the reference pose (a hold would pull against the leg's loop)."""
+    import mujoco
+
+    coupled = set()
+    for e in range(model.neq):
+        if int(model.eq_type[e]) != mujoco.mjtEq.mjEQ_JOINT or not model.eq_active0[e]:
+            continue
+        pair = (int(model.eq_obj1id[e]), int(model.eq_obj2id[e]))
+        for mine, other in (pair, pair[::-1]):
+            if mine in leg_joints and other >= 0 and other not in leg_joints:
+                coupled.add(other)
+    return frozenset(coupled)
+
+
 def pd_layer(model: Any, data: Any, qpos: Array, leg_joints: set[int], leg_moment: float,
-              given: dict[str, tuple[float, float | None]]) -> tuple[tuple[str, Actuator], ...]:
+              given: dict[str, tuple[float, float | None]], coupled: frozenset[int] = frozenset()
+              ) -> tuple[tuple[str, Actuator], ...]:
     """The joints the PD layer drives, with their actuators (gains from :func:`pd_gains` at the posture ``qpos``,
     or ``given``: joint name -> (kp, kv or None for critical damping)): every torque motor on a hinge or slide,
-    every leg joint without an actuator, and every joint of a model without actuators (a URDF). A leg joint holds
+    every leg joint without an actuator, and every joint of a model without actuators (a URDF), but the
+    ``coupled`` joints (moved by a leg joint through a joint equality: :func:`coupled_joints`). A leg joint holds
     ``leg_moment`` [N m]; another hinge the weight of what it moves (:func:`_weight_moment`); a slide nothing.
 
     Raises:
@@ -158,6 +177,8 @@ def pd_layer(model: Any, data: Any, qpos: Array, leg_joints: set[int], leg_momen
     for j in range(model.njnt):
         hinge = int(model.jnt_type[j]) == mujoco.mjtJoint.mjJNT_HINGE  # a numpy integer is never `in` enums
         if not hinge and int(model.jnt_type[j]) != mujoco.mjtJoint.mjJNT_SLIDE:
+            continue
+        if j in coupled:
             continue
         name = element_name(model, mujoco.mjtObj.mjOBJ_JOINT, j)
         existing = joint_actuator(model, j)

@@ -109,6 +109,7 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
     for index, actuator in enumerate(spec.actuators):  # the names the robot gives them (robots.pd.element_name)
         if not actuator.name:
             actuator.name = f"#{index}"
+    _release_coupled(spec, plant)
     add_pd_layer(spec, plant)
     lift_control_ranges(spec, model)
     qpos = np.array(plant.qpos_reference)
@@ -180,6 +181,16 @@ def _add_sensors(spec: mujoco.MjSpec, plant: ModelPlant, virtual: set[int]) -> N
                              ("tau", mujoco.mjtSensor.mjSENS_JOINTACTFRC)):
             sensor = spec.add_sensor(name=f"{column}_{suffix}", type=kind, objname=joint.name)
             sensor.objtype = mujoco.mjtObj.mjOBJ_JOINT
+
+
+def _release_coupled(spec: mujoco.MjSpec, plant: ModelPlant) -> None:
+    """Make the model's actuators on the joints a leg joint moves through an equality do nothing (gain and bias
+    0): the leg joint's loop drives them, and a hold would pull against it."""
+    coupled = set(plant.coupled_joints)
+    for actuator in spec.actuators:
+        if actuator.trntype == mujoco.mjtTrn.mjTRN_JOINT and actuator.target in coupled:
+            actuator.gainprm = np.zeros(len(actuator.gainprm))
+            actuator.biasprm = np.zeros(len(actuator.biasprm))
 
 
 def explicit_damping_ratio(model: mujoco.MjModel, qpos: Array) -> float:
