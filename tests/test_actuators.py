@@ -16,7 +16,8 @@ from zmpwalk.scenarios import load_scenario
 from zmpwalk.sim import actuator_table, simulate
 from zmpwalk.sim.actuators import IMPACT_WINDOW, sustained
 from zmpwalk.sim.motors import load_motors, motor_fits
-from zmpwalk.sim.plant import build_plant, planned_torques, plant_qpos
+from zmpwalk.sim.plant import build_plant, planned_torques
+from zmpwalk.sim.poses import plant_qpos
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "motors.toml"
 

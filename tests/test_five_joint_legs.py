@@ -180,7 +180,8 @@ def test_the_stabilizer_drops_the_virtual_share(h1_leg: LegChain) -> None:
 
 @needs_h1
 def test_the_plant_column_of_the_virtual_joint_does_nothing() -> None:
-    from zmpwalk.sim.plant import build_plant, set_initial_state
+    from zmpwalk.sim.plant import build_plant
+    from zmpwalk.sim.poses import set_initial_state
 
     robot = load_robot(H1)
     assert robot.legs is not None

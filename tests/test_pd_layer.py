@@ -21,7 +21,8 @@ from zmpwalk.robots import load_robot
 from zmpwalk.robots.description import PD_BANDWIDTH, PD_LOAD_STIFFNESS
 from zmpwalk.robots.inspect import robot_summary, robot_toml
 from zmpwalk.robots.pd import pd_gains
-from zmpwalk.sim.plant import build_plant, plant_qpos, servo_offsets, servo_torques, set_initial_state
+from zmpwalk.sim.plant import build_plant, servo_offsets, servo_torques
+from zmpwalk.sim.poses import plant_qpos, set_initial_state
 
 LEG = """
 <body name="{s}_hip" pos="0 {y} -0.1"><joint name="{s}_hy" axis="0 0 1"/><geom size="0.02" mass="1"/>

@@ -18,7 +18,8 @@ from zmpwalk.robots import load_robot
 from zmpwalk.robots.inspect import robot_table
 from zmpwalk.robots.tree import base_mount, root_from_base
 from zmpwalk.sim.mujoco_plant import MujocoPlant
-from zmpwalk.sim.plant import build_plant, set_base_pose
+from zmpwalk.sim.plant import build_plant
+from zmpwalk.sim.poses import set_base_pose
 
 TORSO_MASS = 8.0  # [kg]
 TORSO_COM = (0.02, 0.0, 0.25)  # [m] in the pelvis frame at the reference pose

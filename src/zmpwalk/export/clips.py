@@ -37,7 +37,7 @@ from zmpwalk.robots.collision import collision_points, rigid_bodies
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sim.loop import ControllerRun, simulate_controller, simulated_clock
 from zmpwalk.sim.mujoco_plant import MujocoPlant, _ankle_sites, _base_position
-from zmpwalk.sim.plant import set_base_pose
+from zmpwalk.sim.poses import set_base_pose
 
 Array = NDArray[np.float64]
 

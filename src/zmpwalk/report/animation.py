@@ -9,7 +9,7 @@ from collections.abc import Callable
 import numpy as np
 
 from zmpwalk.robots.model import RobotModel
-from zmpwalk.sim.plant import set_base_pose
+from zmpwalk.sim.poses import set_base_pose
 from zmpwalk.sim.run import SimulationResult
 
 FPS = 12  # [1/s] frames of the GIF

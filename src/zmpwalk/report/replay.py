@@ -22,7 +22,7 @@ from zmpwalk.footsteps import Pose2D, foot_corners
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sim.contact import LOADED_FRACTION
-from zmpwalk.sim.plant import set_base_pose
+from zmpwalk.sim.poses import set_base_pose
 from zmpwalk.sim.run import SimulationResult
 
 FPS = 40  # [1/s] frames of the replay

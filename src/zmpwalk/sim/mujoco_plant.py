@@ -28,7 +28,8 @@ from zmpwalk.sample import WalkingSample
 from zmpwalk.sim.disturbances import NOSLIP_ITERATIONS, SensorNoise
 from zmpwalk.sim.mjcf import contact_mapping
 from zmpwalk.sim.plant import Plant as SimPlant
-from zmpwalk.sim.plant import build_plant, passive_torques, set_base_pose, set_initial_state, static_feedforward
+from zmpwalk.sim.plant import build_plant, passive_torques, static_feedforward
+from zmpwalk.sim.poses import set_base_pose, set_initial_state
 from zmpwalk.sim.ranges import check_range
 from zmpwalk.sim.run import FALL_HEIGHT_FRACTION, FALL_TILT, Disturbances, _MeasurementReader
 from zmpwalk.sim.soles import SensorSlices

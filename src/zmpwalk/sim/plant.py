@@ -40,13 +40,13 @@ from numpy.typing import NDArray
 
 from zmpwalk.errors import InvalidParameterError
 from zmpwalk.kinematics import JOINT_COLUMNS
-from zmpwalk.robots.collision import collision_points, rigid_bodies
 from zmpwalk.robots.description import PHYSICS_STEP, ModelPlant
 from zmpwalk.robots.imported import load_model_spec
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.robots.pd import is_position_servo
 from zmpwalk.robots.tree import Mount, base_mount, floating_base, root_from_base
 from zmpwalk.sides import Support
+from zmpwalk.sim.integrator import EULER_BOUND, explicit_damping_ratio
 
 LEFT_SUPPORT, RIGHT_SUPPORT = int(Support.LEFT), int(Support.RIGHT)  # plain ints: a numpy integer compares with
 # an IntEnum member a hundred times slower
@@ -54,6 +54,8 @@ LEFT_SUPPORT, RIGHT_SUPPORT = int(Support.LEFT), int(Support.RIGHT)  # plain int
 Array = NDArray[np.float64]
 
 MAX_TIMESTEP = PHYSICS_STEP  # [s]
+FEEDFORWARD_PERIOD = 0.005  # [s] the static feedforward is computed at this period and interpolated
+FRICTION_RATE = 0.05  # [rad/s] (m/s on a slide) a joint's dry friction enters the feedforward as f tanh(q' / this)
 
 
 @dataclass
@@ -117,8 +119,8 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
     virtual = _virtual_columns(robot)
     _add_sensors(spec, plant, virtual)
     model = spec.compile()
-    if model.opt.integrator == mujoco.mjtIntegrator.mjINT_EULER and explicit_damping_ratio(model, qpos) >= 2.0:
-        spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    if model.opt.integrator == mujoco.mjtIntegrator.mjINT_EULER and explicit_damping_ratio(model, qpos) >= EULER_BOUND:
+        spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST  # the damping implicit (sim.integrator)
         model = spec.compile()
     actuators = _leg_actuators(model, plant, virtual)
     columns = np.array([i for i in range(12) if i not in virtual], dtype=np.intp)
@@ -191,31 +193,6 @@ def _release_coupled(spec: mujoco.MjSpec, plant: ModelPlant) -> None:
         if actuator.trntype == mujoco.mjtTrn.mjTRN_JOINT and actuator.target in coupled:
             actuator.gainprm = np.zeros(len(actuator.gainprm))
             actuator.biasprm = np.zeros(len(actuator.biasprm))
-
-
-def explicit_damping_ratio(model: mujoco.MjModel, qpos: Array) -> float:
-    r"""The largest ``kv h / I`` over the model's servos on a joint at ``qpos``: ``kv`` a servo's damping on its
-    joint [N m s/rad] (``-biasprm[2] gear^2``), ``h`` the time step [s], ``I = 1 / (M^{-1})_{jj}`` the inertia the
-    joint's degree of freedom moves with everything else free [kg m^2].
-
-    MuJoCo's Euler integrator applies an actuator's damping explicitly: on one degree of freedom ``v' = -(kv / I)
-    v`` steps as ``v_{k+1} = (1 - kv h / I) v_k``, which grows once ``kv h / I >= 2``. :func:`build_plant` then
-    integrates with ``implicitfast`` (the damping implicit), as MuJoCo advises for such models; a servo's stiffness
-    ``kp h^2 / I`` is far inside its own bound (4) wherever the damping is critical (``kv = 2 sqrt(kp I)``)."""
-    data = mujoco.MjData(model)
-    data.qpos[:] = qpos
-    mujoco.mj_forward(model, data)
-    mass = np.zeros((model.nv, model.nv))
-    mujoco.mj_fullM(model, data, mass)
-    inverse_diagonal = np.diag(np.linalg.inv(mass))
-    largest = 0.0
-    for actuator in range(model.nu):
-        if model.actuator_trntype[actuator] != mujoco.mjtTrn.mjTRN_JOINT:
-            continue
-        damping = -float(model.actuator_biasprm[actuator][2]) * float(model.actuator_gear[actuator][0]) ** 2
-        dof = int(model.jnt_dofadr[model.actuator_trnid[actuator][0]])
-        largest = max(largest, damping * float(model.opt.timestep) * float(inverse_diagonal[dof]))
-    return largest
 
 
 def _leg_actuators(model: mujoco.MjModel, plant: ModelPlant, virtual: set[int]) -> list[int]:
@@ -316,52 +293,6 @@ def _held_controls(model: mujoco.MjModel, plant: ModelPlant) -> Array:
     return controls
 
 
-def set_base_pose(plant: Plant, qpos: Array, position_base: Array, yaw: float,
-                  quaternion_base: Array | None = None) -> None:
-    """Write the floating root's pose into ``qpos`` (its first 7 values) that puts the legs' base at
-    ``position_base`` [m], upright at ``yaw`` [rad] (or turned by ``quaternion_base`` (w, x, y, z), where given)."""
-    if plant.mount is None:
-        qpos[0:3] = position_base
-        qpos[3:7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)) if quaternion_base is None else quaternion_base
-        return
-    quaternion = np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)] if quaternion_base is None
-                          else quaternion_base, dtype=np.float64)  # a copy: the caller's stays as given
-    rotation_base = np.empty(9)
-    mujoco.mju_quat2Mat(rotation_base, quaternion)
-    position_root, rotation_root = root_from_base(plant.mount, np.asarray(position_base, dtype=np.float64),
-                                                  rotation_base.reshape(3, 3))
-    qpos[0:3] = position_root
-    mujoco.mju_mat2Quat(quaternion, rotation_root.flatten())
-    qpos[3:7] = quaternion
-
-
-def set_initial_state(plant: Plant, data: mujoco.MjData, position_base: Array, yaw: float, angles: Array,
-                      penetration: float = 0.0) -> None:
-    """Stand the plant in the first pose at rest: the base origin [m] and yaw [rad], the leg angles (12,)
-    [rad], the other joints at the reference pose, the lowest sole ``penetration`` [m] into the ground."""
-    model = plant.model
-    data.qpos[:] = plant.qpos_hold
-    set_base_pose(plant, data.qpos, position_base, yaw)
-    data.qpos[plant.leg_qpos] = angles[plant.leg_columns]
-    data.qvel[:] = 0.0
-    data.ctrl[:] = plant.ctrl_hold
-    data.ctrl[plant.leg_actuators] = angles
-    mujoco.mj_kinematics(model, data)
-    soles = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, f"{s}_ankle") for s in ("left", "right")]
-    if plant.imported:
-        bottom = min(float(collision_points(model, data, rigid_bodies(model, int(model.site_bodyid[site])))[:, 2]
-                           .min()) for site in soles)
-    else:
-        geoms = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"{s}_sole") for s in ("left", "right")]
-        bottom = min(float(data.geom_xpos[g][2] - model.geom_size[g][2]) for g in geoms)
-    data.qpos[2] += -bottom - penetration
-    mujoco.mj_forward(model, data)
-
-
-FEEDFORWARD_PERIOD = 0.005  # [s] the static feedforward is computed at this period and interpolated
-FRICTION_RATE = 0.05  # [rad/s] (m/s on a slide) a joint's dry friction enters the feedforward as f tanh(q' / this)
-
-
 def passive_torques(model: mujoco.MjModel, qvel: Array) -> Array:
     """The torques (nv,) [N m] a joint's own damping and dry friction in the model (``<joint damping>``,
     ``frictionloss``) take from a motion at rates ``qvel`` (nv,), which the actuators must add to move it so:
@@ -370,21 +301,6 @@ def passive_torques(model: mujoco.MjModel, qvel: Array) -> Array:
     (joint springs, gravity compensation, fluid drag) are left out."""
     return np.asarray(model.dof_damping * qvel + model.dof_frictionloss * np.tanh(qvel / FRICTION_RATE),
                       dtype=np.float64)
-
-
-def plant_qpos(plant: Plant, position_base: Array, yaw: Array, angles: Array) -> Array:
-    """Full ``qpos`` rows (n, nq) of the planned motion: the base origin [m] (n, 3) and yaw [rad] (upright),
-    leg joint columns (n, 12), the other joints at the reference pose."""
-    n = len(yaw)
-    qpos = np.repeat(plant.qpos_hold[None, :], n, axis=0)
-    if plant.mount is None:
-        qpos[:, 0:3] = position_base
-        qpos[:, 3:7] = np.column_stack([np.cos(yaw / 2), np.zeros(n), np.zeros(n), np.sin(yaw / 2)])
-    else:
-        for row, position, angle in zip(qpos, position_base, yaw, strict=True):
-            set_base_pose(plant, row, position, float(angle))
-    qpos[:, plant.leg_qpos] = angles[:, plant.leg_columns]
-    return qpos
 
 
 def static_feedforward(plant: Plant, qpos: Array, zmp: Array, support: NDArray[np.integer],
@@ -407,7 +323,7 @@ def static_feedforward(plant: Plant, qpos: Array, zmp: Array, support: NDArray[n
     ``dynamic=False`` keeps only gravity and the static reaction (``q' = q'' = 0``).
 
     Args:
-        qpos: Planned poses (n, nq) (:func:`plant_qpos`) at ``rate``.
+        qpos: Planned poses (n, nq) (:func:`zmpwalk.sim.poses.plant_qpos`) at ``rate``.
         zmp: Planned ZMP in world [m], (n, 2).
         support: 0 double, 1 left, 2 right, (n,).
         ankles: Planned left and right ankle positions in world [m], each (n, 3).

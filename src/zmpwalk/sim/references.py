@@ -13,7 +13,8 @@ from numpy.typing import NDArray
 
 from zmpwalk.kinematics import JointTrajectory
 from zmpwalk.patterns.result import WalkingPattern
-from zmpwalk.sim.plant import Plant, damping_feedforward, plant_qpos, servo_offsets, servo_torques
+from zmpwalk.sim.plant import Plant, damping_feedforward, servo_offsets, servo_torques
+from zmpwalk.sim.poses import plant_qpos
 from zmpwalk.sim.ranges import CONTROL_RATE as CONTROL_RATE  # [Hz] servo reference and measurement rate
 
 Array = NDArray[np.float64]

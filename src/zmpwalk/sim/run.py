@@ -49,7 +49,8 @@ from zmpwalk.sim.disturbances import NOSLIP_ITERATIONS, Disturbances, SensorNois
 from zmpwalk.sim.disturbances import _MeasurementReader as _MeasurementReader
 from zmpwalk.sim.measure import AFTER_FALL, FALL_HEIGHT_FRACTION, FALL_TILT, measure_walk
 from zmpwalk.sim.mjcf import contact_mapping
-from zmpwalk.sim.plant import Plant, build_plant, set_initial_state
+from zmpwalk.sim.plant import Plant, build_plant
+from zmpwalk.sim.poses import set_initial_state
 from zmpwalk.sim.ranges import check_range
 from zmpwalk.sim.references import CONTROL_RATE, rows_at, servo_controls
 from zmpwalk.sim.replan import CaptureReplanner

@@ -77,7 +77,8 @@ def static_torques(robot: RobotModel) -> StaticTorques:
     Raises:
         InvalidParameterError: ``robot`` is a box model (no model of its own to hold).
     """
-    from zmpwalk.sim.plant import FEEDFORWARD_PERIOD, build_plant, plant_qpos, servo_torques
+    from zmpwalk.sim.plant import FEEDFORWARD_PERIOD, build_plant, servo_torques
+    from zmpwalk.sim.poses import plant_qpos
 
     if robot.plant is None or robot.legs is None:
         raise InvalidParameterError("robot", robot.name, "a robot imported from its MJCF or URDF model")

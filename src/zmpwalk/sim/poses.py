@@ -1,0 +1,74 @@
+"""Posing a plant's model: the floating root placed so that the legs' base is where a plan puts it (through the held
+waist where the legs hang below one: :func:`zmpwalk.robots.tree.root_from_base`), the leg joints at their angles and
+every other joint at the reference pose; the standing start of a walk."""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+from zmpwalk.robots.collision import collision_points, rigid_bodies
+from zmpwalk.robots.tree import root_from_base
+from zmpwalk.sim.plant import Plant
+
+Array = NDArray[np.float64]
+
+
+def set_base_pose(plant: Plant, qpos: Array, position_base: Array, yaw: float,
+                  quaternion_base: Array | None = None) -> None:
+    """Write the floating root's pose into ``qpos`` (its first 7 values) that puts the legs' base at
+    ``position_base`` [m], upright at ``yaw`` [rad] (or turned by ``quaternion_base`` (w, x, y, z), where given)."""
+    if plant.mount is None:
+        qpos[0:3] = position_base
+        qpos[3:7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)) if quaternion_base is None else quaternion_base
+        return
+    quaternion = np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)] if quaternion_base is None
+                          else quaternion_base, dtype=np.float64)  # a copy: the caller's stays as given
+    rotation_base = np.empty(9)
+    mujoco.mju_quat2Mat(rotation_base, quaternion)
+    position_root, rotation_root = root_from_base(plant.mount, np.asarray(position_base, dtype=np.float64),
+                                                  rotation_base.reshape(3, 3))
+    qpos[0:3] = position_root
+    mujoco.mju_mat2Quat(quaternion, rotation_root.flatten())
+    qpos[3:7] = quaternion
+
+
+def set_initial_state(plant: Plant, data: mujoco.MjData, position_base: Array, yaw: float, angles: Array,
+                      penetration: float = 0.0) -> None:
+    """Stand the plant in the first pose at rest: the base origin [m] and yaw [rad], the leg angles (12,)
+    [rad], the other joints at the reference pose, the lowest sole ``penetration`` [m] into the ground."""
+    model = plant.model
+    data.qpos[:] = plant.qpos_hold
+    set_base_pose(plant, data.qpos, position_base, yaw)
+    data.qpos[plant.leg_qpos] = angles[plant.leg_columns]
+    data.qvel[:] = 0.0
+    data.ctrl[:] = plant.ctrl_hold
+    data.ctrl[plant.leg_actuators] = angles
+    mujoco.mj_kinematics(model, data)
+    soles = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, f"{s}_ankle") for s in ("left", "right")]
+    if plant.imported:
+        bottom = min(float(collision_points(model, data, rigid_bodies(model, int(model.site_bodyid[site])))[:, 2]
+                           .min()) for site in soles)
+    else:
+        geoms = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"{s}_sole") for s in ("left", "right")]
+        bottom = min(float(data.geom_xpos[g][2] - model.geom_size[g][2]) for g in geoms)
+    data.qpos[2] += -bottom - penetration
+    mujoco.mj_forward(model, data)
+
+
+def plant_qpos(plant: Plant, position_base: Array, yaw: Array, angles: Array) -> Array:
+    """Full ``qpos`` rows (n, nq) of the planned motion: the base origin [m] (n, 3) and yaw [rad] (upright),
+    leg joint columns (n, 12), the other joints at the reference pose."""
+    n = len(yaw)
+    qpos = np.repeat(plant.qpos_hold[None, :], n, axis=0)
+    if plant.mount is None:
+        qpos[:, 0:3] = position_base
+        qpos[:, 3:7] = np.column_stack([np.cos(yaw / 2), np.zeros(n), np.zeros(n), np.sin(yaw / 2)])
+    else:
+        for row, position, angle in zip(qpos, position_base, yaw, strict=True):
+            set_base_pose(plant, row, position, float(angle))
+    qpos[:, plant.leg_qpos] = angles[:, plant.leg_columns]
+    return qpos
