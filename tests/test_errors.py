@@ -220,7 +220,7 @@ def _error_examples() -> list[ZmpwalkError]:
         FileFormatError("steps.toml", "[[steps]] 2: missing field 'duration'"),
         InfeasiblePatternError("the sway cubic reverses"),
         JointLimitError("left_knee", 2.7, 1.5, (0.0, 2.6)),
-        SimulationError(0.009, "back_bky", "a stiffer joint than the time step integrates"),
+        SimulationError(0.009, "root", "acceleration", "a stiffer joint than the time step integrates"),
     ]
 
 

@@ -73,9 +73,10 @@ def test_the_plant_integrates_damping_implicitly_where_euler_would_grow(tmp_path
     assert (explicit_damping_ratio(plant.model, plant.qpos_hold) >= EULER_BOUND) == (waist_kv > 1000.0)
 
 
-def test_a_diverged_simulation_raises_naming_the_joint(tmp_path: Path) -> None:
-    """Forced back to Euler, the waist's damping diverges within a few steps: the plant raises
-    instead of walking on from the state MuJoCo resets to; the error pickles with its fields."""
+def test_a_diverged_simulation_raises_at_its_tick(tmp_path: Path) -> None:
+    """Forced back to Euler, the waist's damping diverges within a few ticks: the plant raises at the end of that
+    tick, on its own clock (MuJoCo's restarts at its reset), instead of walking on from the state MuJoCo resets to;
+    the error pickles with its fields."""
     path = tmp_path / "waist.xml"
     path.write_text(_torso_on_a_waist(2000.0), encoding="utf-8")
     robot = load_robot(path)
@@ -83,9 +84,27 @@ def test_a_diverged_simulation_raises_naming_the_joint(tmp_path: Path) -> None:
     plant.model.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
     plant.stand(OnlineWalker(robot, rate=1000.0, joints=True).tick())
     plant.data.qvel[6] = 1.0  # [rad/s] the waist
-    with pytest.raises(SimulationError, match=r"diverged at t = .* joint") as raised:
-        for _ in range(1000):
+    ticks = [0]
+    with pytest.raises(SimulationError, match=r"diverged by t = .*: MuJoCo found a non-finite or huge") as raised:
+        while ticks[0] < 1000:
+            ticks[0] += 1
             plant.step()
+    assert 1 < ticks[0] < 100  # the tick that raised
+    assert raised.value.time == pytest.approx(plant.time, abs=1e-12) == pytest.approx(ticks[0] / 1000.0)  # [s]
     error = pickle.loads(pickle.dumps(raised.value))
-    assert error.joint == raised.value.joint and error.time == raised.value.time
-    assert np.isfinite(error.time) and error.time < 1.0  # [s]
+    assert (error.joint, error.time, error.quantity) == (raised.value.joint, raised.value.time, raised.value.quantity)
+
+
+def test_a_non_finite_position_names_its_joint(tmp_path: Path) -> None:
+    """MuJoCo names a bad position by its qpos address: the error maps it to the joint that holds it (after a free
+    joint's seven positions the addresses and the degrees of freedom part)."""
+    path = tmp_path / "waist.xml"
+    path.write_text(_torso_on_a_waist(200.0), encoding="utf-8")
+    robot = load_robot(path)
+    plant = MujocoPlant(robot, 1000.0)
+    plant.stand(OnlineWalker(robot, rate=1000.0, joints=True).tick())
+    knee = plant.model.joint("r_kn")
+    plant.data.qpos[knee.qposadr[0]] = np.nan
+    with pytest.raises(SimulationError) as raised:
+        plant.step()
+    assert (raised.value.joint, raised.value.quantity, raised.value.time) == ("r_kn", "position", 0.001)

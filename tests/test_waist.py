@@ -145,6 +145,15 @@ def test_a_waist_held_by_its_own_servos_is_rigid_with_the_floating_base(tmp_path
     assert robot.legs[0].hip == pytest.approx(np.array([0.0, 0.1, -0.1]) - np.array(WAIST), abs=1e-12)  # [m]
 
 
+def test_a_model_without_actuators_keeps_its_floating_base(tmp_path: Path) -> None:
+    """Without actuators (a URDF's case) the PD layer drives every joint, the waist's too, as a servo would hold
+    it: the floating torso stays the legs' base."""
+    text = waisted_biped()
+    text = text[:text.index("<tendon>")] + text[text.index("</actuator>") + len("</actuator>"):]
+    robot = load_robot(write(tmp_path, "bare.xml", text))
+    assert robot.plant is not None and robot.plant.base_body == "torso" and robot.plant.root_body == ""
+
+
 @pytest.mark.parametrize("waist_roll", [0.0, 0.1])
 def test_the_root_is_placed_from_the_pelvis(tmp_path: Path, waist_roll: float) -> None:
     """The plant writes the root's pose that puts the pelvis where the plan puts it, upright at its yaw or turned

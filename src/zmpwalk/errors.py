@@ -155,16 +155,19 @@ class SimulationError(ZmpwalkError, RuntimeError):
     reset its state, so what the run would measure after it is not the robot's.
 
     Attributes:
-        time: Simulated time of the first such step [s] (MuJoCo's clock: from the stand).
-        joint: The joint of the degree of freedom MuJoCo named.
+        time: The control tick at whose end MuJoCo had found it [s], on the run's clock.
+        joint: The joint of the first position or degree of freedom MuJoCo found so (a non-finite value spreads to
+            every degree of freedom within a step: the first is often the floating base's, not the cause).
+        quantity: ``"position"``, ``"velocity"`` or ``"acceleration"``.
     """
 
-    def __init__(self, time: float, joint: str, detail: str = "") -> None:
+    def __init__(self, time: float, joint: str, quantity: str, detail: str = "") -> None:
         self.time = time
         self.joint = joint
+        self.quantity = quantity
         extra = f"; {detail}" if detail else ""
-        super().__init__(f"the simulation diverged at t = {time:.3f} s (MuJoCo: a non-finite or huge value at joint "
-                         f"{joint!r}){extra}")
+        super().__init__(f"the simulation diverged by t = {time:.3f} s: MuJoCo found a non-finite or huge {quantity}, "
+                         f"first at joint {joint!r}{extra}")
 
 
 class InfeasiblePatternError(ZmpwalkError, ValueError):

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from zmpwalk.commands import StepCommand
-from zmpwalk.errors import InvalidParameterError, ZmpwalkError
+from zmpwalk.errors import InvalidParameterError, SimulationError, UnreachableError, ZmpwalkError
 from zmpwalk.patterns import GENERATORS
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.schedule import Schedule
@@ -241,19 +241,23 @@ def _joints(spec: WalkSpec, pattern: WalkingPattern) -> JointTrajectory:
 
 
 def _named_joints(spec: WalkSpec, pattern: WalkingPattern) -> JointTrajectory:
-    """:func:`_joints`; where the legs cannot follow the pattern of a walk the controller runs, the error is the
-    walker's own check of the commands, which names the command and the stride that fits (the pattern's leg check
-    knows a sample's time only).
+    """:func:`_joints`; where the legs cannot reach along the pattern of a walk the controller runs, the error is
+    the walker's own check of the commands, which names the command and the stride that fits (the pattern's leg
+    check knows a sample's time only): the controller walks the commands until its first refusal, an error path of
+    seconds.
 
     Raises:
         ZmpwalkError: The walker's refusal of the first command it cannot walk; else the pattern's own error.
     """
     try:
         return _joints(spec, pattern)
-    except ZmpwalkError:
+    except UnreachableError as error:
         if not through_controller(spec):
             raise
-        _controller_walk(spec, None)  # raises the first refusal, in spec.source's words
+        try:
+            _controller_walk(spec, None)  # raises the first refusal, in spec.source's words
+        except SimulationError:
+            raise error from None
         raise
 
 

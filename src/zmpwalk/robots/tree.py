@@ -147,8 +147,12 @@ def legs_base(model: object, root: int, feet: list[int]) -> int:
         if left != right:
             break
         split = left
+    if m.nu == 0:  # type: ignore[attr-defined]
+        return root  # no actuators (a URDF): the PD layer drives every joint, the waist's as a servo holds it
+    on_joints = {int(mujoco.mjtTrn.mjTRN_JOINT), int(mujoco.mjtTrn.mjTRN_JOINTINPARENT)}  # a numpy integer is
+    # never `in` a tuple of enum members
     driven = {int(m.actuator_trnid[a][0]) for a in range(m.nu)  # type: ignore[attr-defined]
-              if m.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT}  # type: ignore[attr-defined]
+              if int(m.actuator_trntype[a]) in on_joints}  # type: ignore[attr-defined]
     return split if any(j not in driven for j in joint_path(m, root, split)) else root
 
 

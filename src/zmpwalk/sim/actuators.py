@@ -64,7 +64,7 @@ def actuator_table(result: SimulationResult, skip: float = 0.0) -> list[Actuator
     by current over milliseconds, not by one sample); the largest single-sample torque is reported apart.
     """
     keep = result.time >= skip
-    if not keep.any():  # nothing measured from there on (a walk that fell before): every figure not measured
+    if not keep.any():  # a walk that ended before ``skip``: its figures over every sample it has
         keep = np.ones(len(result.time), dtype=bool)
     torque = np.abs(result.joint_torques[keep])
     velocity = result.joint_velocities[keep]

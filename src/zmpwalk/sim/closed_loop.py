@@ -22,6 +22,7 @@ from zmpwalk.errors import InfeasiblePatternError, UnreachableError
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.sides import Support
 from zmpwalk.sim.disturbances import Disturbances, SensorNoise, _MeasurementReader
+from zmpwalk.sim.integrator import diverged, divergence_counters
 from zmpwalk.sim.plant import Plant
 from zmpwalk.sim.references import CONTROL_RATE, tracked_references
 from zmpwalk.sim.soles import SensorSlices
@@ -96,6 +97,7 @@ def closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabil
         return readings, log
     stabilizer.reset()
     last_capture = -n
+    counters = divergence_counters(data)
     for k in range(n):
         if progress is not None and k % 500 == 0:
             progress(k / n)
@@ -110,6 +112,7 @@ def closed_loop(model: mujoco.MjModel, data: mujoco.MjData, plant: Plant, stabil
         for _ in range(steps_per_tick):
             mujoco.mj_step(model, data)
         readings[k] = data.sensordata
+        _raise_diverged(model, counters, float(time[k]))
         state = stabilizer.state
         _record(log, k, state)
         if capture is not None and _capture_due(tracks.tracked["support"], k, last_capture, state, capture[0],
@@ -133,6 +136,7 @@ def _played(model: mujoco.MjModel, data: mujoco.MjData, control: Array, steps_pe
     """Play ``control`` tick by tick with no stabilizer (the push of ``disturbances`` applied), filling
     ``readings``; after the state turns non-finite every later row repeats the last one."""
     n = len(readings)
+    counters = divergence_counters(data)
     for k in range(n):
         if progress is not None and k % 500 == 0:
             progress(k / n)
@@ -142,9 +146,17 @@ def _played(model: mujoco.MjModel, data: mujoco.MjData, control: Array, steps_pe
         for _ in range(steps_per_tick):
             mujoco.mj_step(model, data)
         readings[k] = data.sensordata
+        _raise_diverged(model, counters, float(time[k]))
         if not np.all(np.isfinite(data.qpos)):
             readings[k + 1:] = readings[k]
             break
+
+
+def _raise_diverged(model: mujoco.MjModel, counters: tuple[object, ...], time: float) -> None:
+    """Raise :class:`~zmpwalk.errors.SimulationError` where MuJoCo found the state diverged (and reset it)."""
+    error = diverged(model, counters, time)
+    if error is not None:
+        raise error
 
 
 def _record(log: dict[str, Array], k: int, state: BalanceState) -> None:

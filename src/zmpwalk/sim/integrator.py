@@ -5,12 +5,19 @@ joints between a light pelvis and a heavy torso); :func:`zmpwalk.sim.plant.build
 
 from __future__ import annotations
 
+from typing import Any
+
 import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
+from zmpwalk.errors import SimulationError
+from zmpwalk.robots.pd import element_name
+
 Array = NDArray[np.float64]
 
+_DIVERGED = ((mujoco.mjtWarning.mjWARN_BADQPOS, "position"), (mujoco.mjtWarning.mjWARN_BADQVEL, "velocity"),
+             (mujoco.mjtWarning.mjWARN_BADQACC, "acceleration"))
 EULER_BOUND = 2.0  # [-] kv h / I at which Euler's explicit damping stops decaying: |1 - kv h / I| = 1
 
 
@@ -34,9 +41,34 @@ def explicit_damping_ratio(model: mujoco.MjModel, qpos: Array) -> float:
     inverse_diagonal = np.diag(np.linalg.inv(mass))
     largest = 0.0
     for actuator in range(model.nu):
-        if model.actuator_trntype[actuator] != mujoco.mjtTrn.mjTRN_JOINT:
-            continue
+        if (int(model.actuator_trntype[actuator]) != int(mujoco.mjtTrn.mjTRN_JOINT)
+                or int(model.actuator_biastype[actuator]) != int(mujoco.mjtBias.mjBIAS_AFFINE)):
+            continue  # a bias other than affine does not read biasprm[2] as damping
         damping = -float(model.actuator_biasprm[actuator][2]) * float(model.actuator_gear[actuator][0]) ** 2
         dof = int(model.jnt_dofadr[model.actuator_trnid[actuator][0]])
         largest = max(largest, damping * float(model.opt.timestep) * float(inverse_diagonal[dof]))
     return largest
+
+
+def divergence_counters(data: mujoco.MjData) -> tuple[Any, ...]:
+    """MuJoCo's counters of a diverged position, velocity and acceleration in ``data`` (live views: each step
+    counts into them); read them with :func:`diverged`."""
+    return tuple(data.warning[int(kind)] for kind, _ in _DIVERGED)
+
+
+def diverged(model: mujoco.MjModel, counters: tuple[Any, ...], time: float) -> SimulationError | None:
+    """The error for the first counter of :func:`divergence_counters` that counted (MuJoCo reset the state), naming
+    the joint of the position or degree of freedom it found first; None while none has. ``time`` [s]: the run's
+    clock at the end of the tick (MuJoCo's own restarts at its reset)."""
+    for counter, (_, quantity) in zip(counters, _DIVERGED, strict=True):
+        if not counter.number:
+            continue
+        index = int(counter.lastinfo)
+        if quantity == "position":  # a qpos address: the joint whose positions start at or before it
+            joint = int(np.searchsorted(model.jnt_qposadr, index, side="right")) - 1
+        else:  # a degree of freedom
+            joint = int(model.dof_jntid[index]) if 0 <= index < model.nv else -1
+        name = element_name(model, mujoco.mjtObj.mjOBJ_JOINT, joint) if 0 <= joint < model.njnt else "?"
+        return SimulationError(time, name, quantity, "a stiffer or more damped joint than the time step integrates "
+                               f"({model.opt.timestep:g} s), or forces beyond the model's")
+    return None

@@ -21,11 +21,12 @@ from numpy.typing import NDArray
 
 from zmpwalk.balance import BalanceMeasurement
 from zmpwalk.control.plant import JointTargets
-from zmpwalk.errors import InvalidParameterError, SimulationError
+from zmpwalk.errors import InvalidParameterError
 from zmpwalk.robots.model import RobotModel
-from zmpwalk.robots.pd import element_name, is_position_servo
+from zmpwalk.robots.pd import is_position_servo
 from zmpwalk.sample import WalkingSample
 from zmpwalk.sim.disturbances import NOSLIP_ITERATIONS, SensorNoise
+from zmpwalk.sim.integrator import diverged, divergence_counters
 from zmpwalk.sim.mjcf import contact_mapping
 from zmpwalk.sim.plant import Plant as SimPlant
 from zmpwalk.sim.plant import build_plant, passive_torques, static_feedforward
@@ -254,8 +255,7 @@ class MujocoPlant:
         self.weight = float(model.body_subtreemass[1]) * robot.gravity  # [N]
         self._upright_least, self._least_height = math.cos(FALL_TILT), FALL_HEIGHT_FRACTION * robot.pelvis_height
         self._ticks = 0
-        self._diverged = tuple(self.data.warning[int(kind)] for kind in (  # live views: MuJoCo counts into them
-            mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL, mujoco.mjtWarning.mjWARN_BADQACC))
+        self._diverged = divergence_counters(self.data)
         self._origin = round(time_origin * self.rate)  # [ticks]
         self._delay = round(latency * self.rate)
         if abs(self._delay - latency * self.rate) > 1e-6:
@@ -332,18 +332,11 @@ class MujocoPlant:
                 mujoco.mj_step(self.model, self.data)
         self._ticks += 1
         if self._diverged[0].number or self._diverged[1].number or self._diverged[2].number:
-            self._raise_diverged()
+            error = diverged(self.model, self._diverged, self.time)
+            if error is not None:
+                raise error
         if self._delay:
             self._past[self._ticks % (self._delay + 1)] = self.sensordata
-
-    def _raise_diverged(self) -> None:
-        """Raise :class:`~zmpwalk.errors.SimulationError` for MuJoCo's first warning of a diverged state."""
-        warning = next(w for w in self._diverged if w.number)
-        dof = int(warning.lastinfo)
-        joint = (element_name(self.model, mujoco.mjtObj.mjOBJ_JOINT, int(self.model.dof_jntid[dof]))
-                 if 0 <= dof < self.model.nv else "?")
-        raise SimulationError(float(self.data.time), joint, "a stiffer or more damped joint than the time step "
-                              f"integrates ({self.model.opt.timestep:g} s), or forces beyond the model's")
 
     def fallen(self) -> bool:
         """The fall criterion of :mod:`zmpwalk.sim.run` now (the torso touching the floor, tilted over
