@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import mujoco
 import numpy as np
@@ -83,6 +84,17 @@ class Plant:
     imported: bool
     leg_columns: NDArray[np.intp] = field(default_factory=lambda: np.arange(12))
     mount: Mount | None = None
+
+    @cached_property
+    def root_in_base(self) -> tuple[float, ...] | None:
+        """The floating root's origin [m] and orientation (quaternion w, x, y, z) in the legs' base frame, from
+        :attr:`mount` (``-R^T o`` and ``R^T``); None where the base is the root."""
+        if self.mount is None:
+            return None
+        offset, rotation = self.mount
+        quaternion = np.empty(4)
+        mujoco.mju_mat2Quat(quaternion, np.ascontiguousarray(rotation.T).flatten())
+        return (*(-rotation.T @ offset).tolist(), *quaternion.tolist())
 
 
 def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:

@@ -25,6 +25,15 @@ def set_base_pose(plant: Plant, qpos: Array, position_base: Array, yaw: float,
         qpos[0:3] = position_base
         qpos[3:7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)) if quaternion_base is None else quaternion_base
         return
+    root = plant.root_in_base
+    if quaternion_base is None and root is not None:  # upright at yaw, scalar arithmetic (a tick's feedforward)
+        ox, oy, oz, w, x, y, z = root
+        c, s = math.cos(yaw), math.sin(yaw)
+        px, py, pz = (float(v) for v in position_base)
+        qpos[0], qpos[1], qpos[2] = px + c * ox - s * oy, py + s * ox + c * oy, pz + oz
+        cw, sz = math.cos(yaw / 2), math.sin(yaw / 2)  # (cw, 0, 0, sz) * (w, x, y, z)
+        qpos[3], qpos[4], qpos[5], qpos[6] = cw * w - sz * z, cw * x - sz * y, cw * y + sz * x, cw * z + sz * w
+        return
     quaternion = np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)] if quaternion_base is None
                           else quaternion_base, dtype=np.float64)  # a copy: the caller's stays as given
     rotation_base = np.empty(9)
