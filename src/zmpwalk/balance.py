@@ -122,7 +122,7 @@ class BalanceMeasurement:
     Attributes:
         wrench_left, wrench_right: Force [N] (3) then torque [N m] (3) that the ground exerts on each foot,
             about the ankle point, in the foot frame (x forward along the sole, y left, z up), (6,).
-        attitude: Torso (base) roll and pitch [rad] from the IMU, (2,).
+        attitude: Torso (base) roll and pitch [rad] from the IMU, (2,): of the legs' base (docs/controller.md).
         rate: Torso angular velocity in the base frame [rad/s] (gyro), (3,).
         joint_angles: The 12 leg joint encoders [rad], columns of :data:`zmpwalk.kinematics.JOINT_COLUMNS`.
         yaw: Torso heading in world [rad] (the IMU's, from the walk's start), or None to use the pattern's.
