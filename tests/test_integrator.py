@@ -63,14 +63,43 @@ def _torso_on_a_waist(waist_kv: float) -> str:
                                                       (200.0, mujoco.mjtIntegrator.mjINT_EULER)])
 def test_the_plant_integrates_damping_implicitly_where_euler_would_grow(tmp_path: Path, waist_kv: float,
                                                                         integrator: int) -> None:
-    """The model's Euler integrator is kept while every servo's damping is within its explicit bound, and
-    replaced by implicitfast where one is not (Atlas's torso on its back joints: 3.8)."""
+    """The model's Euler integrator is kept while every damping mode is within its explicit bound, and replaced by
+    implicitfast where one is not (Atlas's torso on its back joints)."""
     path = tmp_path / "waist.xml"
     path.write_text(_torso_on_a_waist(waist_kv), encoding="utf-8")
     plant = build_plant(load_robot(path))
     assert mujoco.MjModel.from_xml_path(str(path)).opt.integrator == mujoco.mjtIntegrator.mjINT_EULER
     assert plant.model.opt.integrator == integrator
     assert (explicit_damping_ratio(plant.model, plant.qpos_hold) >= EULER_BOUND) == (waist_kv > 1000.0)
+
+
+def test_the_bound_is_the_damping_modes_not_one_joint_at_a_time() -> None:
+    """Two hinges in series, each damper within its own bound taken alone with the other free (``kv h (M^-1)_jj``
+    = 1.9 at most), can still have a mode past 2: the ratio is the largest eigenvalue of ``h D^1/2 M^-1 D^1/2``, checked
+    against numpy on the model's own mass matrix and against the growth Euler gives that mode."""
+    h = 0.001  # [s]
+    text = """<mujoco><option timestep="{h}" gravity="0 0 0"/><worldbody>
+<body><joint name="a" axis="0 0 1"/><inertial pos="0.1 0 0" mass="1" diaginertia="0.001 0.001 0.001"/>
+ <body pos="0.2 0 0"><joint name="b" axis="0 0 1"/><inertial pos="0.1 0 0" mass="1" diaginertia="0.001 0.001 0.001"/>
+ </body></body></worldbody><actuator><position joint="a" kp="0" kv="{kv}"/><position joint="b" kp="0" kv="{kv}"/>
+</actuator></mujoco>"""
+    probe = mujoco.MjModel.from_xml_string(text.format(h=h, kv=1.0))
+    data = mujoco.MjData(probe)
+    mujoco.mj_forward(probe, data)
+    mass = np.zeros((2, 2))
+    mujoco.mj_fullM(probe, data, mass)
+    inverse = np.linalg.inv(mass)
+    kv = 1.9 / (h * inverse.diagonal().max())  # [N m s/rad] each joint alone at 1.9
+    model = mujoco.MjModel.from_xml_string(text.format(h=h, kv=kv))
+    largest = float(np.linalg.eigvals(h * inverse * kv).real.max())
+    assert largest > 2.0  # the coupled mode is past the bound
+    assert explicit_damping_ratio(model, np.zeros(2)) == pytest.approx(largest, rel=1e-9)
+    data = mujoco.MjData(model)
+    values, vectors = np.linalg.eig(h * inverse * kv)
+    data.qvel[:] = 1e-6 * vectors[:, int(np.argmax(values.real))].real  # [rad/s] small: M stays as it is
+    before = np.linalg.norm(data.qvel)
+    mujoco.mj_step(model, data, 5)
+    assert np.linalg.norm(data.qvel) == pytest.approx(before * abs(1.0 - largest) ** 5, rel=1e-6)  # Euler grows it
 
 
 def test_a_diverged_simulation_raises_at_its_tick(tmp_path: Path) -> None:

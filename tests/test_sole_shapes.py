@@ -89,3 +89,25 @@ def test_a_foot_geom_paired_only_with_the_robot_is_not_its_sole(tmp_path: Path) 
     robot = load_robot(path)
     assert robot.foot_length == pytest.approx(0.2, abs=1e-6) and robot.foot_width == pytest.approx(0.08, abs=1e-6)
     assert robot.ankle_height == pytest.approx(0.06, abs=1e-6)
+
+
+def test_a_pair_of_slightly_tilted_cylinders_is_the_sole_along_them(tmp_path: Path) -> None:
+    """Two cylinders along the foot whose far ends sit 2.1 mm lower over 0.2 m (0.6 degrees, PNDbotics Adam Lite's
+    0.53): measured from the world's up only their toe ends were within 2 mm of the lowest (a 0 mm long sole,
+    refused); the plane their bottom lines lie in is the sole's, its pitch the tilt the inverse kinematics levels."""
+    import math
+
+    from zmpwalk.robots.collision import tilt_of
+
+    drop = 0.0021  # [m] over the 0.2 m bars
+    foot = "".join(f'<geom type="cylinder" fromto="-0.07 {y} -0.04 0.13 {y} {-0.04 - drop}" size="0.02" '
+                   'mass="0.25"/>' for y in (0.02, -0.02))
+    path = tmp_path / "tilted.xml"
+    path.write_text(biped(foot), encoding="utf-8")
+    robot = load_robot(path)
+    assert robot.foot_length == pytest.approx(0.2, rel=1e-3)  # [m]
+    assert robot.foot_width == pytest.approx(0.04, rel=1e-3)  # [m] between the bars' bottom lines
+    assert robot.legs is not None
+    roll, pitch = tilt_of(robot.legs[0].sole_rotation[:, 2])
+    assert roll == pytest.approx(0.0, abs=1e-12)
+    assert abs(pitch) == pytest.approx(math.atan2(drop, 0.2), abs=1e-9)  # [rad]

@@ -110,11 +110,40 @@ def sole_face_up(model: object, data: object, bodies: list[int], lowest: float) 
         lowest = float(d.geom_xpos[g][2] - np.abs(rotation[2, :]) @ m.geom_size[g])  # type: ignore[attr-defined]
         if best is None or lowest < best[0]:
             best = (lowest, np.array(up, dtype=np.float64))
+    if best is None:
+        best = _lowest_bar_up(m, d, bodies, colliding)
     if best is None or math.acos(min(float(best[1][2]), 1.0)) > FACE_TILT:
         return None
     if best[0] > lowest + SOLE_BAND:  # the box is not what the foot stands on (spheres, a mesh below it)
         return None
     return best[1]
+
+
+def _lowest_bar_up(model: object, data: object, bodies: list[int],
+                   colliding: set[int]) -> tuple[float, Array] | None:
+    """Of a foot without a collision box, the cylinder or capsule lying lowest (PNDbotics Adam Lite's two
+    cylinders along the foot): its lowest height [m] and the up of the plane its bottom line lies in, the world's
+    up made square to its axis (level across the bar, along the bar as it lies); None without such a geom."""
+    import mujoco
+
+    m, d = model, data
+    bars = (int(mujoco.mjtGeom.mjGEOM_CYLINDER), int(mujoco.mjtGeom.mjGEOM_CAPSULE))
+    best: tuple[float, Array] | None = None
+    for g in range(m.ngeom):  # type: ignore[attr-defined]
+        kind = int(m.geom_type[g])  # type: ignore[attr-defined]
+        if int(m.geom_bodyid[g]) not in bodies or g not in colliding or kind not in bars:  # type: ignore[attr-defined]
+            continue
+        axis = d.geom_xmat[g].reshape(3, 3)[:, 2]  # type: ignore[attr-defined]
+        radius, half = float(m.geom_size[g][0]), float(m.geom_size[g][1])  # type: ignore[attr-defined]
+        across = math.sqrt(max(1.0 - float(axis[2]) ** 2, 0.0))  # a cylinder's end circle reaches down this much
+        drop = radius if kind == int(mujoco.mjtGeom.mjGEOM_CAPSULE) else radius * across
+        lowest = float(d.geom_xpos[g][2]) - abs(float(axis[2])) * half - drop  # type: ignore[attr-defined]
+        up = np.array([0.0, 0.0, 1.0]) - float(axis[2]) * np.asarray(axis, dtype=np.float64)
+        if np.linalg.norm(up) < 1e-9:  # a bar standing upright: no plane
+            continue
+        if best is None or lowest < best[0]:
+            best = (lowest, up / np.linalg.norm(up))
+    return best
 
 
 def collision_points(model: object, data: object, bodies: list[int]) -> Array:

@@ -22,32 +22,32 @@ EULER_BOUND = 2.0  # [-] kv h / I at which Euler's explicit damping stops decayi
 
 
 def explicit_damping_ratio(model: mujoco.MjModel, qpos: Array) -> float:
-    r"""The largest ``kv h / I`` over the model's servos on a joint at ``qpos``: ``kv`` a servo's damping on its
-    joint [N m s/rad] (``-biasprm[2] gear^2``), ``h`` the time step [s], ``I = 1 / (M^{-1})_{jj}`` the inertia the
-    joint's degree of freedom moves with everything else free [kg m^2].
+    r"""The largest eigenvalue of ``h D^1/2 M^-1 D^1/2`` at ``qpos``: ``D`` the servos' damping on each degree of
+    freedom [N m s/rad] (``-biasprm[2] gear^2`` of each affine servo on a joint), ``M`` the joint-space inertia
+    [kg m^2] (everything free), ``h`` the time step [s].
 
-    MuJoCo's Euler integrator applies an actuator's damping explicitly: on one degree of freedom ``v' = -(kv / I)
-    v`` steps as ``v_{k+1} = (1 - kv h / I) v_k``, which grows once ``kv h / I >= 2`` (:data:`EULER_BOUND`);
-    :func:`zmpwalk.sim.plant.build_plant` then integrates with ``implicitfast`` (the damping implicit), as MuJoCo
-    advises for such models. A servo's stiffness ``kp h^2 / I`` is far inside its own bound (4) wherever the damping
-    is critical (``kv = 2 sqrt(kp I)``). The bound on the diagonal is a lower bound of the damping modes' (the
-    largest eigenvalue of ``h D^1/2 M^-1 D^1/2``), which the stance feet's contacts stiffen: the diagonal's is the one
-    kept (docs/design-log/robot-import.md)."""
+    MuJoCo's Euler integrator applies an actuator's damping explicitly: ``v' = -M^-1 D v`` steps as ``v_{k+1} = (1
+    - h M^-1 D) v_k``, whose modes (the eigenvalues of ``h M^-1 D``, those of the symmetric matrix above) grow once
+    one reaches 2 (:data:`EULER_BOUND`); on one degree of freedom it is ``kv h / I``. :func:`zmpwalk.sim.plant.
+    build_plant` then integrates with ``implicitfast`` (the damping implicit), as MuJoCo advises for such models. A
+    servo's stiffness ``kp h^2 / I`` is far inside its own bound (4) wherever the damping is critical (``kv = 2 sqrt(kp
+    I)``). The contacts of the feet are left out (they stiffen the legs' modes): the bound errs towards implicitfast."""
     data = mujoco.MjData(model)
     data.qpos[:] = qpos
     mujoco.mj_forward(model, data)
     mass = np.zeros((model.nv, model.nv))
     mujoco.mj_fullM(model, data, mass)
-    inverse_diagonal = np.diag(np.linalg.inv(mass))
-    largest = 0.0
+    damping = np.zeros(model.nv)
     for actuator in range(model.nu):
         if (int(model.actuator_trntype[actuator]) != int(mujoco.mjtTrn.mjTRN_JOINT)
                 or int(model.actuator_biastype[actuator]) != int(mujoco.mjtBias.mjBIAS_AFFINE)):
             continue  # a bias other than affine does not read biasprm[2] as damping
-        damping = -float(model.actuator_biasprm[actuator][2]) * float(model.actuator_gear[actuator][0]) ** 2
         dof = int(model.jnt_dofadr[model.actuator_trnid[actuator][0]])
-        largest = max(largest, damping * float(model.opt.timestep) * float(inverse_diagonal[dof]))
-    return largest
+        gear = float(model.actuator_gear[actuator][0])
+        damping[dof] += max(0.0, -float(model.actuator_biasprm[actuator][2]) * gear * gear)
+    root = np.sqrt(damping)
+    modes = float(model.opt.timestep) * root[:, None] * np.linalg.inv(mass) * root[None, :]
+    return float(np.linalg.eigvalsh(modes).max()) if model.nv else 0.0
 
 
 def divergence_counters(data: mujoco.MjData) -> tuple[Any, ...]:
