@@ -102,7 +102,6 @@ class ModelFeedforward:
         self._mass = float(np.sum(model.body_mass))
         self._gravity = -float(model.opt.gravity[2])
         self._qpos = plant.qpos_hold.copy()
-        self._qpos[4:6] = 0.0  # the base upright: torques() writes only the quaternion's w and z
         self._previous_qpos: Array | None = None
         self._qvel, self._previous_qvel = np.zeros(model.nv), np.zeros(model.nv)
         self._tau = np.zeros(model.nv)
@@ -125,14 +124,9 @@ class ModelFeedforward:
         angles = sample.joint_angles if sample.joint_angles is not None else _held_angles(plant)
         qpos = self._qpos
         yaw = sample.yaw_pelvis_in_world
-        if plant.mount is not None:  # the legs' base below a waist: the root placed from it
-            set_base_pose(plant, qpos, _base_position(plant, self._scratch, sample, angles, self._sites), yaw)
-        else:
-            if plant.imported:
-                qpos[0:3] = _base_position(plant, self._scratch, sample, angles, self._sites)
-            else:  # the box model's base is the pelvis point
-                qpos[0:3] = sample.position_pelvis_in_world
-            qpos[3], qpos[6] = math.cos(yaw / 2), math.sin(yaw / 2)  # upright: qpos[4:6] stay 0
+        base = (_base_position(plant, self._scratch, sample, angles, self._sites) if plant.imported
+                else sample.position_pelvis_in_world)  # the box model's base is the pelvis point
+        set_base_pose(plant, qpos, base, yaw)  # the root placed from it (below a waist, through the held waist)
         if self._leg_slice is not None:
             qpos[self._leg_slice] = angles
         else:

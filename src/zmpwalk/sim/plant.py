@@ -127,7 +127,9 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
     add_pd_layer(spec, plant)
     lift_control_ranges(spec, model)
     qpos = np.array(plant.qpos_reference)
-    _add_sites(spec, model, robot, plant, qpos)
+    root = floating_base(model, str(plant.path))
+    mount = base_mount(model, qpos, root, mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, plant.base_body))
+    _add_sites(spec, model, robot, plant, qpos, (int(model.jnt_qposadr[model.body_jntadr[root]]), mount))
     virtual = _virtual_columns(robot)
     _add_sensors(spec, plant, virtual)
     model = spec.compile()
@@ -138,24 +140,21 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
     columns = np.array([i for i in range(12) if i not in virtual], dtype=np.intp)
     leg_qpos = np.array([model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, plant.joints[i].name)]
                          for i in columns])
-    root = floating_base(model, str(plant.path))
-    mount = base_mount(model, qpos, root, mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, plant.base_body))
     return Plant(model, np.array(actuators), leg_qpos, _held_controls(model, plant), qpos, True, columns, mount)
 
 
 def _add_sites(spec: mujoco.MjSpec, model: mujoco.MjModel, robot: RobotModel, plant: ModelPlant,
-               qpos: Array) -> None:
+               qpos: Array, root: tuple[int, Mount | None]) -> None:
     """Add the ``pelvis`` site at the base body's origin and an ``{left,right}_ankle`` site at each ankle point
     (axes of the sole frame), placed in the foot bodies from the zero pose of the legs with the base at the origin
-    (``qpos``: the reference pose, the other joints' angles)."""
+    (``qpos``: the reference pose, the other joints' angles; ``root``: the floating root's ``qpos`` address and
+    where the legs' base sits on it)."""
     data = mujoco.MjData(model)
     joint_ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint.name) for joint in plant.joints]
     zero = qpos.copy()
     for j in joint_ids:
         zero[model.jnt_qposadr[j]] = 0.0
-    root = floating_base(model, str(plant.path))
-    root_adr = int(model.jnt_qposadr[model.body_jntadr[root]])
-    mount = base_mount(model, qpos, root, mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, plant.base_body))
+    root_adr, mount = root
     position_root, rotation_root = root_from_base(mount, np.zeros(3), np.eye(3))  # the base at the origin
     zero[root_adr:root_adr + 3] = position_root
     mujoco.mju_mat2Quat(zero[root_adr + 3:root_adr + 7], rotation_root.flatten())
