@@ -20,7 +20,7 @@ from zmpwalk.patterns.polynomial import generate
 from zmpwalk.patterns.result import WalkingPattern
 from zmpwalk.robots import load_robot
 from zmpwalk.robots.model import RobotModel
-from zmpwalk.whole_body import COM_TOLERANCE, IK_CHUNK, LegFill, imported_legs_in_parts, leg_parts
+from zmpwalk.whole_body import COM_TOLERANCE, IK_CHUNK, LegFill, compile_kernel, imported_legs_in_parts, leg_parts
 
 ROBOTS = Path(__file__).resolve().parents[2] / "shared" / "robots"
 MODELS = {"talos": ROBOTS / "pal_talos" / "scene_position.xml", "booster_t1": ROBOTS / "booster_t1" / "scene.xml",
@@ -109,6 +109,17 @@ def test_the_rates_are_the_chains_inverse_jacobian_of_the_feet_twists(name: str,
     # and they are the angles' time derivative (central differences at 500 Hz: O(dt^2))
     finite = np.gradient(np.unwrap(trajectory.angles, axis=0), pattern.time, axis=0)
     assert np.abs(finite[1:-1] - trajectory.velocities[1:-1]).max() < 0.02  # [rad/s]
+
+
+def test_compiling_ahead_gives_the_kernel_the_types_a_fill_gives_it(tmp_path: Path) -> None:
+    """The build's warm-up (compile_kernel, run by setup.py so that the first walk of an imported robot loads the
+    kernel instead of compiling it) compiles the one specialisation that a walk's fill then calls: no other."""
+    from zmpwalk.stabilizer import whole_body_ik
+
+    compile_kernel()
+    walk_of(robot_of("talos", tmp_path))
+    assert len(whole_body_ik.base_under_com.signatures) == 1
+    assert len(whole_body_ik.joint_rates.signatures) == 1
 
 
 def test_a_part_solves_at_most_a_chunk_of_samples(tmp_path: Path) -> None:

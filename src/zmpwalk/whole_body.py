@@ -92,10 +92,17 @@ class LegFill:
                  velocity_com_in_world: Array, yaw_rate_pelvis: Array,
                  feet: tuple[tuple[Array, Array, Array, Array], tuple[Array, Array, Array, Array]],
                  robot: RobotModel) -> None:
+        self._fill(time, position_com_in_world, yaw_pelvis_in_world, velocity_com_in_world, yaw_rate_pelvis, feet,
+                   _arrays(robot))
+
+    def _fill(self, time: Array, position_com_in_world: Array, yaw_pelvis_in_world: Array,
+              velocity_com_in_world: Array, yaw_rate_pelvis: Array,
+              feet: tuple[tuple[Array, Array, Array, Array], tuple[Array, Array, Array, Array]],
+              arrays: _Arrays) -> None:
         from zmpwalk.stabilizer import whole_body_ik  # compiles (or loads) the kernel: only where wanted
 
         self._kernel = whole_body_ik
-        self._arrays = _arrays(robot)
+        self._arrays = arrays
         n = len(time)
         self.time = np.ascontiguousarray(time, dtype=np.float64)
         self._com = np.ascontiguousarray(position_com_in_world, dtype=np.float64)
@@ -122,19 +129,26 @@ class LegFill:
 
     def advance(self) -> None:
         """One part: the next chunk's base and angles, then the rates of the rows whose neighbours are solved."""
-        n, arrays, kernel = len(self.time), self._arrays, self._kernel
+        n = len(self.time)
         if self._solved < n:
             last = min(self._solved + IK_CHUNK, n)
-            kernel.base_under_com(arrays.params, arrays.chain, arrays.sole_back, self._com, self._yaw,
-                                  self._feet[0], self._feet[1], self._solved, last, self._start, COM_TOLERANCE,
-                                  self.base, self.angles, self.excess)
+            self._solve(self._solved, last)
             self._solved = last
         ready = n if self._solved == n else self._solved - 1  # a row's rate reads the next row's base
         if ready > self.done:
-            kernel.joint_rates(arrays.params, arrays.chain, self.time, self.angles, self.base, self._com,
-                               self._velocity, self._yaw, self._yaw_rate, self._feet[0], self._feet[2],
-                               self._feet[3], self.done, ready, self.rates)
+            self._rates(self.done, ready)
             self.done = ready
+
+    def _solve(self, first: int, last: int) -> None:
+        arrays = self._arrays
+        self._kernel.base_under_com(arrays.params, arrays.chain, arrays.sole_back, self._com, self._yaw,
+                                    self._feet[0], self._feet[1], first, last, self._start, COM_TOLERANCE,
+                                    self.base, self.angles, self.excess)
+
+    def _rates(self, first: int, last: int) -> None:
+        self._kernel.joint_rates(self._arrays.params, self._arrays.chain, self.time, self.angles, self.base,
+                                 self._com, self._velocity, self._yaw, self._yaw_rate, self._feet[0],
+                                 self._feet[2], self._feet[3], first, last, self.rates)
 
     def parts(self) -> Parts[None]:
         """:meth:`advance` until every row is filled, a part each."""
@@ -155,10 +169,22 @@ def imported_legs_in_parts(time: Array, position_com_in_world: Array, yaw_pelvis
     return fill.base, fill.angles, fill.rates, fill.excess
 
 
+def compile_kernel() -> None:
+    """Compile the kernel (or load it from numba's disk cache) for the argument types :class:`LegFill` gives it,
+    without a robot: both of its functions called as a fill calls them, on zero arrays, for no sample."""
+    one, three = np.zeros(1), np.zeros((1, 3))
+    arrays = _Arrays(params=np.zeros(PARAMETERS), chain=np.zeros((2, 6, 11)), sole_back=np.zeros((2, 3, 3)),
+                     posture=np.zeros(12), offset=np.zeros(2))
+    fill = LegFill.__new__(LegFill)
+    fill._fill(one, three, one, three, one, ((three, one, three, one), (three, one, three, one)), arrays)
+    fill._solve(0, 0)
+    fill._rates(0, 0)
+
+
 def leg_parts(robot: RobotModel, samples: int) -> int:
     """The parts :func:`imported_legs_in_parts` takes for ``samples`` samples of ``robot``'s legs (0 for a robot
     file's robot, whose closed-form legs take a few parts whatever the samples): a check's or a plan's pacing."""
     return 0 if robot.legs is None else -(-samples // IK_CHUNK)
 
 
-__all__ = ["COM_TOLERANCE", "IK_CHUNK", "LegFill", "imported_legs_in_parts", "leg_parts"]
+__all__ = ["COM_TOLERANCE", "IK_CHUNK", "LegFill", "compile_kernel", "imported_legs_in_parts", "leg_parts"]
