@@ -6,7 +6,8 @@ numba, are compiled there, once, into the package's own ``__pycache__`` folders,
 walk after the install loads them (under a second) instead of compiling them (10-20 s each on two cores). numba
 checks each cached function against its source's content, its own version and the CPU it runs on, and compiles
 again where any of them differs (a wheel moved to another machine, a numba upgraded since), so the step only saves
-time. It is skipped for editable installs (the source tree's caches are filled on first use) and where
+time. numba reads a cache only from a folder it may write to: an install the user cannot write to compiles at first
+use, into numba's cache in the user's home. It is skipped for editable installs (the source tree's caches are filled on first use) and where
 ``ZMPWALK_NO_PRECOMPILE`` is set; a failure leaves the wheel as it was (the first walk compiles).
 """
 
