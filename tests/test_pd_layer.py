@@ -245,6 +245,36 @@ def test_pd_gains_from_the_robot_file(tmp_path: Path) -> None:
         load_robot(write(tmp_path, "neg.toml", text.replace('"l_kn" = {kp = 500', '"l_kn" = {kp = -1')))
 
 
+def test_the_robot_files_load_stiffness_is_the_rules_kappa(tmp_path: Path) -> None:
+    """``[pd] load_stiffness`` replaces the rule's kappa for the joints the file does not list: a leg joint whose
+    gain is the weight term (kappa W) doubles from 4 to 8, critically damped; a named joint keeps its gains; the
+    written file offers the field; a kappa of 1 or less, or not a number, is refused naming it."""
+    model = write(tmp_path, "motor.xml", motor_biped())
+    robot = load_robot(model)
+    assert robot.plant is not None
+    text = robot_toml(robot, tmp_path)
+    assert "# load_stiffness = 4   # [-]" in text
+    kept = "\n".join(line for line in text.splitlines() if not line.startswith('"') or line.startswith('"l_kn"'))
+    stiffer = load_robot(write(tmp_path, "k8.toml", kept.replace("# load_stiffness = 4", "load_stiffness = 8")))
+    assert stiffer.plant is not None and stiffer.plant.load_stiffness == 8.0
+    before = {j.name: j.actuator for j in robot.plant.joints if j.actuator}
+    after = {j.name: j.actuator for j in stiffer.plant.joints if j.actuator}
+    weight = robot.mass * robot.gravity * robot.pendulum_length  # W of a leg joint [N m]
+    weighted = [name for name, a in before.items() if a.kp == pytest.approx(PD_LOAD_STIFFNESS * weight, rel=1e-12)]
+    assert weighted  # the synthetic legs' gains come from kappa W
+    for name in weighted:
+        if name == "l_kn":  # listed in the file: as written, 6 digits
+            assert after[name].kp == pytest.approx(before[name].kp, rel=1e-5)
+            continue
+        # W from the file's robot: its written pelvis height (6 digits) moves the pendulum by a few micrometres
+        assert after[name].kp == pytest.approx(8.0 * stiffer.mass * stiffer.gravity * stiffer.pendulum_length,
+                                               rel=1e-12)
+        assert after[name].kv == pytest.approx(2 * math.sqrt(after[name].kp * after[name].inertia), rel=1e-12)
+    for bad in ("1", "0.5", '"stiff"', "nan"):
+        with pytest.raises(FileFormatError, match=r"\[pd\] load_stiffness = .*a finite number > 1"):
+            load_robot(write(tmp_path, "bad.toml", kept.replace("# load_stiffness = 4", f"load_stiffness = {bad}")))
+
+
 def inertial(mass: float, com: str, inertia: tuple[float, float, float]) -> str:
     return (f'<inertial><origin xyz="{com}"/><mass value="{mass}"/><inertia ixx="{inertia[0]}" iyy="{inertia[1]}" '
             f'izz="{inertia[2]}" ixy="0" ixz="0" iyz="0"/></inertial>')

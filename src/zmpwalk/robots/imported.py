@@ -64,7 +64,14 @@ from numpy.typing import NDArray
 from zmpwalk.errors import FileFormatError
 from zmpwalk.leg_chain import LegChain
 from zmpwalk.robots.collision import Sole, collision_points, rigid_bodies, sole_face_up, sole_roll_bound
-from zmpwalk.robots.description import HUBO_FOOT_LIFT, LIFT_RANGE_MARGIN, Actuator, LegJoint, ModelPlant
+from zmpwalk.robots.description import (
+    HUBO_FOOT_LIFT,
+    LIFT_RANGE_MARGIN,
+    PD_LOAD_STIFFNESS,
+    Actuator,
+    LegJoint,
+    ModelPlant,
+)
 from zmpwalk.robots.legs import VIRTUAL_PREFIX, FootAtReference, Segments, build_leg, leg_joint_ids, segments
 from zmpwalk.robots.model import RobotModel, schedule_scale
 from zmpwalk.robots.pd import coupled_joints, element_name, pd_layer
@@ -163,7 +170,8 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
         keyframe: The keyframe of the reference pose (default: the model's first, else its zero pose).
         package_paths: Folders holding the packages of a URDF's ``package://`` paths.
         name: Short name (default: the model's).
-        overrides: Robot-file values replacing derived ones (``pelvis_height``, ``dsp_time``, ...).
+        overrides: Robot-file values replacing derived ones (``pelvis_height``, ``dsp_time``, ...; and
+            ``load_stiffness``, the PD rule's ``kappa``, :func:`~zmpwalk.robots.pd.pd_gains`).
         pd_gains: The PD layer's gains of some joints (model joint name -> (kp [N m/rad], kv [N m s/rad] or
             None: critical damping)) replacing :func:`pd_gains`'s (a robot file's ``[pd]``).
 
@@ -171,7 +179,8 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
         FileFormatError: What the model lacks for walking, named (no floating base, no legs, a leg of
             other than five or six hinge joints, ambiguous feet, a sole that does not stand flat in the
             reference posture, ...).
-        InvalidParameterError: ``pd_gains`` names a joint the PD layer does not drive.
+        InvalidParameterError: ``pd_gains`` names a joint the PD layer does not drive, or ``load_stiffness`` is
+            not a finite number > 1.
     """
     import mujoco
 
@@ -225,11 +234,13 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     lift = _foot_lift(chains_ready, leg_joints, HUBO_FOOT_LIFT * length_scale)  # [m]
     # The joint PD layer: gains from the ready posture's inertia; a leg joint holds the robot, m g l.
     coupled = coupled_joints(model, leg_joint_set)
+    load_stiffness = values.get("load_stiffness", PD_LOAD_STIFFNESS)
     pd_joints = pd_layer(model, data, qpos, leg_joint_set, mass * float(np.linalg.norm(model.opt.gravity)) * pendulum,
-                          pd_gains or {}, coupled)
+                          pd_gains or {}, coupled, load_stiffness)
     leg_joints = _driven_joints(leg_joints, dict(pd_joints), geometry, values.get("sole_roll_limit"), source)
     names = {j: element_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in coupled}
-    plant = replace(plant, joints=tuple(leg_joints), pd_joints=pd_joints, coupled_joints=tuple(sorted(names.values())),
+    plant = replace(plant, joints=tuple(leg_joints), pd_joints=pd_joints, load_stiffness=load_stiffness,
+                    coupled_joints=tuple(sorted(names.values())),
                     held_joints=tuple(n for n in plant.held_joints if n not in names.values()))
     return _robot_model(
         name=robot_name, description=f"imported from {path.name} ({mass:.1f} kg)", mass=mass, height=height_scale,

@@ -144,8 +144,9 @@ def robot_table(robot: RobotModel, statics: StaticTorques | None = None) -> str:
         lines.append("")
         lines += _joint_lines(s["joints"], statics)
         if any(joint["actuator"] and joint["actuator"]["pd_layer"] for joint in s["joints"]) or s["pd_joints"]:
+            kappa = robot.plant.load_stiffness if robot.plant is not None else PD_LOAD_STIFFNESS
             lines.append(f"PD layer (the firmware's joint loop, run at the physics step, clipped at 'max'): kp = "
-                         f"max(I w^2, {PD_LOAD_STIFFNESS:g} W) with w = 2 pi x {PD_BANDWIDTH / (2 * math.pi):g} Hz, "
+                         f"max(I w^2, {kappa:g} W) with w = 2 pi x {PD_BANDWIDTH / (2 * math.pi):g} Hz, "
                          f"W = m g l = {robot.mass * robot.gravity * robot.pendulum_length:.1f} N m for a leg joint; "
                          f"kv = 2 x {PD_DAMPING_RATIO:g} sqrt(kp I); I [kg m^2] its reflected inertia "
                          "(docs/robot-import.md), or the robot file's [pd]")
@@ -223,7 +224,10 @@ def robot_toml(robot: RobotModel, folder: Path) -> str:
         lines += ["", "[pd]",
                   "# The joint PD layer (the firmware's joint loop) of each torque motor or unactuated joint:",
                   "# kp [N m/rad], kv [N m s/rad] (kv may be left out: critical damping). Derived by zmpwalk's rule",
-                  "# (docs/robot-import.md); put your firmware's gains here."]
+                  "# (docs/robot-import.md); put your firmware's gains here.",
+                  f"{'' if robot.plant.load_stiffness != PD_LOAD_STIFFNESS else '# '}load_stiffness = "
+                  f"{robot.plant.load_stiffness:g}   # [-] the rule's kappa (kp >= kappa W) for a joint not listed "
+                  "below: delete a joint's line to have it derived"]
         lines += [f"{_quote(name)} = {{kp = {actuator.kp:.6g}, kv = {actuator.kv:.6g}}}"
                   for name, actuator in robot.plant.pd_joints]
     lines += ["", "# Derived from the model (for checking; edit the model, not these lines):"]

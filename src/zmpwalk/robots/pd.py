@@ -88,7 +88,8 @@ def _joint_torque_limit(model: Any, joint: int) -> float:
     return float(np.max(np.abs(model.jnt_actfrcrange[joint])))
 
 
-def pd_gains(inertia: float, moment: float, timestep: float = PHYSICS_STEP) -> tuple[float, float]:
+def pd_gains(inertia: float, moment: float, timestep: float = PHYSICS_STEP,
+             load_stiffness: float = PD_LOAD_STIFFNESS) -> tuple[float, float]:
     r"""The joint PD layer's gains of one joint: stiffness ``kp`` [N m/rad] and damping ``kv`` [N m s/rad].
 
     .. math::
@@ -111,9 +112,11 @@ def pd_gains(inertia: float, moment: float, timestep: float = PHYSICS_STEP) -> t
             posture, the rotor's armature included [kg m^2].
         moment: ``W``, the weight moment the joint holds [N m] (0: the bandwidth alone).
         timestep: ``dt``, the period of the PD loop, the physics step [s].
+        load_stiffness: ``kappa`` [-], a robot file's ``[pd] load_stiffness`` where it gives one.
 
     Raises:
-        InvalidParameterError: A non-positive inertia or time step, or a negative moment.
+        InvalidParameterError: A non-positive inertia or time step, a negative moment, or a load stiffness
+            that is not a finite number > 1.
     """
     if not inertia > 0 or not math.isfinite(inertia):
         raise InvalidParameterError("inertia", inertia, "a finite reflected inertia > 0 kg m^2")
@@ -121,9 +124,20 @@ def pd_gains(inertia: float, moment: float, timestep: float = PHYSICS_STEP) -> t
         raise InvalidParameterError("timestep", timestep, "a physics step > 0 s")
     if not moment >= 0:
         raise InvalidParameterError("moment", moment, "a weight moment >= 0 N m")
-    kp = max(inertia * PD_BANDWIDTH ** 2, PD_LOAD_STIFFNESS * moment)
+    check_load_stiffness(load_stiffness)
+    kp = max(inertia * PD_BANDWIDTH ** 2, load_stiffness * moment)
     kp = min(kp, inertia * (PD_STEP_LIMIT / timestep) ** 2)
     return kp, 2.0 * PD_DAMPING_RATIO * math.sqrt(kp * inertia)
+
+
+def check_load_stiffness(load_stiffness: float) -> None:
+    """Raise :class:`InvalidParameterError` unless ``load_stiffness`` (``kappa`` of :func:`pd_gains`) is a finite
+    number > 1: at 1 or less a joint is no stiffer than the toppling of the weight it holds."""
+    if isinstance(load_stiffness, bool) or not isinstance(load_stiffness, (int, float)) \
+            or not math.isfinite(load_stiffness) or not load_stiffness > 1.0:
+        raise InvalidParameterError("load_stiffness", load_stiffness, "a finite number > 1 [-] (the rule's kappa, "
+                                    f"{PD_LOAD_STIFFNESS:g} by default): the joint's stiffness over the weight "
+                                    "moment it holds per radian")
 
 
 def _weight_moment(model: Any, data: Any, joint: int) -> float:
@@ -154,17 +168,18 @@ def coupled_joints(model: Any, leg_joints: set[int]) -> frozenset[int]:
 
 
 def pd_layer(model: Any, data: Any, qpos: Array, leg_joints: set[int], leg_moment: float,
-              given: dict[str, tuple[float, float | None]], coupled: frozenset[int] = frozenset()
-              ) -> tuple[tuple[str, Actuator], ...]:
+              given: dict[str, tuple[float, float | None]], coupled: frozenset[int] = frozenset(),
+              load_stiffness: float = PD_LOAD_STIFFNESS) -> tuple[tuple[str, Actuator], ...]:
     """The joints the PD layer drives, with their actuators (gains from :func:`pd_gains` at the posture ``qpos``,
     or ``given``: joint name -> (kp, kv or None for critical damping)): every torque motor on a hinge or slide,
     every leg joint without an actuator, and every joint of a model without actuators (a URDF), but the
     ``coupled`` joints (moved by a leg joint through a joint equality: :func:`coupled_joints`). A leg joint holds
-    ``leg_moment`` [N m]; another hinge the weight of what it moves (:func:`_weight_moment`); a slide nothing.
+    ``leg_moment`` [N m]; another hinge the weight of what it moves (:func:`_weight_moment`); a slide nothing;
+    ``load_stiffness`` is the rule's ``kappa``.
 
     Raises:
-        InvalidParameterError: ``given`` names a joint the layer does not drive, or a leg joint's torque
-            limit is 0.
+        InvalidParameterError: ``given`` names a joint the layer does not drive, a leg joint's torque
+            limit is 0, or the load stiffness is not a finite number > 1.
     """
     import mujoco
 
@@ -194,7 +209,7 @@ def pd_layer(model: Any, data: Any, qpos: Array, leg_joints: set[int], leg_momen
         dof = int(model.jnt_dofadr[j])
         moment = leg_moment if j in leg_joints else _weight_moment(model, data, j) if hinge else 0.0
         reflected = float(inertia[dof, dof])
-        kp, kv = pd_gains(reflected, moment, timestep)
+        kp, kv = pd_gains(reflected, moment, timestep, load_stiffness)
         if name in given:
             kp, wanted = given[name]
             kv = 2.0 * PD_DAMPING_RATIO * math.sqrt(kp * reflected) if wanted is None else wanted

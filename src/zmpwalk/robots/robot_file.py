@@ -15,6 +15,7 @@ from zmpwalk.errors import FileFormatError, InvalidParameterError
 from zmpwalk.files import read_toml
 from zmpwalk.robots.imported import import_robot
 from zmpwalk.robots.model import RobotModel, checked_generator, robot_from_dict, stabilizer_gains
+from zmpwalk.robots.pd import check_load_stiffness
 
 
 def robot_from_toml(path: Path) -> RobotModel:
@@ -65,10 +66,13 @@ def _robot_from_model_table(data: dict[str, Any], path: Path) -> RobotModel:
         raise FileFormatError(source, f"unknown table(s) {', '.join(sorted(unknown))} in a robot file with [model]")
     packages = tuple(path.parent / str(p) for p in table.get("package_paths", []))
     gains = stabilizer_gains(data.get("stabilizer"), source)
+    pd_gains, load_stiffness = _pd_table(data.get("pd"), source)
+    if load_stiffness is not None:
+        overrides["load_stiffness"] = load_stiffness
     try:
         robot = import_robot(path.parent / str(table["file"]), feet=(feet[0], feet[1]) if feet else None,
                              keyframe=table.get("keyframe"), package_paths=packages, name=table.get("name"),
-                             overrides=overrides, pd_gains=_pd_table(data.get("pd"), source))
+                             overrides=overrides, pd_gains=pd_gains)
     except InvalidParameterError as error:
         raise FileFormatError(source, f"[pd] {error}") from None
     if gains:
@@ -76,15 +80,24 @@ def _robot_from_model_table(data: dict[str, Any], path: Path) -> RobotModel:
     return robot if generator is None else replace(robot, generator=generator)
 
 
-def _pd_table(table: object, source: str) -> dict[str, tuple[float, float | None]]:
+def _pd_table(table: object, source: str) -> tuple[dict[str, tuple[float, float | None]], float | None]:
     """The ``[pd]`` table of a model robot file: the joint PD layer's gains per model joint,
-    ``JOINT = {kp = [N m/rad], kv = [N m s/rad]}`` (``kv`` may be left out: critical damping)."""
+    ``JOINT = {kp = [N m/rad], kv = [N m s/rad]}`` (``kv`` may be left out: critical damping), and the rule's
+    ``load_stiffness = kappa`` for the joints it does not name (None where not given)."""
     if table is None:
-        return {}
+        return {}, None
     if not isinstance(table, dict):
         raise FileFormatError(source, "[pd] must be a table: JOINT = {kp = N m/rad, kv = N m s/rad}")
     gains: dict[str, tuple[float, float | None]] = {}
+    load_stiffness = table.get("load_stiffness")
+    if load_stiffness is not None:
+        try:
+            check_load_stiffness(load_stiffness)
+        except InvalidParameterError as error:
+            raise FileFormatError(source, f"[pd] {error}") from None
     for joint, entry in table.items():
+        if joint == "load_stiffness":
+            continue
         if not isinstance(entry, dict) or "kp" not in entry or set(entry) - {"kp", "kv"}:
             raise FileFormatError(source, f"[pd] {joint} must be {{kp = N m/rad, kv = N m s/rad}} (kv may be left "
                                   "out: critical damping)")
@@ -102,4 +115,4 @@ def _pd_table(table: object, source: str) -> dict[str, tuple[float, float | None
         if kp is None:  # pragma: no cover - "kp" is required above
             raise FileFormatError(source, f"[pd] {joint} needs kp")
         gains[str(joint)] = (kp, values[1])
-    return gains
+    return gains, None if load_stiffness is None else float(load_stiffness)
