@@ -222,13 +222,13 @@ def robot_toml(robot: RobotModel, folder: Path) -> str:
                      "raise it for a foot that rolls on its centre line (docs/robot-import.md)")
     if robot.plant is not None and robot.plant.pd_joints:
         lines += ["", "[pd]",
-                  "# The joint PD layer (the firmware's joint loop) of each torque motor or unactuated joint:",
-                  "# kp [N m/rad], kv [N m s/rad] (kv may be left out: critical damping). Derived by zmpwalk's rule",
-                  "# (docs/robot-import.md); put your firmware's gains here.",
+                  "# The joint PD layer (the firmware's joint loop) of each torque motor or unactuated joint, derived",
+                  "# by zmpwalk's rule (docs/robot-import.md): kp = max(I w^2, kappa W), critical damping. Set the",
+                  "# rule's kappa here, or uncomment a joint's line and put your firmware's gains in it:",
+                  "# kp [N m/rad], kv [N m s/rad] (kv may be left out: critical damping).",
                   f"{'' if robot.plant.load_stiffness != PD_LOAD_STIFFNESS else '# '}load_stiffness = "
-                  f"{robot.plant.load_stiffness:g}   # [-] the rule's kappa (kp >= kappa W) for a joint not listed "
-                  "below: delete a joint's line to have it derived"]
-        lines += [f"{_quote(name)} = {{kp = {actuator.kp:.6g}, kv = {actuator.kv:.6g}}}"
+                  f"{robot.plant.load_stiffness:g}   # [-] the rule's kappa for every joint not given below"]
+        lines += [f"# {_quote(name)} = {{kp = {actuator.kp:.6g}, kv = {actuator.kv:.6g}}}"
                   for name, actuator in robot.plant.pd_joints]
     lines += ["", "# Derived from the model (for checking; edit the model, not these lines):"]
     lines += [f"#   {line}" if line else "#" for line in robot_table(robot).splitlines()]
