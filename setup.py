@@ -4,11 +4,12 @@
 (:mod:`zmpwalk.balance_kernel`) and an imported robot's legs (:mod:`zmpwalk.stabilizer.whole_body_ik`), both
 numba, are compiled there, once, into the package's own ``__pycache__`` folders, which the wheel carries: the first
 walk after the install loads them (under a second) instead of compiling them (10-20 s each on two cores). numba
-checks each cached function against its source's content, its own version and the CPU it runs on, and compiles
-again where any of them differs (a wheel moved to another machine, a numba upgraded since), so the step only saves
-time. numba reads a cache only from a folder it may write to: an install the user cannot write to compiles at first
-use, into numba's cache in the user's home. It is skipped for editable installs (the source tree's caches are filled on first use) and where
-``ZMPWALK_NO_PRECOMPILE`` is set; a failure leaves the wheel as it was (the first walk compiles).
+(0.68 on) checks each cached function against its source's content, its own version and the CPU it runs on, and
+compiles again where any of them differs (a wheel moved to another machine, a numba upgraded since), so the step
+only saves time. numba reads a cache only from a folder it may write to: an install the user cannot write to
+compiles at first use, into numba's cache in the user's home. The step is skipped for editable installs (the
+source tree's caches are filled on first use) and where ``ZMPWALK_NO_PRECOMPILE`` is set; a failure leaves the
+wheel as it was (the first walk compiles).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 from setuptools import setup
 from setuptools.command.build_py import build_py
@@ -32,9 +34,13 @@ class BuildPyCompiled(build_py):
         super().run()
         if self.editable_mode or os.environ.get("ZMPWALK_NO_PRECOMPILE") or self.dry_run:
             return
+        build_lib = Path(self.build_lib).resolve()
+        for stale in [*build_lib.rglob("*.nbi"), *build_lib.rglob("*.nbc")]:  # a build folder used before
+            stale.unlink()
         env = {key: value for key, value in os.environ.items() if key != "NUMBA_CACHE_DIR"}  # next to the sources
-        # the build folder first, then what this process sees (pip's isolated build environment: numba, numpy)
-        env["PYTHONPATH"] = os.pathsep.join([os.path.abspath(self.build_lib), *filter(None, sys.path)])
+        # the build folder first, then the PYTHONPATH pip's isolated build environment gives (numba, numpy); no .pyc
+        env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(build_lib), os.environ.get("PYTHONPATH")]))
+        env["PYTHONDONTWRITEBYTECODE"] = "1"
         self.announce("compiling the stabilizer and the legs' kernel (numba), once for this machine", level=2)
         try:
             subprocess.run([sys.executable, "-c", COMPILE], env=env, check=True, timeout=600)

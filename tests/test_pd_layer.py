@@ -20,7 +20,7 @@ from zmpwalk.patterns.polynomial import generate
 from zmpwalk.robots import load_robot
 from zmpwalk.robots.description import PD_BANDWIDTH, PD_LOAD_STIFFNESS
 from zmpwalk.robots.inspect import robot_summary, robot_toml
-from zmpwalk.robots.pd import pd_gains
+from zmpwalk.robots.pd import check_load_stiffness, pd_gains
 from zmpwalk.sim.plant import build_plant, servo_offsets, servo_torques
 from zmpwalk.sim.poses import plant_qpos, set_initial_state
 
@@ -273,6 +273,15 @@ def test_the_robot_files_load_stiffness_is_the_rules_kappa(tmp_path: Path) -> No
     for bad in ("1", "0.5", '"stiff"', "nan"):
         with pytest.raises(FileFormatError, match=r"\[pd\] load_stiffness = .*a finite number > 1"):
             load_robot(write(tmp_path, "bad.toml", kept.replace("# load_stiffness = 4", f"load_stiffness = {bad}")))
+    with pytest.raises(FileFormatError, match=r"pd joint = 'load_stiffness'"):  # a table: a joint of that name
+        load_robot(write(tmp_path, "joint.toml", kept.replace("# load_stiffness = 4", "load_stiffness = {kp = 500}")))
+    with pytest.raises(InvalidParameterError, match="load_stiffness"):  # an integer beyond a float's range
+        check_load_stiffness(10 ** 400)
+    assert check_load_stiffness(np.int64(8)) == 8.0
+    # written again from the file's robot: kappa and the joint the file gives stay given, the others commented out
+    again = robot_toml(stiffer, tmp_path)
+    assert "\nload_stiffness = 8   # [-]" in again and '\n"l_kn" = {kp = ' in again and '\n# "r_kn" = {kp = ' in again
+    assert load_robot(write(tmp_path, "again.toml", again)).plant == stiffer.plant
 
 
 def inertial(mass: float, com: str, inertia: tuple[float, float, float]) -> str:

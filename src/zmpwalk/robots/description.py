@@ -118,7 +118,9 @@ class ModelPlant:
         rest_mass: Mass of everything but the leg segments (rigid with the base) [kg].
         rest_com: Its centre of mass in the pelvis frame [m].
         pd_joints: Every joint driven by the joint PD layer, leg joints included: (joint name, its actuator).
-        load_stiffness: The PD layer's ``kappa`` (:func:`~zmpwalk.robots.pd.pd_gains`) its gains were derived with.
+        load_stiffness: The PD layer's ``kappa`` [-] (:func:`~zmpwalk.robots.pd.pd_gains`) its gains were derived
+            with.
+        pd_given: The joints whose PD gains the robot file gives (names), not derived.
         root_body: Name of the floating base where it is not ``base_body``, else empty.
         coupled_joints: Joints a leg joint moves through a joint equality (names): neither held nor driven (their
             actuators' controls 0).
@@ -138,5 +140,6 @@ class ModelPlant:
     rest_com: tuple[float, float, float] = (0.0, 0.0, 0.0)  # [m]
     pd_joints: tuple[tuple[str, Actuator], ...] = ()
     load_stiffness: float = PD_LOAD_STIFFNESS  # [-]
+    pd_given: tuple[str, ...] = ()
     root_body: str = ""
     coupled_joints: tuple[str, ...] = ()

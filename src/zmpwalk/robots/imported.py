@@ -74,7 +74,7 @@ from zmpwalk.robots.description import (
 )
 from zmpwalk.robots.legs import VIRTUAL_PREFIX, FootAtReference, Segments, build_leg, leg_joint_ids, segments
 from zmpwalk.robots.model import RobotModel, schedule_scale
-from zmpwalk.robots.pd import coupled_joints, element_name, pd_layer
+from zmpwalk.robots.pd import check_load_stiffness, coupled_joints, element_name, pd_layer
 from zmpwalk.robots.tree import (
     Mount,
     base_mount,
@@ -234,12 +234,13 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     lift = _foot_lift(chains_ready, leg_joints, HUBO_FOOT_LIFT * length_scale)  # [m]
     # The joint PD layer: gains from the ready posture's inertia; a leg joint holds the robot, m g l.
     coupled = coupled_joints(model, leg_joint_set)
-    load_stiffness = values.get("load_stiffness", PD_LOAD_STIFFNESS)
+    load_stiffness = check_load_stiffness(values.get("load_stiffness", PD_LOAD_STIFFNESS))
     pd_joints = pd_layer(model, data, qpos, leg_joint_set, mass * float(np.linalg.norm(model.opt.gravity)) * pendulum,
                           pd_gains or {}, coupled, load_stiffness)
     leg_joints = _driven_joints(leg_joints, dict(pd_joints), geometry, values.get("sole_roll_limit"), source)
     names = {j: element_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in coupled}
     plant = replace(plant, joints=tuple(leg_joints), pd_joints=pd_joints, load_stiffness=load_stiffness,
+                    pd_given=tuple(sorted(pd_gains or {})),
                     coupled_joints=tuple(sorted(names.values())),
                     held_joints=tuple(n for n in plant.held_joints if n not in names.values()))
     return _robot_model(

@@ -224,12 +224,12 @@ def robot_toml(robot: RobotModel, folder: Path) -> str:
         lines += ["", "[pd]",
                   "# The joint PD layer (the firmware's joint loop) of each torque motor or unactuated joint, derived",
                   "# by zmpwalk's rule (docs/robot-import.md): kp = max(I w^2, kappa W), critical damping. Set the",
-                  "# rule's kappa here, or uncomment a joint's line and put your firmware's gains in it:",
+                  "# rule's kappa here, or give a joint's own (uncommented: the robot file's) with your firmware's:",
                   "# kp [N m/rad], kv [N m s/rad] (kv may be left out: critical damping).",
                   f"{'' if robot.plant.load_stiffness != PD_LOAD_STIFFNESS else '# '}load_stiffness = "
-                  f"{robot.plant.load_stiffness:g}   # [-] the rule's kappa for every joint not given below"]
-        lines += [f"# {_quote(name)} = {{kp = {actuator.kp:.6g}, kv = {actuator.kv:.6g}}}"
-                  for name, actuator in robot.plant.pd_joints]
+                  f"{robot.plant.load_stiffness:.12g}   # [-] the rule's kappa for every joint not given below"]
+        lines += [f"{'' if name in robot.plant.pd_given else '# '}{_quote(name)} = "
+                  f"{{kp = {actuator.kp:.6g}, kv = {actuator.kv:.6g}}}" for name, actuator in robot.plant.pd_joints]
     lines += ["", "# Derived from the model (for checking; edit the model, not these lines):"]
     lines += [f"#   {line}" if line else "#" for line in robot_table(robot).splitlines()]
     return "\n".join(lines) + "\n"

@@ -5,6 +5,7 @@ holds."""
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import replace
 from typing import Any
 
@@ -124,20 +125,30 @@ def pd_gains(inertia: float, moment: float, timestep: float = PHYSICS_STEP,
         raise InvalidParameterError("timestep", timestep, "a physics step > 0 s")
     if not moment >= 0:
         raise InvalidParameterError("moment", moment, "a weight moment >= 0 N m")
-    check_load_stiffness(load_stiffness)
-    kp = max(inertia * PD_BANDWIDTH ** 2, load_stiffness * moment)
+    kappa = check_load_stiffness(load_stiffness)
+    kp = max(inertia * PD_BANDWIDTH ** 2, kappa * moment)
     kp = min(kp, inertia * (PD_STEP_LIMIT / timestep) ** 2)
     return kp, 2.0 * PD_DAMPING_RATIO * math.sqrt(kp * inertia)
 
 
-def check_load_stiffness(load_stiffness: float) -> None:
-    """Raise :class:`InvalidParameterError` unless ``load_stiffness`` (``kappa`` of :func:`pd_gains`) is a finite
-    number > 1: at 1 or less a joint is no stiffer than the toppling of the weight it holds."""
-    if isinstance(load_stiffness, bool) or not isinstance(load_stiffness, (int, float)) \
-            or not math.isfinite(load_stiffness) or not load_stiffness > 1.0:
+def check_load_stiffness(load_stiffness: object) -> float:
+    """``load_stiffness`` (``kappa`` of :func:`pd_gains`) as a float [-].
+
+    Raises:
+        InvalidParameterError: It is not a finite number > 1: at 1 or less a joint is no stiffer than the toppling
+            of the weight it holds.
+    """
+    value = math.nan
+    if isinstance(load_stiffness, numbers.Real) and not isinstance(load_stiffness, bool):
+        try:
+            value = float(load_stiffness)
+        except OverflowError:  # an integer beyond a float's range
+            value = math.inf
+    if not (math.isfinite(value) and value > 1.0):
         raise InvalidParameterError("load_stiffness", load_stiffness, "a finite number > 1 [-] (the rule's kappa, "
                                     f"{PD_LOAD_STIFFNESS:g} by default): the joint's stiffness over the weight "
                                     "moment it holds per radian")
+    return value
 
 
 def _weight_moment(model: Any, data: Any, joint: int) -> float:

@@ -58,8 +58,9 @@ def _robot_from_model_table(data: dict[str, Any], path: Path) -> RobotModel:
             if key not in names:
                 raise FileFormatError(source, f"[{section}] unknown field {key!r} for a model robot; known: "
                                       f"{', '.join((*names, 'generator') if section == 'walking' else names)}")
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
-                raise FileFormatError(source, f"[{section}] {key} = {value!r} must be a number > 0")
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0 \
+                    or not math.isfinite(_float(value)):
+                raise FileFormatError(source, f"[{section}] {key} = {value!r} must be a finite number > 0")
             overrides[key] = float(value)
     unknown = set(data) - {"model", "pd", "stabilizer", *_MODEL_OVERRIDES}
     if unknown:
@@ -80,6 +81,14 @@ def _robot_from_model_table(data: dict[str, Any], path: Path) -> RobotModel:
     return robot if generator is None else replace(robot, generator=generator)
 
 
+def _float(value: float) -> float:
+    """``value`` as a float, infinite where it is an integer beyond a float's range."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf
+
+
 def _pd_table(table: object, source: str) -> tuple[dict[str, tuple[float, float | None]], float | None]:
     """The ``[pd]`` table of a model robot file: the joint PD layer's gains per model joint,
     ``JOINT = {kp = [N m/rad], kv = [N m s/rad]}`` (``kv`` may be left out: critical damping), and the rule's
@@ -89,14 +98,14 @@ def _pd_table(table: object, source: str) -> tuple[dict[str, tuple[float, float 
     if not isinstance(table, dict):
         raise FileFormatError(source, "[pd] must be a table: JOINT = {kp = N m/rad, kv = N m s/rad}")
     gains: dict[str, tuple[float, float | None]] = {}
-    load_stiffness = table.get("load_stiffness")
-    if load_stiffness is not None:
+    load_stiffness = None
+    if "load_stiffness" in table and not isinstance(table["load_stiffness"], dict):  # a table: a joint of that name
         try:
-            check_load_stiffness(load_stiffness)
+            load_stiffness = check_load_stiffness(table["load_stiffness"])
         except InvalidParameterError as error:
             raise FileFormatError(source, f"[pd] {error}") from None
     for joint, entry in table.items():
-        if joint == "load_stiffness":
+        if joint == "load_stiffness" and load_stiffness is not None:
             continue
         if not isinstance(entry, dict) or "kp" not in entry or set(entry) - {"kp", "kv"}:
             raise FileFormatError(source, f"[pd] {joint} must be {{kp = N m/rad, kv = N m s/rad}} (kv may be left "
@@ -106,7 +115,7 @@ def _pd_table(table: object, source: str) -> tuple[dict[str, tuple[float, float 
             value = entry.get(key)
             if value is None:
                 values.append(None)
-            elif isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
+            elif isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(_float(value)) \
                     or not value > 0:
                 raise FileFormatError(source, f"[pd] {joint} {key} = {value!r} must be a finite number > 0")
             else:
@@ -115,4 +124,4 @@ def _pd_table(table: object, source: str) -> tuple[dict[str, tuple[float, float 
         if kp is None:  # pragma: no cover - "kp" is required above
             raise FileFormatError(source, f"[pd] {joint} needs kp")
         gains[str(joint)] = (kp, values[1])
-    return gains, None if load_stiffness is None else float(load_stiffness)
+    return gains, load_stiffness
