@@ -58,9 +58,8 @@ def _robot_from_model_table(data: dict[str, Any], path: Path) -> RobotModel:
             if key not in names:
                 raise FileFormatError(source, f"[{section}] unknown field {key!r} for a model robot; known: "
                                       f"{', '.join((*names, 'generator') if section == 'walking' else names)}")
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0 \
-                    or not math.isfinite(_float(value)):
-                raise FileFormatError(source, f"[{section}] {key} = {value!r} must be a finite number > 0")
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
+                raise FileFormatError(source, f"[{section}] {key} = {value!r} must be a number > 0")
             overrides[key] = float(value)
     unknown = set(data) - {"model", "pd", "stabilizer", *_MODEL_OVERRIDES}
     if unknown:
@@ -79,14 +78,6 @@ def _robot_from_model_table(data: dict[str, Any], path: Path) -> RobotModel:
     if gains:
         robot = replace(robot, stabilizer_gains=gains)
     return robot if generator is None else replace(robot, generator=generator)
-
-
-def _float(value: float) -> float:
-    """``value`` as a float, infinite where it is an integer beyond a float's range."""
-    try:
-        return float(value)
-    except OverflowError:
-        return math.inf
 
 
 def _pd_table(table: object, source: str) -> tuple[dict[str, tuple[float, float | None]], float | None]:
@@ -115,7 +106,7 @@ def _pd_table(table: object, source: str) -> tuple[dict[str, tuple[float, float 
             value = entry.get(key)
             if value is None:
                 values.append(None)
-            elif isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(_float(value)) \
+            elif isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
                     or not value > 0:
                 raise FileFormatError(source, f"[pd] {joint} {key} = {value!r} must be a finite number > 0")
             else:
