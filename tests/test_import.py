@@ -315,14 +315,16 @@ def test_a_stride_the_whole_body_legs_cannot_follow_names_its_command(tmp_path: 
                                                                       capsys: pytest.CaptureFixture[str]) -> None:
     """The pattern's own reach check (from its CoM point) passes 0.315 m strides of the 0.3 + 0.3 m biped, its legs
     placed under the whole-body CoM do not: the error is the walker's check of the command, naming its table and
-    the stride that fits, not a sample's time alone."""
+    the stride that fits, not a sample's time alone (the robot file keeps the posture: without it the walk is
+    walked from a lower one, tests/test_ready_fit.py)."""
     from zmpwalk.cli import main
 
     path = write(tmp_path, "free.xml", biped(leg("l", 0.1) + leg("r", -0.1)))
+    robot = write(tmp_path, "free.toml", f'[model]\nfile = "{path}"\n[posture]\nready_stretch = 0.92\n')
     steps = write(tmp_path, "long.toml", "[[steps]]\nduration = 0.8\nforward = 0.315\nrepeat = 3\n")
-    assert main(["plan", "--robot", str(path), str(steps)]) == 0  # the pattern's check passes
+    assert main(["plan", "--robot", str(robot), str(steps)]) == 0  # the pattern's check passes
     capsys.readouterr()
-    assert main(["simulate", "--robot", str(path), str(steps)]) == 2
+    assert main(["simulate", "--robot", str(robot), str(steps)]) == 2
     error = capsys.readouterr().err
     assert "long.toml: [[steps]] 1, repeat 1 of 3: forward = 0.315 is not allowed" in error
     fits = float(error.split("at most ")[1].split(" m forward")[0])

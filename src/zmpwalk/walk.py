@@ -233,6 +233,17 @@ def planned_walk(spec: WalkSpec) -> PlannedWalk:
     return PlannedWalk(pattern, correction, _joints(spec, pattern))
 
 
+def checked_walk(spec: WalkSpec) -> PlannedWalk:
+    """:func:`planned_walk` as :func:`run_walk` plans: where the legs cannot reach along the pattern of a walk the
+    controller runs, the error is the walker's refusal of the command (:func:`_named_joints`).
+
+    Raises:
+        ZmpwalkError: As :func:`planned_walk`.
+    """
+    pattern, correction = walk_pattern(spec)
+    return PlannedWalk(pattern, correction, _named_joints(spec, pattern))
+
+
 def _joints(spec: WalkSpec, pattern: WalkingPattern) -> JointTrajectory:
     """The joint angles along ``pattern`` (their ranges checked with ``spec.check_limits``)."""
     from zmpwalk.kinematics import pattern_joint_trajectory

@@ -64,15 +64,17 @@ def add_model_options(parser: argparse.ArgumentParser) -> None:
                         help="folder holding a URDF's package:// packages (repeatable)")
 
 
-def load_robot_of(args: argparse.Namespace) -> RobotModel:
-    """The robot of --robot, imported with --feet, --keyframe and --package-path."""
+def load_robot_of(args: argparse.Namespace, ready_stretch: float | None = None) -> RobotModel:
+    """The robot of --robot, imported with --feet, --keyframe and --package-path (and a ready posture's
+    ``ready_stretch`` [-], :func:`zmpwalk.robots.load_robot`)."""
     feet = None
     if args.feet:
         names = [name.strip() for name in args.feet.split(",")]
         if len(names) != 2 or not all(names):
             raise UsageError(f"--feet = {args.feet!r} must be two body names: LEFT,RIGHT")
         feet = (names[0], names[1])
-    return load_robot(args.robot, feet=feet, keyframe=args.keyframe, package_paths=tuple(args.package_path))
+    return load_robot(args.robot, feet=feet, keyframe=args.keyframe, package_paths=tuple(args.package_path),
+                      ready_stretch=ready_stretch)
 
 
 def require_robot_by_name(args: argparse.Namespace) -> None:

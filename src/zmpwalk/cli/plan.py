@@ -28,12 +28,16 @@ from zmpwalk.cli.options import (
     walk_of,
 )
 from zmpwalk.cli.printing import margin_words
+from zmpwalk.commands import StepCommand
 from zmpwalk.errors import ZmpwalkError
 from zmpwalk.kinematics import pattern_joint_trajectory
 from zmpwalk.patterns import generator
 from zmpwalk.patterns.polynomial import generate_chunks
 from zmpwalk.patterns.result import WalkingPattern, write_pieces_csv
+from zmpwalk.ready_fit import FittedWalk, legs_refuse, walk_from_other_posture
+from zmpwalk.robots.model import RobotModel
 from zmpwalk.tables import zmp_advice
+from zmpwalk.walk import WalkSpec
 
 NAMES = ("plan",)
 
@@ -100,10 +104,35 @@ class PlanSummary:
 
 
 def run(args: argparse.Namespace) -> int:
-    """``zmpwalk plan``: the pattern to --out (nothing written without it, and it says so) and its ZMP margin."""
+    """``zmpwalk plan``: the pattern to --out (nothing written without it, and it says so) and its ZMP margin.
+    Where the robot's own ready posture refuses the walk for its legs, the walk is planned from the posture that
+    fits it (:mod:`zmpwalk.ready_fit`), as ``zmpwalk simulate`` walks it."""
     commands, labels = walk_of(args)
     robot = load_robot_of(args)
     resolve_generator(args, robot)
+    try:
+        return _plan(args, robot, commands, labels, None)
+    except ZmpwalkError as error:
+        fitted = _fitted(args, robot, commands, labels, error)
+        if fitted is None:
+            raise
+        return _plan(args, fitted.spec.robot, commands, labels, fitted)
+
+
+def _fitted(args: argparse.Namespace, robot: RobotModel, commands: list[StepCommand], labels: list[str],
+            refusal: ZmpwalkError) -> FittedWalk | None:
+    """The walk planned from another ready posture where ``refusal`` is the legs' (None: not tried or none fits)."""
+    if robot.plant is None or robot.plant.posture_given or not legs_refuse(refusal):
+        return None
+    options: dict[str, object] = {} if schedule_of(args) is None else {"schedule": schedule_of(args)}
+    spec = WalkSpec(robot, commands, labels, generator=args.generator, pelvis=pelvis_of(args), rate=args.rate,
+                    check_limits=args.joints, source=walk_label(args), **options)  # type: ignore[arg-type]
+    return walk_from_other_posture(spec, lambda stretch: load_robot_of(args, stretch), refusal)
+
+
+def _plan(args: argparse.Namespace, robot: RobotModel, commands: list[StepCommand], labels: list[str],
+          fitted: FittedWalk | None) -> int:
+    """Plan, write and print the walk of ``robot`` (standing as ``fitted`` chose, where it did)."""
     make = generator(args.generator)
     schedule = schedule_of(args)
     options = pattern_options(args)
@@ -121,7 +150,8 @@ def run(args: argparse.Namespace) -> int:
         else:
             for _ in stream:
                 pass
-    result = {**summary.result(), "out": str(args.out) if args.out else None}
+    result = {**summary.result(), "out": str(args.out) if args.out else None,
+              "ready_stretch": None if fitted is None else fitted.stretch}
     outside = float(result["min_zmp_margin"]) < 0  # type: ignore[arg-type]
     if outside and args.generator == "polynomial" and pelvis_of(args) == "cubic":  # what to change, from its terms
         result["advice"] = zmp_advice(robot, commands, float(result["min_zmp_margin_time"]),  # type: ignore[arg-type]
@@ -131,6 +161,8 @@ def run(args: argparse.Namespace) -> int:
     else:
         margin = float(result["min_zmp_margin"])  # type: ignore[arg-type]
         print(f"generator: {generator_words(args, robot)}")
+        if fitted is not None:
+            print(fitted.words())
         print(f"{result['swings']} swings, {result['duration']:.3f} s, {result['samples']} samples at "
               f"{args.rate:g} Hz" + (f" -> {args.out}" if args.out else
                                      "; no CSV written (give --out FILE to write it)"))

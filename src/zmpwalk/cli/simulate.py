@@ -109,16 +109,19 @@ def walk_spec(args: argparse.Namespace, robot: RobotModel) -> WalkSpec:
 
 def run(args: argparse.Namespace) -> int:
     """``zmpwalk simulate``: walk the pattern, write the measurements to --out and print the walk and its verdict."""
+    from zmpwalk.ready_fit import fit_ready_posture
     from zmpwalk.sim import actuator_markdown, write_actuator_csv
     from zmpwalk.sim.run import write_result_csv
     from zmpwalk.walk import run_walk
 
-    robot = load_robot_of(args)
     show = None if args.json or not sys.stderr.isatty() else progress
-    walk = run_walk(walk_spec(args, robot), progress=show)
+    fitted = fit_ready_posture(walk_spec(args, load_robot_of(args)), lambda stretch: load_robot_of(args, stretch))
+    robot = fitted.spec.robot
+    walk = run_walk(fitted.spec, progress=show, planned=fitted.planned)
     result, verdict, rows, fits, correction = walk.result, walk.verdict, walk.rows, walk.fits, walk.correction
     summary = {**simulation_summary(result, verdict, rows, fits, correction), "balance": walk.spec.balance,
-               "generator": walk.pattern.generator, "controller": walk.controller}
+               "generator": walk.pattern.generator, "controller": walk.controller,
+               "ready_stretch": fitted.stretch, "ready_posture_refusal": fitted.refusal or None}
     if args.out:
         args.out.mkdir(parents=True, exist_ok=True)
         write_actuator_csv(rows, args.out / "actuators.csv")
@@ -129,6 +132,8 @@ def run(args: argparse.Namespace) -> int:
     else:
         print("generator: " + ("hyperbolic (the paper example of Lim et al.)" if args.paper_example else
                                generator_words(args, robot)))
+        if fitted.stretch is not None:
+            print(fitted.words())
         print_simulation(result, verdict, rows, fits, correction, walk.controller)
     return 0 if verdict.passed else EXIT_FAILED
 

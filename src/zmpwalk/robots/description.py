@@ -124,6 +124,8 @@ class ModelPlant:
         root_body: Name of the floating base where it is not ``base_body``, else empty.
         coupled_joints: Joints a leg joint moves through a joint equality (names): neither held nor driven (their
             actuators' controls 0).
+        ready_stretch: The ready posture's hip-to-ankle distance over the straight leg [-].
+        posture_given: The robot file sets the ready posture (``pelvis_height`` or ``ready_stretch``).
     """
 
     path: Path
@@ -143,3 +145,5 @@ class ModelPlant:
     pd_given: tuple[str, ...] = ()
     root_body: str = ""
     coupled_joints: tuple[str, ...] = ()
+    ready_stretch: float = 0.0  # [-]
+    posture_given: bool = False

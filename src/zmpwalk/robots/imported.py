@@ -37,7 +37,9 @@ zmpwalk needs (the builder's model is the single source of truth):
   keeps level.
 * **Ready posture**: the hips above the ankles at the keyframe's
   hip-to-ankle distance, at most :data:`READY_STRETCH` of the straight leg (a
-  bent knee for walking). The pattern moves the centre of mass: the CoM's
+  bent knee for walking), or the robot file's ``[posture] ready_stretch`` of it
+  (:func:`zmpwalk.ready_fit.fit_ready_posture` chooses one where a walk's strides
+  need another). The pattern moves the centre of mass: the CoM's
   offset from the base origin in that posture, ``com_offset``, is found by
   fixed-point iteration (the posture moves the CoM, the CoM moves the
   posture) and every pattern point is shifted by it. The pendulum length is the
@@ -61,7 +63,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from zmpwalk.errors import FileFormatError
+from zmpwalk.errors import FileFormatError, InvalidParameterError
 from zmpwalk.leg_chain import LegChain
 from zmpwalk.robots.collision import Sole, collision_points, rigid_bodies, sole_face_up, sole_roll_bound
 from zmpwalk.robots.description import (
@@ -88,6 +90,7 @@ from zmpwalk.robots.tree import (
 Array = NDArray[np.float64]
 
 READY_STRETCH = 0.92  # [-] hip-to-ankle distance of the ready posture, at most this fraction of the straight leg
+STRETCH_RANGE = (0.5, 1.0)  # [-] a ready_stretch given: above the first, below the second (a straight leg)
 
 
 def load_model(path: Path, package_paths: tuple[Path, ...] = ()) -> Any:
@@ -171,7 +174,8 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
         package_paths: Folders holding the packages of a URDF's ``package://`` paths.
         name: Short name (default: the model's).
         overrides: Robot-file values replacing derived ones (``pelvis_height``, ``dsp_time``, ...; and
-            ``load_stiffness``, the PD rule's ``kappa``, :func:`~zmpwalk.robots.pd.pd_gains`).
+            ``load_stiffness``, the PD rule's ``kappa``, :func:`~zmpwalk.robots.pd.pd_gains`; ``ready_stretch``,
+            the ready posture's hip-to-ankle distance over the straight leg [-], instead of the keyframe's).
         pd_gains: The PD layer's gains of some joints (model joint name -> (kp [N m/rad], kv [N m s/rad] or
             None: critical damping)) replacing :func:`pd_gains`'s (a robot file's ``[pd]``).
 
@@ -179,8 +183,8 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
         FileFormatError: What the model lacks for walking, named (no floating base, no legs, a leg of
             other than five or six hinge joints, ambiguous feet, a sole that does not stand flat in the
             reference posture, ...).
-        InvalidParameterError: ``pd_gains`` names a joint the PD layer does not drive, or ``load_stiffness`` is
-            not a finite number > 1.
+        InvalidParameterError: ``pd_gains`` names a joint the PD layer does not drive, ``load_stiffness`` is
+            not a finite number > 1, or ``ready_stretch`` is not in :data:`STRETCH_RANGE`.
     """
     import mujoco
 
@@ -220,7 +224,7 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     mass = float(np.sum(model.body_mass))
     values = dict(overrides or {})
     distance, height_scale = _reference_reach(model, data, qpos_reference, base, left_hip, foot_ids[0],
-                                              ankle_height, thigh + shank)
+                                              ankle_height, thigh + shank, values.get("ready_stretch"))
     model_name = model.names[:model.names.find(b"\0")].decode()
     robot_name = name or re.sub(r"[^A-Za-z0-9_.-]+", "-", model_name).strip("-") or path.stem
     plant = _model_plant(model, path, base, foot_ids, key_id, leg_joint_set | {root_joint}, masses, polygon,
@@ -240,6 +244,8 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     leg_joints = _driven_joints(leg_joints, dict(pd_joints), geometry, values.get("sole_roll_limit"), source)
     names = {j: element_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in coupled}
     plant = replace(plant, joints=tuple(leg_joints), pd_joints=pd_joints, load_stiffness=load_stiffness,
+                    ready_stretch=distance / (thigh + shank),
+                    posture_given=bool({"ready_stretch", "pelvis_height"} & set(values)),
                     pd_given=tuple(sorted(pd_gains or {})),
                     coupled_joints=tuple(sorted(names.values())),
                     held_joints=tuple(n for n in plant.held_joints if n not in names.values()))
@@ -293,17 +299,28 @@ def _zero_pose(model: Any, data: Any, qpos_reference: Array, leg_joints: set[int
 
 
 def _reference_reach(model: Any, data: Any, qpos_reference: Array, base: int, hip: Array, foot: int,
-                     ankle_height: float, straight: float) -> tuple[float, float]:
-    """The ready posture's hip-to-ankle distance [m], the keyframe's, at most :data:`READY_STRETCH` of the
-    ``straight`` leg, and the robot's height above its sole in the reference posture [m] (``data`` left there)."""
+                     ankle_height: float, straight: float, stretch: float | None) -> tuple[float, float]:
+    """The ready posture's hip-to-ankle distance [m], ``stretch`` times the ``straight`` leg, or (None) the
+    keyframe's, at most :data:`READY_STRETCH` of it, and the robot's height above its sole in the reference
+    posture [m] (``data`` left there).
+
+    Raises:
+        InvalidParameterError: ``stretch`` is not a number within :data:`STRETCH_RANGE`.
+    """
     import mujoco
+
+    if stretch is not None and (isinstance(stretch, bool) or not isinstance(stretch, (int, float))
+                                or not STRETCH_RANGE[0] < stretch < STRETCH_RANGE[1]):
+        raise InvalidParameterError("ready_stretch", stretch, f"a fraction of the straight leg above "
+                                    f"{STRETCH_RANGE[0]} and below {STRETCH_RANGE[1]} (a straight leg)")
 
     data.qpos[:] = qpos_reference
     mujoco.mj_kinematics(model, data)
     key_hip = data.xpos[base] + data.xmat[base].reshape(3, 3) @ hip
     key_foot_bottom = min(float(p[2]) for p in collision_points(model, data, rigid_bodies(model, foot)))
     key_distance = float(key_hip[2] - key_foot_bottom - ankle_height)
-    distance = min(key_distance if key_distance > 0 else straight, READY_STRETCH * straight)
+    distance = min(key_distance if key_distance > 0 else straight, READY_STRETCH * straight) if stretch is None \
+        else stretch * straight
     return distance, float(np.max(data.geom_xpos[:, 2]) - key_foot_bottom)
 
 

@@ -133,7 +133,8 @@ def robot_table(robot: RobotModel, statics: StaticTorques | None = None) -> str:
         f"({_mm(robot.sole_center_x)}, {_mm(robot.sole_center_y)}) mm from the ankle",
         f"ready posture: base {robot.pelvis_height:.4f} m above the ground, centre of mass "
         f"{robot.pendulum_length:.4f} m high and ({_mm(robot.com_offset[0])}, {_mm(robot.com_offset[1])}) mm "
-        "from the base origin",
+        "from the base origin" + (f"; hips {robot.plant.ready_stretch:.3f} of the straight leg above the ankles"
+                                  if robot.plant is not None else ""),
         "HUBO tables scaled by: time x{:.3f}, stride x{:.3f}, lateral x{:.3f}".format(*robot.schedule_scale),
         _lift_line(robot),
     ]
@@ -209,8 +210,12 @@ def robot_toml(robot: RobotModel, folder: Path) -> str:
         if plant.package_paths:
             lines.append("package_paths = [" + ", ".join(_quote(str(p)) for p in plant.package_paths) + "]")
         lines.append(f"name = {_quote(robot.name)}")
-    lines += ["", "[posture]",
-              f"pelvis_height = {robot.pelvis_height:.6g}   # [m] base origin above the ground, ready posture",
+    pelvis = f"pelvis_height = {robot.pelvis_height:.6g}   # [m] base origin above the ground, ready posture"
+    if robot.plant is not None:  # the posture derived: left to the import, which fits it to a walk's strides
+        pelvis = (f"# ready_stretch = {robot.plant.ready_stretch:.6g}   # [-] hip-to-ankle distance over the straight "
+                  "leg (the keyframe's, at most 0.92); set, it (or pelvis_height) keeps this posture for every walk "
+                  "(docs/robot-import.md)\n# " + pelvis)
+    lines += ["", "[posture]", pelvis,
               "", "[walking]",
               f"dsp_time = {robot.dsp_time:.6g}   # [s] double-support time d (HUBO's 0.1 s, time-scaled)",
               f"foot_lift = {robot.foot_lift:.6g}   # [m] swing apex height (HUBO's 0.04 m, length-scaled, lowered "

@@ -18,24 +18,34 @@ from zmpwalk.robots.model import RobotModel, checked_generator, robot_from_dict,
 from zmpwalk.robots.pd import check_load_stiffness
 
 
-def robot_from_toml(path: Path) -> RobotModel:
+def robot_from_toml(path: Path, ready_stretch: float | None = None) -> RobotModel:
     """Read a robot data file.
+
+    Args:
+        path: The file.
+        ready_stretch: A file with ``[model]`` that does not set its posture (``[posture]``): the ready posture's
+            hip-to-ankle distance over the straight leg [-]; None: the file's or the keyframe's.
 
     Raises:
         FileFormatError: Missing, unknown or out-of-range fields (names the field).
+        InvalidParameterError: ``ready_stretch`` given for a box model (no ``[model]``) or a file that sets the
+            posture.
     """
     data = read_toml(path)
     if "model" in data:
-        return _robot_from_model_table(data, path)
+        return _robot_from_model_table(data, path, ready_stretch)
+    if ready_stretch is not None:
+        raise InvalidParameterError("ready_stretch", ready_stretch, "None for a box model (a robot file with "
+                                    "[model] only)")
     return robot_from_dict(data, str(path))
 
 
-_MODEL_OVERRIDES = {"posture": ("pelvis_height",),
+_MODEL_OVERRIDES = {"posture": ("pelvis_height", "ready_stretch"),
                     "walking": ("dsp_time", "foot_lift", "lateral_velocity", "foot_speed_limit",
                                 "foot_acceleration_limit", "sole_roll_limit")}
 
 
-def _robot_from_model_table(data: dict[str, Any], path: Path) -> RobotModel:
+def _robot_from_model_table(data: dict[str, Any], path: Path, ready_stretch: float | None) -> RobotModel:
     """A robot file whose ``[model]`` names the robot's own MJCF or URDF (written by ``zmpwalk robot --write``)."""
     source = str(path)
     table = data["model"]
@@ -69,12 +79,19 @@ def _robot_from_model_table(data: dict[str, Any], path: Path) -> RobotModel:
     pd_gains, load_stiffness = _pd_table(data.get("pd"), source)
     if load_stiffness is not None:
         overrides["load_stiffness"] = load_stiffness
+    if ready_stretch is not None:
+        given = sorted({"pelvis_height", "ready_stretch"} & set(overrides))
+        if given:
+            raise InvalidParameterError("ready_stretch", ready_stretch, f"None: {source} sets the ready posture "
+                                        f"([posture] {', '.join(given)})")
+        overrides["ready_stretch"] = ready_stretch
     try:
         robot = import_robot(path.parent / str(table["file"]), feet=(feet[0], feet[1]) if feet else None,
                              keyframe=table.get("keyframe"), package_paths=packages, name=table.get("name"),
                              overrides=overrides, pd_gains=pd_gains)
     except InvalidParameterError as error:
-        raise FileFormatError(source, f"[pd] {error}") from None
+        section = "posture" if error.parameter == "ready_stretch" else "pd"
+        raise FileFormatError(source, f"[{section}] {error}") from None
     if gains:
         robot = replace(robot, stabilizer_gains=gains)
     return robot if generator is None else replace(robot, generator=generator)

@@ -1,0 +1,136 @@
+"""The ready posture fitted to a walk's strides (zmpwalk.ready_fit): an imported robot whose own posture refuses a
+walk for its legs walks it from the nearest hip-to-ankle stretch that plans it whole."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from test_import import biped, leg, write
+from zmpwalk import load_robot
+from zmpwalk.commands import StepCommand
+from zmpwalk.errors import (
+    FileFormatError,
+    InfeasibleCommandError,
+    InfeasiblePatternError,
+    InvalidParameterError,
+    UnreachableError,
+    ZmpwalkError,
+)
+from zmpwalk.joint_limits import JointLimitError
+from zmpwalk.ready_fit import STRETCHES, fit_ready_posture, legs_refuse, stretches_to_try
+from zmpwalk.robots.imported import READY_STRETCH
+from zmpwalk.walk import WalkSpec, planned_walk, run_walk
+
+LONG = [StepCommand(duration=0.8, forward=0.315)] * 3  # [s], [m]: beyond the 0.3 + 0.3 m legs' reach from 0.92
+
+
+@pytest.fixture(scope="module")
+def free_biped(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return write(tmp_path_factory.mktemp("fit"), "free.xml", biped(leg("l", 0.1) + leg("r", -0.1)))
+
+
+def hip_to_ankle(robot: object) -> float:
+    """The left leg's hip-centre-to-ankle distance in the ready posture [m]."""
+    chain = robot.legs[0]  # type: ignore[attr-defined]
+    ankle, _ = chain.fk(chain.reference[None])
+    return float(np.linalg.norm(ankle[0] - chain.hip))
+
+
+def test_stretches_are_tried_nearest_first() -> None:
+    assert STRETCHES == (0.8, 0.82, 0.84, 0.86, 0.88, 0.9, 0.92, 0.94, 0.96)
+    assert stretches_to_try(0.92) == [0.94, 0.9, 0.96, 0.88, 0.86, 0.84, 0.82, 0.8]  # the taller of two as near
+    assert stretches_to_try(0.864)[:3] == [0.88, 0.84, 0.9]  # 0.86 is within 0.005 of the robot's own
+
+
+def test_only_the_legs_refusals_start_the_search() -> None:
+    unreachable = UnreachableError("left", 1.0, 0.004)
+    assert legs_refuse(unreachable)
+    assert legs_refuse(JointLimitError("left_knee", 2.1, 1.0, (0.0, 2.0)))
+    assert not legs_refuse(JointLimitError("left_ankle_roll", 0.1, 1.0, (-0.03, 0.03), sole_roll=0.1))
+    assert legs_refuse(InfeasibleCommandError("forward", 0.3, {"forward": 0.2}, unreachable))
+    zmp = InfeasiblePatternError("the ZMP leaves the soles")
+    assert not legs_refuse(InfeasibleCommandError("forward", 0.3, {}, zmp))
+    assert not legs_refuse(zmp)
+
+
+def test_a_stride_beyond_reach_walks_from_the_nearest_stretch_that_plans_it(free_biped: Path) -> None:
+    robot = load_robot(free_biped)
+    assert robot.plant is not None and robot.plant.ready_stretch == pytest.approx(READY_STRETCH, abs=1e-12)
+    assert hip_to_ankle(robot) == pytest.approx(READY_STRETCH * 0.6, abs=1e-9)  # [m]
+    spec = WalkSpec(robot, LONG)
+    with pytest.raises(UnreachableError, match="left ankle out of reach"):
+        planned_walk(spec)
+    fitted = fit_ready_posture(spec, lambda stretch: load_robot(free_biped, ready_stretch=stretch))
+    assert fitted.stretch == 0.9 and fitted.own_stretch == pytest.approx(READY_STRETCH)
+    assert "forward = 0.315 is not allowed" in fitted.refusal and "hips 0.90 of the straight leg" in fitted.words()
+    assert hip_to_ankle(fitted.spec.robot) == pytest.approx(0.9 * 0.6, abs=1e-9)  # [m]
+    assert fitted.spec.robot.pelvis_height < robot.pelvis_height - 0.01  # [m] crouched lower
+    for nearer in stretches_to_try(READY_STRETCH)[:stretches_to_try(READY_STRETCH).index(0.9)]:  # 0.94: refused
+        with pytest.raises(ZmpwalkError):
+            planned_walk(WalkSpec(load_robot(free_biped, ready_stretch=nearer), LONG, check_limits=True))
+    outcome = run_walk(fitted.spec, planned=fitted.planned)
+    assert outcome.verdict.passed, outcome.verdict
+
+
+def test_a_walk_the_robot_walks_keeps_its_posture(free_biped: Path) -> None:
+    robot = load_robot(free_biped)
+    fitted = fit_ready_posture(WalkSpec(robot, [StepCommand(duration=0.8, forward=0.1)] * 2),
+                               lambda stretch: pytest.fail("no other posture is tried"))
+    assert fitted.stretch is None and fitted.spec.robot is robot and fitted.words() == ""
+
+
+def test_no_stretch_fits_gives_the_robots_own_refusal(free_biped: Path) -> None:
+    robot = load_robot(free_biped)
+    steps = [StepCommand(duration=2.0, forward=0.4)] * 3  # [s], [m]
+    with pytest.raises(InfeasibleCommandError) as own:
+        planned_walk(WalkSpec(robot, steps))
+    for stretch in STRETCHES:
+        with pytest.raises(ZmpwalkError):
+            planned_walk(WalkSpec(load_robot(free_biped, ready_stretch=stretch), steps, check_limits=True))
+    with pytest.raises(InfeasibleCommandError) as error:
+        fit_ready_posture(WalkSpec(robot, steps), lambda stretch: load_robot(free_biped, ready_stretch=stretch))
+    assert str(error.value) == str(own.value)
+
+
+def test_a_robot_file_that_sets_its_posture_keeps_it(free_biped: Path, tmp_path: Path) -> None:
+    path = write(tmp_path, "robot.toml", f'[model]\nfile = "{free_biped}"\n[posture]\nready_stretch = 0.92\n')
+    robot = load_robot(path)
+    assert robot.plant is not None and robot.plant.posture_given
+    with pytest.raises(InfeasibleCommandError, match=r"at most 0\.31"):
+        fit_ready_posture(WalkSpec(robot, LONG), lambda stretch: pytest.fail("the file's posture is kept"))
+    with pytest.raises(InvalidParameterError, match=r"ready_stretch = 0.9 .*sets the ready posture"):
+        load_robot(path, ready_stretch=0.9)
+    low = write(tmp_path, "low.toml", f'[model]\nfile = "{free_biped}"\n[posture]\nready_stretch = 0.85\n')
+    lower = load_robot(low)
+    assert hip_to_ankle(lower) == pytest.approx(0.85 * 0.6, abs=1e-9)  # [m]
+
+
+@pytest.mark.parametrize("value", [0.5, 1.0, 1.2, math.nan, -0.9])
+def test_a_stretch_out_of_range_is_refused_naming_it(free_biped: Path, tmp_path: Path, value: float) -> None:
+    with pytest.raises(InvalidParameterError, match=r"ready_stretch = .* above 0.5 and below 1.0"):
+        load_robot(free_biped, ready_stretch=value)
+    path = write(tmp_path, "bad.toml", f'[model]\nfile = "{free_biped}"\n[posture]\nready_stretch = {value}\n')
+    with pytest.raises(FileFormatError, match=r"\[posture\] ready_stretch"):
+        load_robot(path)
+
+
+def test_a_box_model_has_no_stretch_to_fit() -> None:
+    with pytest.raises(InvalidParameterError, match="ready_stretch"):
+        load_robot("hubo", ready_stretch=0.9)
+
+
+def test_the_cli_walks_and_plans_from_the_fitted_posture(free_biped: Path, tmp_path: Path,
+                                                         capsys: pytest.CaptureFixture[str]) -> None:
+    import json
+
+    from zmpwalk.cli import main
+
+    steps = write(tmp_path, "long.toml", "[[steps]]\nduration = 0.8\nforward = 0.315\nrepeat = 3\n")
+    assert main(["plan", "--robot", str(free_biped), str(steps), "--joints", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["ready_stretch"] == 0.9
+    assert main(["plan", "--robot", str(free_biped), str(steps), "--joints"]) == 0
+    assert "ready posture: hips 0.90 of the straight leg" in capsys.readouterr().out
