@@ -22,7 +22,7 @@ from zmpwalk.errors import (
 )
 from zmpwalk.joint_limits import JointLimitError
 from zmpwalk.ready_fit import STRETCHES, fit_ready_posture, legs_refuse, stretches_to_try
-from zmpwalk.robots.imported import READY_STRETCH
+from zmpwalk.robots.posture import READY_STRETCH
 from zmpwalk.walk import WalkSpec, planned_walk, run_walk
 
 LONG = [StepCommand(duration=0.8, forward=0.315)] * 3  # [s], [m]: beyond the 0.3 + 0.3 m legs' reach from 0.92

@@ -1,7 +1,7 @@
 """The ready posture fitted to a walk's strides.
 
 An imported robot stands ready with its hips at the keyframe's hip-to-ankle distance, at most
-:data:`~zmpwalk.robots.imported.READY_STRETCH` (0.92) of the straight leg. Its legs reach farther fore and aft
+:data:`~zmpwalk.robots.posture.READY_STRETCH` (0.92) of the straight leg. Its legs reach farther fore and aft
 crouched lower (a flat foot ``x`` ahead of the hip at hip-to-ankle height ``h`` needs ``sqrt(h^2 + x^2)`` within the
 leg's reach), and bend their ankles and knees less standing taller. A long stride on a short leg (ToddlerBot, OP3:
 10 cm on legs of 0.20-0.22 m) leaves the reach from 0.92; a keyframe crouched deep for a narrow ankle range

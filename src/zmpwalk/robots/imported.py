@@ -36,7 +36,7 @@ zmpwalk needs (the builder's model is the single source of truth):
   in the pelvis frame at zero angles, which the leg chain's inverse kinematics
   keeps level.
 * **Ready posture**: the hips above the ankles at the keyframe's
-  hip-to-ankle distance, at most :data:`READY_STRETCH` of the straight leg (a
+  hip-to-ankle distance, at most :data:`~zmpwalk.robots.posture.READY_STRETCH` of the straight leg (a
   bent knee for walking), or the robot file's ``[posture] ready_stretch`` of it
   (:func:`zmpwalk.ready_fit.fit_ready_posture` chooses one where a walk's strides
   need another). The pattern moves the centre of mass: the CoM's
@@ -63,7 +63,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from zmpwalk.errors import FileFormatError, InvalidParameterError
+from zmpwalk.errors import FileFormatError
 from zmpwalk.leg_chain import LegChain
 from zmpwalk.robots.collision import Sole, collision_points, rigid_bodies, sole_face_up, sole_roll_bound
 from zmpwalk.robots.description import (
@@ -77,20 +77,17 @@ from zmpwalk.robots.description import (
 from zmpwalk.robots.legs import VIRTUAL_PREFIX, FootAtReference, Segments, build_leg, leg_joint_ids, segments
 from zmpwalk.robots.model import RobotModel, schedule_scale
 from zmpwalk.robots.pd import check_load_stiffness, coupled_joints, element_name, pd_layer
+from zmpwalk.robots.posture import ready_posture, reference_reach
 from zmpwalk.robots.tree import (
-    Mount,
     base_mount,
     find_feet,
     floating_base,
     keyframe_index,
     legs_base,
-    root_from_base,
 )
 
 Array = NDArray[np.float64]
 
-READY_STRETCH = 0.92  # [-] hip-to-ankle distance of the ready posture, at most this fraction of the straight leg
-STRETCH_RANGE = (0.5, 1.0)  # [-] a ready_stretch given: above the first, below the second (a straight leg)
 
 
 def load_model(path: Path, package_paths: tuple[Path, ...] = ()) -> Any:
@@ -223,7 +220,7 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     thigh, shank = geometry.thigh, geometry.shank
     mass = float(np.sum(model.body_mass))
     values = dict(overrides or {})
-    distance, height_scale = _reference_reach(model, data, qpos_reference, base, left_hip, foot_ids[0],
+    distance, height_scale = reference_reach(model, data, qpos_reference, base, left_hip, foot_ids[0],
                                               ankle_height, thigh + shank, values.get("ready_stretch"))
     model_name = model.names[:model.names.find(b"\0")].decode()
     robot_name = name or re.sub(r"[^A-Za-z0-9_.-]+", "-", model_name).strip("-") or path.stem
@@ -231,7 +228,7 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
                          package_paths)
     if base != root:
         plant = replace(plant, root_body=element_name(model, mujoco.mjtObj.mjOBJ_BODY, root))
-    ready = _ready_posture(model, data, chains, legs, qpos_reference, (adr, mount), distance, hip_x, hip_spacing,
+    ready = ready_posture(model, data, chains, legs, qpos_reference, (adr, mount), distance, hip_x, hip_spacing,
                            hip_drop, ankle_height, values.get("pelvis_height"), source)
     pelvis_height, pendulum, com_offset, chains_ready, qpos = ready
     length_scale = schedule_scale(pendulum, thigh + shank, hip_spacing)[1]
@@ -296,32 +293,6 @@ def _zero_pose(model: Any, data: Any, qpos_reference: Array, leg_joints: set[int
     data.qpos[:] = zero
     mujoco.mj_kinematics(model, data)
     return data.xmat[base].reshape(3, 3).copy(), data.xpos[base].copy()
-
-
-def _reference_reach(model: Any, data: Any, qpos_reference: Array, base: int, hip: Array, foot: int,
-                     ankle_height: float, straight: float, stretch: float | None) -> tuple[float, float]:
-    """The ready posture's hip-to-ankle distance [m], ``stretch`` times the ``straight`` leg, or (None) the
-    keyframe's, at most :data:`READY_STRETCH` of it, and the robot's height above its sole in the reference
-    posture [m] (``data`` left there).
-
-    Raises:
-        InvalidParameterError: ``stretch`` is not a number within :data:`STRETCH_RANGE`.
-    """
-    import mujoco
-
-    if stretch is not None and (isinstance(stretch, bool) or not isinstance(stretch, (int, float))
-                                or not STRETCH_RANGE[0] < stretch < STRETCH_RANGE[1]):
-        raise InvalidParameterError("ready_stretch", stretch, f"a fraction of the straight leg above "
-                                    f"{STRETCH_RANGE[0]} and below {STRETCH_RANGE[1]} (a straight leg)")
-
-    data.qpos[:] = qpos_reference
-    mujoco.mj_kinematics(model, data)
-    key_hip = data.xpos[base] + data.xmat[base].reshape(3, 3) @ hip
-    key_foot_bottom = min(float(p[2]) for p in collision_points(model, data, rigid_bodies(model, foot)))
-    key_distance = float(key_hip[2] - key_foot_bottom - ankle_height)
-    distance = min(key_distance if key_distance > 0 else straight, READY_STRETCH * straight) if stretch is None \
-        else stretch * straight
-    return distance, float(np.max(data.geom_xpos[:, 2]) - key_foot_bottom)
 
 
 def _driven_joints(joints: list[LegJoint], driven: dict[str, Actuator], geometry: _Geometry,
@@ -454,61 +425,3 @@ def _foot_at_reference(model: object, data: object, foot: int, label: str, sourc
     face = sole_face_up(model, data, rigid_bodies(model, foot), float(points[:, 2].min()))  # a box sole's plane
     up = rotation[2, :].copy() if face is None else rotation.T @ face
     return FootAtReference((points - position) @ rotation, up)
-
-
-def _ready_posture(model: Any, data: Any, chains: list[LegChain], legs: list[list[int]], qpos_reference: Array,
-                   root: tuple[int, Mount | None], distance: float, hip_x: float, hip_spacing: float,
-                   hip_drop: float, ankle_height: float, pelvis_height_override: float | None, source: str
-                   ) -> tuple[float, float, Array, list[LegChain], Array]:
-    """The ready posture: the ankles ``hip_spacing`` apart below the pattern's point with the soles level, the
-    hip-to-ankle distance ``distance`` [m]. The pattern moves the CoM: its offset from the base origin moves the
-    posture, which moves the CoM, to a fixed point (within 1e-7 m). ``root``: the floating root's ``qpos`` address
-    and where the legs' base sits on it (:func:`~zmpwalk.robots.tree.base_mount`).
-
-    Returns:
-        The pelvis height [m], the pendulum length (the CoM's height) [m], the CoM offset from the base origin
-        [m] (2,), the chains with the ready posture as their reference angles, and the posture's ``qpos``.
-
-    Raises:
-        FileFormatError: A leg cannot reach the ready posture.
-    """
-    import mujoco
-
-    com_offset = np.zeros(2)
-    pelvis_height = pendulum = 0.0
-    chains_ready = chains
-    qpos = qpos_reference.copy()
-    adr, mount = root
-    for _ in range(8):  # fixed point: posture -> CoM offset -> posture
-        dx = hip_x - com_offset[0]
-        vertical = math.sqrt(max(distance * distance - dx * dx, 1e-12))
-        pelvis_height = float(ankle_height + hip_drop + vertical if pelvis_height_override is None
-                              else pelvis_height_override)
-        chains_ready = []
-        qpos = qpos_reference.copy()
-        position_root, rotation_root = root_from_base(mount, np.array([0.0, 0.0, pelvis_height]), np.eye(3))
-        qpos[adr:adr + 3] = position_root
-        mujoco.mju_mat2Quat(qpos[adr + 3:adr + 7], rotation_root.flatten())
-        for chain, side, leg in zip(chains, (1, -1), legs, strict=True):
-            # the ankle below the pattern point, which is the CoM offset from the base origin; the sole level
-            target = np.array([[com_offset[0], side * hip_spacing / 2 + com_offset[1], ankle_height - pelvis_height]])
-            angles, excess = chain.solve(target, np.eye(3)[None])
-            if excess[0] > 0:
-                raise FileFormatError(source, f"the {chain.label} leg cannot reach the ready posture "
-                                      f"(pelvis height {pelvis_height:.3f} m)")
-            chains_ready.append(replace(chain, reference=angles[0]))
-            for j, angle in zip(leg, angles[0], strict=False):  # a five-joint leg's virtual roll has no qpos
-                qpos[model.jnt_qposadr[j]] = angle
-        data.qpos[:] = qpos
-        mujoco.mj_kinematics(model, data)
-        mujoco.mj_comPos(model, data)
-        com = data.subtree_com[0]
-        new_offset = np.array([com[0], com[1]])
-        pendulum = float(com[2])
-        converged = np.max(np.abs(new_offset - com_offset)) < 1e-7
-        com_offset = new_offset
-        if converged:
-            break
-    return pelvis_height, pendulum, com_offset, chains_ready, qpos
-
-
