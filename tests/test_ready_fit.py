@@ -22,8 +22,9 @@ from zmpwalk.errors import (
 )
 from zmpwalk.joint_limits import JointLimitError
 from zmpwalk.ready_fit import STRETCHES, fit_ready_posture, legs_refuse, stretches_to_try
+from zmpwalk.robots.model import RobotModel
 from zmpwalk.robots.posture import READY_STRETCH
-from zmpwalk.walk import WalkSpec, planned_walk, run_walk
+from zmpwalk.walk import WalkSpec, checked_walk, planned_walk, run_walk
 
 LONG = [StepCommand(duration=0.8, forward=0.315)] * 3  # [s], [m]: beyond the 0.3 + 0.3 m legs' reach from 0.92
 
@@ -100,8 +101,10 @@ def test_a_robot_file_that_sets_its_posture_keeps_it(free_biped: Path, tmp_path:
     path = write(tmp_path, "robot.toml", f'[model]\nfile = "{free_biped}"\n[posture]\nready_stretch = 0.92\n')
     robot = load_robot(path)
     assert robot.plant is not None and robot.plant.posture_given
+    fitted = fit_ready_posture(WalkSpec(robot, LONG), lambda stretch: pytest.fail("the file's posture is kept"))
+    assert fitted.planned is None and fitted.stretch is None and fitted.spec.robot is robot  # planned by run_walk
     with pytest.raises(InfeasibleCommandError, match=r"at most 0\.31"):
-        fit_ready_posture(WalkSpec(robot, LONG), lambda stretch: pytest.fail("the file's posture is kept"))
+        checked_walk(fitted.spec)
     with pytest.raises(InvalidParameterError, match=r"ready_stretch = 0.9 .*sets the ready posture"):
         load_robot(path, ready_stretch=0.9)
     low = write(tmp_path, "low.toml", f'[model]\nfile = "{free_biped}"\n[posture]\nready_stretch = 0.85\n')
@@ -118,9 +121,11 @@ def test_a_stretch_out_of_range_is_refused_naming_it(free_biped: Path, tmp_path:
         load_robot(path)
 
 
-def test_a_box_model_has_no_stretch_to_fit() -> None:
+def test_a_box_model_has_no_stretch_to_fit(hubo: RobotModel) -> None:
     with pytest.raises(InvalidParameterError, match="ready_stretch"):
         load_robot("hubo", ready_stretch=0.9)
+    fitted = fit_ready_posture(WalkSpec(hubo, LONG), lambda stretch: pytest.fail("a box model has no stretch"))
+    assert fitted.planned is None and fitted.spec.robot is hubo
 
 
 def test_the_cli_walks_and_plans_from_the_fitted_posture(free_biped: Path, tmp_path: Path,

@@ -36,7 +36,8 @@ class FittedWalk:
 
     Attributes:
         spec: The walk, its robot standing at ``stretch`` (the spec given where the robot's own posture fits).
-        planned: Its pattern and joints.
+        planned: Its pattern and joints; None for a robot whose posture is not fitted (a box model, a robot file
+            that sets it): not planned here.
         stretch: The ready posture's hip-to-ankle distance over the straight leg [-] it walks from, or None: the
             robot's own.
         own_stretch: The robot's own [-] (0 for a box model).
@@ -44,7 +45,7 @@ class FittedWalk:
     """
 
     spec: WalkSpec
-    planned: PlannedWalk
+    planned: PlannedWalk | None
     stretch: float | None = None  # [-]
     own_stretch: float = 0.0  # [-]
     refusal: str = ""
@@ -85,25 +86,25 @@ def fit_ready_posture(spec: WalkSpec, reload: Callable[[float], RobotModel]) -> 
         reload: The same robot standing at a stretch [-] (``load_robot(..., ready_stretch=stretch)``).
 
     Returns:
-        The walk as planned, from the robot's posture or the one fitted.
+        The walk as planned, from the robot's posture or the one fitted; ``spec`` unplanned for a box model or a
+        robot file that sets its posture.
 
     Raises:
-        ZmpwalkError: The robot's own posture's refusal, where no stretch plans the walk (or the robot is a box
-            model, or its file sets its posture, or the refusal is not the legs').
+        ZmpwalkError: The robot's own posture's refusal, where no stretch plans the walk (or the refusal is not
+            the legs').
     """
     plant = spec.robot.plant
-    fittable = plant is not None and not plant.posture_given
+    if plant is None or plant.posture_given:
+        return FittedWalk(spec, None)
     try:
         planned = checked_walk(spec)
     except ZmpwalkError as error:
-        if not fittable or not legs_refuse(error):
+        if not legs_refuse(error):
             raise
         fitted = walk_from_other_posture(spec, reload, error)
         if fitted is None:
             raise
         return fitted
-    if not fittable:
-        return FittedWalk(spec, planned)
     try:
         check_joint_limits(planned.joints.time, planned.joints.angles, spec.robot)
     except JointLimitError as error:

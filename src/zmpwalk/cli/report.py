@@ -79,7 +79,9 @@ def add_parser(commands: Commands) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """``zmpwalk demo`` and ``zmpwalk report``: write the report folder and print the walk's verdict."""
+    from zmpwalk.ready_fit import fit_ready_posture
     from zmpwalk.report import build_report
+    from zmpwalk.walk import WalkSpec
 
     if args.steps and args.steps_option:
         raise UsageError("give the steps file once: STEPS or --steps STEPS")
@@ -98,6 +100,10 @@ def run(args: argparse.Namespace) -> int:
     resolve_generator(args, robot)
     quiet = args.json or not sys.stderr.isatty()
     with named_source(str(args.steps) if args.steps else f"scenario {args.scenario}"):
+        fitted = fit_ready_posture(WalkSpec(robot, commands, labels, generator=args.generator,
+                                            schedule=schedule_of(args), pelvis=pelvis_of(args)),
+                                   lambda stretch: load_robot_of(args, stretch))
+        robot = fitted.spec.robot
         report = build_report(robot, commands, args.out, title=f"zmpwalk: {robot.name}, {name}",
                               generator=args.generator, animate=not args.no_animation,
                               gif=args.gif and not args.no_animation,
@@ -106,12 +112,15 @@ def run(args: argparse.Namespace) -> int:
                               motors=motors_of(args), pelvis=pelvis_of(args))
     verdict = report.verdict
     if args.json:
-        summary = {**report.summary, "index": str(report.index), "seconds": report.seconds}
+        summary = {**report.summary, "index": str(report.index), "seconds": report.seconds,
+                   "ready_stretch": fitted.stretch}
         print(json.dumps(json_safe(summary), indent=2, allow_nan=False))
     else:
         s = report.summary
         state = f"FELL at t = {s['fall_time']:.2f} s" if s["fell"] else "no fall"
         print(f"generator: {generator_words(args, robot)}")
+        if fitted.stretch is not None:
+            print(fitted.words())
         print(f"controller: {s['controller']}")
         print(f"{robot.name}, {name}: {verdict.state} ({state}); plan's min ZMP margin "
               f"{margin_words(float(s['min_zmp_margin']))} -> {report.index}")
