@@ -120,8 +120,8 @@ def walk_from_other_posture(spec: WalkSpec, reload: Callable[[float], RobotModel
     (``refusal``: the robot's own posture's, which the result quotes), or None."""
     own = spec.robot.plant.ready_stretch if spec.robot.plant is not None else 0.0
     for stretch in stretches_to_try(own):
-        candidate = replace(spec, robot=reload(stretch))
-        try:
+        try:  # a leg may not reach that posture at all (FileFormatError), or the walk from it
+            candidate = replace(spec, robot=reload(stretch))
             planned = planned_walk(replace(candidate, check_limits=True))
         except ZmpwalkError:
             continue
@@ -130,5 +130,5 @@ def walk_from_other_posture(spec: WalkSpec, reload: Callable[[float], RobotModel
 
 
 def _first_line(error: ZmpwalkError) -> str:
-    """The refusal without the file's name it is prefixed with."""
+    """The refusal's first line (the message of a five-joint leg's, say, runs on)."""
     return str(error).splitlines()[0]
