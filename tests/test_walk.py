@@ -97,3 +97,18 @@ def test_a_spec_is_frozen_and_keeps_its_commands_as_given(hubo) -> None:
     assert spec.generator_name == hubo.default_generator
     with pytest.raises(AttributeError):
         spec.balance = False  # type: ignore[misc]
+
+
+def test_a_fall_is_judged_against_the_walk_the_plan_lasts(hubo) -> None:
+    """Through the controller the run is sized for the longest walk its commands might take (three times each step,
+    and more); a fall is judged against the plan's length, as long as the same walk unpushed, which stands."""
+    from zmpwalk.sim.disturbances import Disturbances
+
+    commands = [StepCommand(duration=0.95, forward=0.2)] * 4  # [s], [m]
+    push = Disturbances(push_time=1.5, push_impulse=(-60.0, 0.0, 0.0))  # [s], [N s]: backward, mid-walk
+    pushed, walked = (run_walk(WalkSpec(hubo, commands, disturbances=d)) for d in (push, None))
+    assert pushed.result.fell and not walked.result.fell
+    fall, stand = (next(c for c in w.verdict.criteria if c.name == "no fall") for w in (pushed, walked))
+    assert fall.limit == pytest.approx(stand.limit, abs=2e-3)  # [s] one tick, 10.01 s
+    assert stand.limit == pytest.approx(walked.pattern.time[-1] + walked.spec.hold - walked.result.time[0], abs=2e-3)
+    assert f"of {stand.limit:.2f} s" in fall.shown

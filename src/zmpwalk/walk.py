@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 from zmpwalk.commands import StepCommand
@@ -318,6 +318,8 @@ def run_walk(spec: WalkSpec, progress: Progress | None = None, planned: PlannedW
     report = None if progress is None else (lambda done: progress("simulation", round(100 * done), 100))
     if through_controller(spec):
         result = _controller_walk(spec, report)
+        if result.fell:  # the run was sized for the longest walk the commands might take; the plan says its length
+            result = replace(result, planned_end=float(pattern.time[-1]) + spec.hold)
         balanced = True
     else:
         stabilizer = Stabilizer(spec.robot, spec.rate, com_reference=pattern.com_point) if spec.balance else None
