@@ -56,11 +56,11 @@ def joint_actuator(model: object, joint: int) -> Actuator | None:
         gear = float(m.actuator_gear[a][0])  # type: ignore[attr-defined]
         gain, bias = m.actuator_gainprm[a], m.actuator_biasprm[a]  # type: ignore[attr-defined]
         if is_position_servo(m, a):
-            kind, kp, kv = "position", float(gain[0]) * gear, float(-bias[2]) * gear
+            kind, kp, kv = "position", float(gain[0]) * gear, float(-bias[2]) * gear + 0.0  # + 0.0: no -0.0 damping
         elif _is_motor(m, a):
             kind, kp, kv = "motor", 0.0, 0.0
         else:
-            kind, kp, kv = "general", float(gain[0]), float(-bias[2])
+            kind, kp, kv = "general", float(gain[0]), float(-bias[2]) + 0.0
         limit = _joint_torque_limit(m, joint)
         if m.actuator_forcelimited[a]:  # type: ignore[attr-defined]
             limit = min(limit, float(np.max(np.abs(m.actuator_forcerange[a]))) * abs(gear))  # type: ignore[attr-defined]
