@@ -128,6 +128,7 @@ def test_a_box_model_has_no_stretch_to_fit(hubo: RobotModel) -> None:
     assert fitted.planned is None and fitted.spec.robot is hubo
 
 
+@pytest.mark.slow
 def test_the_cli_walks_and_plans_from_the_fitted_posture(free_biped: Path, tmp_path: Path,
                                                          capsys: pytest.CaptureFixture[str]) -> None:
     import json
@@ -139,3 +140,9 @@ def test_the_cli_walks_and_plans_from_the_fitted_posture(free_biped: Path, tmp_p
     assert json.loads(capsys.readouterr().out)["ready_stretch"] == 0.9
     assert main(["plan", "--robot", str(free_biped), str(steps), "--joints"]) == 0
     assert "ready posture: hips 0.90 of the straight leg" in capsys.readouterr().out
+    assert main(["simulate", "--robot", str(free_biped), str(steps), "--json"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    assert printed["ready_stretch"] == 0.9 and "forward = 0.315 is not allowed" in printed["ready_posture_refusal"]
+    assert main(["report", "--robot", str(free_biped), str(steps), "--out", str(tmp_path / "report"),
+                 "--no-animation", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["ready_stretch"] == 0.9
