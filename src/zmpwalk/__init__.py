@@ -27,6 +27,7 @@ from zmpwalk.patterns.lipm import generate_hyperbolic
 from zmpwalk.patterns.polynomial import generate
 from zmpwalk.patterns.preview import generate_preview
 from zmpwalk.patterns.result import WalkingPattern
+from zmpwalk.ready_fit import FittedWalk, fit_ready_posture
 from zmpwalk.robots import RobotModel, list_robots, load_robot
 from zmpwalk.sample import WalkingSample
 from zmpwalk.schedule import Schedule, ShapeParameters
@@ -35,6 +36,7 @@ from zmpwalk.walk import WalkOutcome, WalkSpec, run_walk
 __all__ = [
     "BalanceMeasurement",
     "FileFormatError",
+    "FittedWalk",
     "InfeasibleCommandError",
     "InfeasiblePatternError",
     "InvalidParameterError",
@@ -60,6 +62,7 @@ __all__ = [
     "WalkingPattern",
     "WalkingSample",
     "ZmpwalkError",
+    "fit_ready_posture",
     "generate",
     "generate_hyperbolic",
     "generate_preview",
