@@ -42,9 +42,9 @@ def hip_to_ankle(robot: object) -> float:
 
 
 def test_stretches_are_tried_nearest_first() -> None:
-    assert STRETCHES == (0.8, 0.82, 0.84, 0.86, 0.88, 0.9, 0.92, 0.94, 0.96)
-    assert stretches_to_try(0.92) == [0.94, 0.9, 0.96, 0.88, 0.86, 0.84, 0.82, 0.8]  # the taller of two as near
-    assert stretches_to_try(0.864)[:3] == [0.88, 0.84, 0.9]  # 0.86 is within 0.005 of the robot's own
+    assert list(STRETCHES) == pytest.approx([0.8, 0.82, 0.84, 0.86, 0.88, 0.9, 0.92, 0.94, 0.96], abs=1e-12)
+    assert stretches_to_try(0.92) == pytest.approx([0.94, 0.9, 0.96, 0.88, 0.86, 0.84, 0.82, 0.8], abs=1e-12)
+    assert stretches_to_try(0.864)[:3] == pytest.approx([0.88, 0.84, 0.9], abs=1e-12)  # 0.86: within 0.005
 
 
 def test_only_the_legs_refusals_start_the_search() -> None:
@@ -66,11 +66,11 @@ def test_a_stride_beyond_reach_walks_from_the_nearest_stretch_that_plans_it(free
     with pytest.raises(UnreachableError, match="left ankle out of reach"):
         planned_walk(spec)
     fitted = fit_ready_posture(spec, lambda stretch: load_robot(free_biped, ready_stretch=stretch))
-    assert fitted.stretch == 0.9 and fitted.own_stretch == pytest.approx(READY_STRETCH)
+    assert fitted.stretch == pytest.approx(0.9, abs=1e-12) and fitted.own_stretch == pytest.approx(READY_STRETCH)
     assert "forward = 0.315 is not allowed" in fitted.refusal and "hips 0.90 of the straight leg" in fitted.words()
     assert hip_to_ankle(fitted.spec.robot) == pytest.approx(0.9 * 0.6, abs=1e-9)  # [m]
     assert fitted.spec.robot.pelvis_height < robot.pelvis_height - 0.01  # [m] crouched lower
-    for nearer in stretches_to_try(READY_STRETCH)[:stretches_to_try(READY_STRETCH).index(0.9)]:  # 0.94: refused
+    for nearer in (0.94,):  # the one nearer the robot's 0.92 tried first
         with pytest.raises(ZmpwalkError):
             planned_walk(WalkSpec(load_robot(free_biped, ready_stretch=nearer), LONG, check_limits=True))
     outcome = run_walk(fitted.spec, planned=fitted.planned)
@@ -100,7 +100,7 @@ def test_no_stretch_fits_gives_the_robots_own_refusal(free_biped: Path) -> None:
 def test_a_robot_file_that_sets_its_posture_keeps_it(free_biped: Path, tmp_path: Path) -> None:
     path = write(tmp_path, "robot.toml", f'[model]\nfile = "{free_biped}"\n[posture]\nready_stretch = 0.92\n')
     robot = load_robot(path)
-    assert robot.plant is not None and robot.plant.posture_given
+    assert robot.plant is not None and robot.plant.posture_set_by == "ready_stretch"
     fitted = fit_ready_posture(WalkSpec(robot, LONG), lambda stretch: pytest.fail("the file's posture is kept"))
     assert fitted.planned is None and fitted.stretch is None and fitted.spec.robot is robot  # planned by run_walk
     with pytest.raises(InfeasibleCommandError, match=r"at most 0\.31"):
@@ -121,6 +121,76 @@ def test_a_stretch_out_of_range_is_refused_naming_it(free_biped: Path, tmp_path:
         load_robot(path)
 
 
+NARROW_ANKLE = '<joint name="{s}_ap" axis="0 1 0" range="-25 25"/>'  # [deg] MJCF's default unit: +-0.4363 rad
+
+
+def test_a_joint_out_of_range_walks_from_a_taller_posture(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The 0.3 + 0.3 m biped with ankle pitches of +-25 deg: 10 cm strides take the rear ankle past its stop from
+    0.92 (the batch plan, which does not check the ranges, walks it; the controller's check refuses it); from 0.90
+    too; from 0.94, taller, every joint stays in its range. ``zmpwalk plan`` fits it with or without --joints."""
+    import json
+
+    from zmpwalk.cli import main
+    from zmpwalk.joint_limits import check_joint_limits
+
+    path = write(tmp_path, "narrow.xml", biped(leg("l", 0.1, NARROW_ANKLE) + leg("r", -0.1, NARROW_ANKLE)))
+    robot = load_robot(path)
+    steps = [StepCommand(duration=0.8, forward=0.1)] * 3  # [s], [m]
+    own = checked_walk(WalkSpec(robot, steps))
+    with pytest.raises(JointLimitError, match="ankle_pitch"):
+        check_joint_limits(own.joints.time, own.joints.angles, robot)
+    with pytest.raises(JointLimitError, match="ankle_pitch"):
+        planned_walk(WalkSpec(load_robot(path, ready_stretch=0.9), steps, check_limits=True))
+    fitted = fit_ready_posture(WalkSpec(robot, steps), lambda stretch: load_robot(path, ready_stretch=stretch))
+    assert fitted.stretch == pytest.approx(0.94, abs=1e-12) and "ankle_pitch" in fitted.refusal
+    assert fitted.planned is not None
+    check_joint_limits(fitted.planned.joints.time, fitted.planned.joints.angles, fitted.spec.robot)  # raises none
+    assert np.abs(fitted.planned.joints.angles[:, [4, 10]]).max() <= math.radians(25)  # [rad] the ankle pitches
+    file = write(tmp_path, "steps.toml", "[[steps]]\nduration = 0.8\nforward = 0.1\nrepeat = 3\n")
+    for joints in ([], ["--joints"]):
+        assert main(["plan", "--robot", str(path), str(file), "--json", *joints]) == 0
+        printed = json.loads(capsys.readouterr().out)
+        assert printed["ready_stretch"] == pytest.approx(0.94, abs=1e-12) and printed["ready_posture_refusal"]
+
+
+def test_a_written_robot_file_keeps_what_it_set_and_leaves_the_rest_derived(free_biped: Path, tmp_path: Path,
+                                                                              capsys: pytest.CaptureFixture[str]
+                                                                              ) -> None:
+    from zmpwalk.cli import main
+
+    derived = tmp_path / "derived.toml"
+    assert main(["robot", str(free_biped), "--write", str(derived)]) == 0
+    text = derived.read_text(encoding="utf-8")
+    for name in ("ready_stretch", "pelvis_height", "dsp_time", "foot_lift", "lateral_velocity"):
+        assert f"\n# {name} = " in text  # derived: commented out, so a walk may fit the posture
+    assert load_robot(derived).plant.posture_set_by == ""  # type: ignore[union-attr]
+    for field, value in (("ready_stretch", "0.86"), ("pelvis_height", "0.53")):
+        given = write(tmp_path, f"{field}.toml", f'[model]\nfile = "{free_biped}"\n[posture]\n{field} = {value}\n'
+                      "[walking]\ndsp_time = 0.07\n")
+        again = tmp_path / f"{field}_again.toml"
+        assert main(["robot", str(given), "--write", str(again)]) == 0
+        assert f"\n{field} = {value}" in again.read_text(encoding="utf-8")
+        first, second = load_robot(given), load_robot(again)
+        assert first.plant is not None and second.plant is not None and first.plant.posture_set_by == field
+        assert second.plant.file_values == first.plant.file_values == tuple(sorted((field, "dsp_time")))
+        assert second.pelvis_height == pytest.approx(first.pelvis_height, abs=1e-12)  # [m]
+        assert second.plant.ready_stretch == pytest.approx(hip_to_ankle(second) / 0.6, abs=1e-9)  # as it stands
+        assert second.dsp_time == pytest.approx(0.07, abs=1e-12)  # [s]
+    capsys.readouterr()
+
+
+def test_a_posture_set_twice_or_out_of_range_names_where(free_biped: Path, tmp_path: Path) -> None:
+    both = write(tmp_path, "both.toml", f'[model]\nfile = "{free_biped}"\n[posture]\nready_stretch = 0.9\n'
+                 "pelvis_height = 0.5\n")
+    with pytest.raises(FileFormatError, match="both set the ready posture"):
+        load_robot(both)
+    plain = write(tmp_path, "plain.toml", f'[model]\nfile = "{free_biped}"\n')
+    with pytest.raises(InvalidParameterError, match=r"ready_stretch = 1.2 .*above 0.5") as error:
+        load_robot(plain, ready_stretch=1.2)  # the argument's value, not the file's
+    assert not isinstance(error.value, FileFormatError)
+    assert load_robot(plain, ready_stretch=0.9).plant.ready_stretch == pytest.approx(0.9, abs=1e-12)  # type: ignore[union-attr]
+
+
 def test_a_box_model_has_no_stretch_to_fit(hubo: RobotModel) -> None:
     with pytest.raises(InvalidParameterError, match="ready_stretch"):
         load_robot("hubo", ready_stretch=0.9)
@@ -137,12 +207,13 @@ def test_the_cli_walks_and_plans_from_the_fitted_posture(free_biped: Path, tmp_p
 
     steps = write(tmp_path, "long.toml", "[[steps]]\nduration = 0.8\nforward = 0.315\nrepeat = 3\n")
     assert main(["plan", "--robot", str(free_biped), str(steps), "--joints", "--json"]) == 0
-    assert json.loads(capsys.readouterr().out)["ready_stretch"] == 0.9
+    assert json.loads(capsys.readouterr().out)["ready_stretch"] == pytest.approx(0.9, abs=1e-12)
     assert main(["plan", "--robot", str(free_biped), str(steps), "--joints"]) == 0
     assert "ready posture: hips 0.90 of the straight leg" in capsys.readouterr().out
     assert main(["simulate", "--robot", str(free_biped), str(steps), "--json"]) == 0
     printed = json.loads(capsys.readouterr().out)
-    assert printed["ready_stretch"] == 0.9 and "forward = 0.315 is not allowed" in printed["ready_posture_refusal"]
+    assert printed["ready_stretch"] == pytest.approx(0.9, abs=1e-12)
+    assert "forward = 0.315 is not allowed" in printed["ready_posture_refusal"]
     assert main(["report", "--robot", str(free_biped), str(steps), "--out", str(tmp_path / "report"),
                  "--no-animation", "--json"]) == 0
-    assert json.loads(capsys.readouterr().out)["ready_stretch"] == 0.9
+    assert json.loads(capsys.readouterr().out)["ready_stretch"] == pytest.approx(0.9, abs=1e-12)

@@ -59,6 +59,14 @@ class FittedWalk:
                 f"this walk: {self.refusal}")
 
 
+    def in_context(self, error: ZmpwalkError) -> ZmpwalkError:
+        """``error`` of the walk, saying it walked from the fitted posture (as it is where it did not)."""
+        if self.stretch is None:
+            return error
+        return error.in_context(f"walking from a ready posture of hips {self.stretch:.2f} of the straight leg (the "
+                                f"robot's {self.own_stretch:.3f} refuses this walk)")
+
+
 def legs_refuse(error: ZmpwalkError) -> bool:
     """Whether ``error`` is the legs' refusal a ready posture can change: a leg out of reach or a joint of the model
     out of its range, raised as such or as the cause of an :class:`~zmpwalk.errors.InfeasibleCommandError`."""
@@ -94,7 +102,7 @@ def fit_ready_posture(spec: WalkSpec, reload: Callable[[float], RobotModel]) -> 
             the legs').
     """
     plant = spec.robot.plant
-    if plant is None or plant.posture_given:
+    if plant is None or plant.posture_set_by:
         return FittedWalk(spec, None)
     try:
         planned = checked_walk(spec)

@@ -318,8 +318,9 @@ def run_walk(spec: WalkSpec, progress: Progress | None = None, planned: PlannedW
     report = None if progress is None else (lambda done: progress("simulation", round(100 * done), 100))
     if through_controller(spec):
         result = _controller_walk(spec, report)
-        if result.fell:  # the run was sized for the longest walk the commands might take; the plan says its length
-            result = replace(result, planned_end=float(pattern.time[-1]) + spec.hold)
+        if result.fell and result.fall_time is not None:  # the run was sized for the longest walk the commands
+            # might take; the plan says its length (capture steps may have walked on past it)
+            result = replace(result, planned_end=max(float(pattern.time[-1]) + spec.hold, result.fall_time))
         balanced = True
     else:
         stabilizer = Stabilizer(spec.robot, spec.rate, com_reference=pattern.com_point) if spec.balance else None

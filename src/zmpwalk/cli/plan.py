@@ -34,7 +34,7 @@ from zmpwalk.kinematics import pattern_joint_trajectory
 from zmpwalk.patterns import generator
 from zmpwalk.patterns.polynomial import generate_chunks
 from zmpwalk.patterns.result import WalkingPattern, write_pieces_csv
-from zmpwalk.ready_fit import FittedWalk, legs_refuse, walk_from_other_posture
+from zmpwalk.ready_fit import FittedWalk, fit_ready_posture
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.tables import zmp_advice
 from zmpwalk.walk import WalkSpec
@@ -105,29 +105,20 @@ class PlanSummary:
 
 def run(args: argparse.Namespace) -> int:
     """``zmpwalk plan``: the pattern to --out (nothing written without it, and it says so) and its ZMP margin.
-    Where the robot's own ready posture refuses the walk for its legs, the walk is planned from the posture that
-    fits it (:mod:`zmpwalk.ready_fit`), as ``zmpwalk simulate`` walks it."""
+    Where an imported robot's own ready posture refuses the walk for its legs (reach, or a joint's range, checked
+    whether or not --joints writes the angles), the walk is planned from the posture that fits it
+    (:mod:`zmpwalk.ready_fit`), as ``zmpwalk simulate`` walks it."""
     commands, labels = walk_of(args)
     robot = load_robot_of(args)
     resolve_generator(args, robot)
-    try:
-        return _plan(args, robot, commands, labels, None)
-    except ZmpwalkError as error:
-        fitted = _fitted(args, robot, commands, labels, error)
-        if fitted is None:
-            raise
-        return _plan(args, fitted.spec.robot, commands, labels, fitted)
-
-
-def _fitted(args: argparse.Namespace, robot: RobotModel, commands: list[StepCommand], labels: list[str],
-            refusal: ZmpwalkError) -> FittedWalk | None:
-    """The walk planned from another ready posture where ``refusal`` is the legs' (None: not tried or none fits)."""
-    if robot.plant is None or robot.plant.posture_given or not legs_refuse(refusal):
-        return None
-    options: dict[str, object] = {} if schedule_of(args) is None else {"schedule": schedule_of(args)}
-    spec = WalkSpec(robot, commands, labels, generator=args.generator, pelvis=pelvis_of(args), rate=args.rate,
-                    check_limits=args.joints, source=walk_label(args), **options)  # type: ignore[arg-type]
-    return walk_from_other_posture(spec, lambda stretch: load_robot_of(args, stretch), refusal)
+    fitted = None
+    if robot.plant is not None and not robot.plant.posture_set_by:
+        options: dict[str, object] = {} if schedule_of(args) is None else {"schedule": schedule_of(args)}
+        spec = WalkSpec(robot, commands, labels, generator=args.generator, pelvis=pelvis_of(args), rate=args.rate,
+                        source=walk_label(args), **options)  # type: ignore[arg-type]
+        fitted = fit_ready_posture(spec, lambda stretch: load_robot_of(args, stretch))
+        robot = fitted.spec.robot
+    return _plan(args, robot, commands, labels, fitted if fitted is not None and fitted.stretch is not None else None)
 
 
 def _plan(args: argparse.Namespace, robot: RobotModel, commands: list[StepCommand], labels: list[str],
@@ -151,7 +142,8 @@ def _plan(args: argparse.Namespace, robot: RobotModel, commands: list[StepComman
             for _ in stream:
                 pass
     result = {**summary.result(), "out": str(args.out) if args.out else None,
-              "ready_stretch": None if fitted is None else fitted.stretch}
+              "ready_stretch": None if fitted is None else fitted.stretch,
+              "ready_posture_refusal": None if fitted is None else fitted.refusal}
     outside = float(result["min_zmp_margin"]) < 0  # type: ignore[arg-type]
     if outside and args.generator == "polynomial" and pelvis_of(args) == "cubic":  # what to change, from its terms
         result["advice"] = zmp_advice(robot, commands, float(result["min_zmp_margin_time"]),  # type: ignore[arg-type]

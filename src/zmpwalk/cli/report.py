@@ -32,6 +32,7 @@ from zmpwalk.cli.options import (
     schedule_of,
 )
 from zmpwalk.cli.printing import json_safe, margin_words, print_verdict, progress
+from zmpwalk.errors import ZmpwalkError
 from zmpwalk.scenarios import load_scenario_with_labels, load_steps_file_with_labels
 
 NAMES = ("demo", "report")
@@ -101,26 +102,30 @@ def run(args: argparse.Namespace) -> int:
     quiet = args.json or not sys.stderr.isatty()
     with named_source(str(args.steps) if args.steps else f"scenario {args.scenario}"):
         fitted = fit_ready_posture(WalkSpec(robot, commands, labels, generator=args.generator,
-                                            schedule=schedule_of(args), pelvis=pelvis_of(args)),
+                                            schedule=schedule_of(args), pelvis=pelvis_of(args), check_limits=True,
+                                            balance=balance_of(args), latency=args.latency, motors=motors_of(args)),
                                    lambda stretch: load_robot_of(args, stretch))
         robot = fitted.spec.robot
-        report = build_report(robot, commands, args.out, title=f"zmpwalk: {robot.name}, {name}",
-                              generator=args.generator, animate=not args.no_animation,
-                              gif=args.gif and not args.no_animation,
-                              progress=None if quiet else progress, labels=labels,
-                              balance=balance_of(args), latency=args.latency, schedule=schedule_of(args),
-                              motors=motors_of(args), pelvis=pelvis_of(args))
+        if fitted.stretch is not None and not args.json:
+            print(fitted.words(), flush=True)  # before the walk, which may fail
+        try:
+            report = build_report(robot, commands, args.out, title=f"zmpwalk: {robot.name}, {name}",
+                                  generator=args.generator, animate=not args.no_animation,
+                                  gif=args.gif and not args.no_animation,
+                                  progress=None if quiet else progress, labels=labels,
+                                  balance=balance_of(args), latency=args.latency, schedule=schedule_of(args),
+                                  motors=motors_of(args), pelvis=pelvis_of(args))
+        except ZmpwalkError as error:
+            raise fitted.in_context(error) from None
     verdict = report.verdict
     if args.json:
         summary = {**report.summary, "index": str(report.index), "seconds": report.seconds,
-                   "ready_stretch": fitted.stretch}
+                   "ready_stretch": fitted.stretch, "ready_posture_refusal": fitted.refusal or None}
         print(json.dumps(json_safe(summary), indent=2, allow_nan=False))
     else:
         s = report.summary
         state = f"FELL at t = {s['fall_time']:.2f} s" if s["fell"] else "no fall"
         print(f"generator: {generator_words(args, robot)}")
-        if fitted.stretch is not None:
-            print(fitted.words())
         print(f"controller: {s['controller']}")
         print(f"{robot.name}, {name}: {verdict.state} ({state}); plan's min ZMP margin "
               f"{margin_words(float(s['min_zmp_margin']))} -> {report.index}")

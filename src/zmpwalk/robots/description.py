@@ -124,8 +124,9 @@ class ModelPlant:
         root_body: Name of the floating base where it is not ``base_body``, else empty.
         coupled_joints: Joints a leg joint moves through a joint equality (names): neither held nor driven (their
             actuators' controls 0).
-        ready_stretch: The ready posture's hip-to-ankle distance over the straight leg [-].
-        posture_given: The robot file sets the ready posture (``pelvis_height`` or ``ready_stretch``).
+        ready_stretch: The ready posture's hip-to-ankle distance over the straight leg [-] (the left leg's).
+        file_values: The fields of the robot file's ``[posture]`` and ``[walking]`` (or ``load_robot``'s
+            ``ready_stretch``) that replace derived values (names).
     """
 
     path: Path
@@ -146,4 +147,10 @@ class ModelPlant:
     root_body: str = ""
     coupled_joints: tuple[str, ...] = ()
     ready_stretch: float = 0.0  # [-]
-    posture_given: bool = False
+    file_values: tuple[str, ...] = ()
+
+    @property
+    def posture_set_by(self) -> str:
+        """The field that set the ready posture, ``"ready_stretch"`` or ``"pelvis_height"``; empty: derived (the
+        keyframe's)."""
+        return next((name for name in ("ready_stretch", "pelvis_height") if name in self.file_values), "")

@@ -63,7 +63,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from zmpwalk.errors import FileFormatError
+from zmpwalk.errors import FileFormatError, InvalidParameterError
 from zmpwalk.leg_chain import LegChain
 from zmpwalk.robots.collision import Sole, collision_points, rigid_bodies, sole_face_up, sole_roll_bound
 from zmpwalk.robots.description import (
@@ -77,7 +77,7 @@ from zmpwalk.robots.description import (
 from zmpwalk.robots.legs import VIRTUAL_PREFIX, FootAtReference, Segments, build_leg, leg_joint_ids, segments
 from zmpwalk.robots.model import RobotModel, schedule_scale
 from zmpwalk.robots.pd import check_load_stiffness, coupled_joints, element_name, pd_layer
-from zmpwalk.robots.posture import ready_posture, reference_reach
+from zmpwalk.robots.posture import hip_to_ankle, ready_posture, reference_reach
 from zmpwalk.robots.tree import (
     base_mount,
     find_feet,
@@ -181,7 +181,7 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
             other than five or six hinge joints, ambiguous feet, a sole that does not stand flat in the
             reference posture, ...).
         InvalidParameterError: ``pd_gains`` names a joint the PD layer does not drive, ``load_stiffness`` is
-            not a finite number > 1, or ``ready_stretch`` is not in :data:`STRETCH_RANGE`.
+            not a finite number > 1, or ``ready_stretch`` is not in :data:`~zmpwalk.robots.posture.STRETCH_RANGE`.
     """
     import mujoco
 
@@ -220,6 +220,10 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     thigh, shank = geometry.thigh, geometry.shank
     mass = float(np.sum(model.body_mass))
     values = dict(overrides or {})
+    posture = sorted({"ready_stretch", "pelvis_height"} & set(values))
+    if len(posture) > 1:
+        raise InvalidParameterError("overrides", sorted(values), "one of ready_stretch and pelvis_height: both set "
+                                    "the ready posture")
     distance, height_scale = reference_reach(model, data, qpos_reference, base, left_hip, foot_ids[0],
                                               ankle_height, thigh + shank, values.get("ready_stretch"))
     model_name = model.names[:model.names.find(b"\0")].decode()
@@ -241,8 +245,9 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     leg_joints = _driven_joints(leg_joints, dict(pd_joints), geometry, values.get("sole_roll_limit"), source)
     names = {j: element_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in coupled}
     plant = replace(plant, joints=tuple(leg_joints), pd_joints=pd_joints, load_stiffness=load_stiffness,
-                    ready_stretch=distance / (thigh + shank),
-                    posture_given=bool({"ready_stretch", "pelvis_height"} & set(values)),
+                    ready_stretch=(hip_to_ankle(chains_ready[0]) if "pelvis_height" in values else distance)
+                    / (thigh + shank),
+                    file_values=tuple(sorted(set(values) - {"load_stiffness"})),
                     pd_given=tuple(sorted(pd_gains or {})),
                     coupled_joints=tuple(sorted(names.values())),
                     held_joints=tuple(n for n in plant.held_joints if n not in names.values()))

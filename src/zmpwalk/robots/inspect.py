@@ -18,6 +18,7 @@ from zmpwalk.robots.description import (
     Actuator,
 )
 from zmpwalk.robots.model import RobotModel
+from zmpwalk.robots.posture import READY_STRETCH
 
 if TYPE_CHECKING:
     from zmpwalk.sim.statics import StaticTorques
@@ -210,21 +211,25 @@ def robot_toml(robot: RobotModel, folder: Path) -> str:
         if plant.package_paths:
             lines.append("package_paths = [" + ", ".join(_quote(str(p)) for p in plant.package_paths) + "]")
         lines.append(f"name = {_quote(robot.name)}")
-    pelvis = f"pelvis_height = {robot.pelvis_height:.6g}   # [m] base origin above the ground, ready posture"
-    if robot.plant is not None:  # the posture derived: left to the import, which fits it to a walk's strides
-        pelvis = (f"# ready_stretch = {robot.plant.ready_stretch:.6g}   # [-] hip-to-ankle distance over the straight "
-                  "leg (the keyframe's, at most 0.92); set, it (or pelvis_height) keeps this posture for every walk "
-                  "(docs/robot-import.md)\n# " + pelvis)
-    lines += ["", "[posture]", pelvis,
-              "", "[walking]",
-              f"dsp_time = {robot.dsp_time:.6g}   # [s] double-support time d (HUBO's 0.1 s, time-scaled)",
-              f"foot_lift = {robot.foot_lift:.6g}   # [m] swing apex height (HUBO's 0.04 m, length-scaled, lowered "
-              f"where a pitch joint would come within {LIFT_RANGE_MARGIN:g} rad of its range)",
-              f"lateral_velocity = {robot.lateral_velocity:.6g}   # [m] V_y of Eq. 20 (HUBO's 0.1 m, lateral-scaled)"]
+    given = robot.plant.file_values if robot.plant is not None else None
+
+    def field(name: str, value: float, comment: str) -> str:  # a derived value of a model robot: commented out
+        return f"{'' if given is None or name in given else '# '}{name} = {value:.6g}   # {comment}"
+
+    posture = [field("pelvis_height", robot.pelvis_height, "[m] base origin above the ground, ready posture")]
+    if robot.plant is not None:
+        posture.insert(0, field("ready_stretch", robot.plant.ready_stretch, "[-] hip-to-ankle distance over the "
+                                f"straight leg (the keyframe's, at most {READY_STRETCH:g}); either set keeps the "
+                                "posture for every walk, else a walk is fitted one (docs/robot-import.md)"))
+    lines += ["", "[posture]", *posture, "", "[walking]",
+              field("dsp_time", robot.dsp_time, "[s] double-support time d (HUBO's 0.1 s, time-scaled)"),
+              field("foot_lift", robot.foot_lift, "[m] swing apex height (HUBO's 0.04 m, length-scaled, lowered "
+                    f"where a pitch joint would come within {LIFT_RANGE_MARGIN:g} rad of its range)"),
+              field("lateral_velocity", robot.lateral_velocity, "[m] V_y of Eq. 20 (HUBO's 0.1 m, lateral-scaled)")]
     if robot.legs is not None and robot.legs[0].virtual is not None:  # five-joint legs: the sole roll they may leave
         bound = robot.joint_limits["left_ankle_roll"][1]
-        lines.append(f"# sole_roll_limit = {bound:.6g}   # [rad] the sole roll a walk may leave (no ankle roll); "
-                     "raise it for a foot that rolls on its centre line (docs/robot-import.md)")
+        lines.append(field("sole_roll_limit", bound, "[rad] the sole roll a walk may leave (no ankle roll); raise "
+                           "it for a foot that rolls on its centre line (docs/robot-import.md)"))
     if robot.plant is not None and robot.plant.pd_joints:
         lines += ["", "[pd]",
                   "# The joint PD layer (the firmware's joint loop) of each torque motor or unactuated joint, derived",

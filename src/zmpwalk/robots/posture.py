@@ -25,6 +25,25 @@ READY_STRETCH = 0.92  # [-] hip-to-ankle distance of the ready posture, at most 
 STRETCH_RANGE = (0.5, 1.0)  # [-] a ready_stretch given: above the first, below the second (a straight leg)
 
 
+def check_stretch(stretch: object) -> float:
+    """``stretch`` as a float, a ready posture's hip-to-ankle distance over the straight leg [-].
+
+    Raises:
+        InvalidParameterError: Not a number within :data:`STRETCH_RANGE`.
+    """
+    if isinstance(stretch, bool) or not isinstance(stretch, (int, float)) \
+            or not STRETCH_RANGE[0] < stretch < STRETCH_RANGE[1]:
+        raise InvalidParameterError("ready_stretch", stretch, f"a fraction of the straight leg above "
+                                    f"{STRETCH_RANGE[0]} and below {STRETCH_RANGE[1]} (a straight leg)")
+    return float(stretch)
+
+
+def hip_to_ankle(chain: LegChain) -> float:
+    """The hip centre's distance from the ankle point in ``chain``'s reference posture [m]."""
+    ankle, _ = chain.fk(chain.reference[None])
+    return float(np.linalg.norm(ankle[0] - chain.hip))
+
+
 def reference_reach(model: Any, data: Any, qpos_reference: Array, base: int, hip: Array, foot: int,
                      ankle_height: float, straight: float, stretch: float | None) -> tuple[float, float]:
     """The ready posture's hip-to-ankle distance [m], ``stretch`` times the ``straight`` leg, or (None) the
@@ -36,11 +55,8 @@ def reference_reach(model: Any, data: Any, qpos_reference: Array, base: int, hip
     """
     import mujoco
 
-    if stretch is not None and (isinstance(stretch, bool) or not isinstance(stretch, (int, float))
-                                or not STRETCH_RANGE[0] < stretch < STRETCH_RANGE[1]):
-        raise InvalidParameterError("ready_stretch", stretch, f"a fraction of the straight leg above "
-                                    f"{STRETCH_RANGE[0]} and below {STRETCH_RANGE[1]} (a straight leg)")
-
+    if stretch is not None:
+        check_stretch(stretch)
     data.qpos[:] = qpos_reference
     mujoco.mj_kinematics(model, data)
     key_hip = data.xpos[base] + data.xmat[base].reshape(3, 3) @ hip

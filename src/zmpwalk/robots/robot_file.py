@@ -16,6 +16,7 @@ from zmpwalk.files import read_toml
 from zmpwalk.robots.imported import import_robot
 from zmpwalk.robots.model import RobotModel, checked_generator, robot_from_dict, stabilizer_gains
 from zmpwalk.robots.pd import check_load_stiffness
+from zmpwalk.robots.posture import check_stretch
 
 
 def robot_from_toml(path: Path, ready_stretch: float | None = None) -> RobotModel:
@@ -79,7 +80,11 @@ def _robot_from_model_table(data: dict[str, Any], path: Path, ready_stretch: flo
     pd_gains, load_stiffness = _pd_table(data.get("pd"), source)
     if load_stiffness is not None:
         overrides["load_stiffness"] = load_stiffness
+    if {"pelvis_height", "ready_stretch"} <= set(overrides):
+        raise FileFormatError(source, "[posture] ready_stretch and pelvis_height both set the ready posture; give "
+                              "one of them")
     if ready_stretch is not None:
+        ready_stretch = check_stretch(ready_stretch)  # the argument's error, not the file's
         given = sorted({"pelvis_height", "ready_stretch"} & set(overrides))
         if given:
             raise InvalidParameterError("ready_stretch", ready_stretch, f"None: {source} sets the ready posture "
