@@ -30,6 +30,7 @@ from zmpwalk.cli.options import (
 from zmpwalk.cli.printing import margin_words
 from zmpwalk.commands import StepCommand
 from zmpwalk.errors import ZmpwalkError
+from zmpwalk.joint_limits import check_joint_limits
 from zmpwalk.kinematics import pattern_joint_trajectory
 from zmpwalk.patterns import generator
 from zmpwalk.patterns.polynomial import generate_chunks
@@ -118,24 +119,32 @@ def run(args: argparse.Namespace) -> int:
                         source=walk_label(args), **options)  # type: ignore[arg-type]
         fitted = fit_ready_posture(spec, lambda stretch: load_robot_of(args, stretch))
         robot = fitted.spec.robot
-    return _plan(args, robot, commands, labels, fitted if fitted is not None and fitted.stretch is not None else None)
+    return _plan(args, robot, commands, labels, fitted)
 
 
 def _plan(args: argparse.Namespace, robot: RobotModel, commands: list[StepCommand], labels: list[str],
           fitted: FittedWalk | None) -> int:
-    """Plan, write and print the walk of ``robot`` (standing as ``fitted`` chose, where it did)."""
+    """Plan (or take the walk ``fitted`` planned), write and print the walk of ``robot`` (standing as ``fitted``
+    chose, where it did)."""
     make = generator(args.generator)
     schedule = schedule_of(args)
     options = pattern_options(args)
+    summary = PlanSummary()
     with named_source(walk_label(args)):
-        if args.generator == "polynomial":  # long walks: planned whole, sampled and written piece by piece
-            pieces = generate_chunks(robot, commands, rate=args.rate, schedule=schedule, labels=labels,
-                                     pelvis=pelvis_of(args))
+        if fitted is not None and fitted.planned is not None:  # planned whole already, its joints with it
+            planned = fitted.planned
+            if args.joints:
+                check_joint_limits(planned.joints.time, planned.joints.angles, robot)
+            columns = planned.joints.columns() if args.joints else None
+            stream = ((piece, columns) for piece in summary.follow(iter([planned.pattern])))
         else:
-            pieces = iter([make(robot, commands, rate=args.rate, labels=labels, **options)])
-        summary = PlanSummary()
-        stream = ((piece, pattern_joint_trajectory(piece).columns() if args.joints else None)
-                  for piece in summary.follow(pieces))
+            if args.generator == "polynomial":  # long walks: planned whole, sampled and written piece by piece
+                pieces = generate_chunks(robot, commands, rate=args.rate, schedule=schedule, labels=labels,
+                                         pelvis=pelvis_of(args))
+            else:
+                pieces = iter([make(robot, commands, rate=args.rate, labels=labels, **options)])
+            stream = ((piece, pattern_joint_trajectory(piece).columns() if args.joints else None)
+                      for piece in summary.follow(pieces))
         if args.out:
             write_pieces_csv(args.out, stream)
         else:
@@ -143,7 +152,7 @@ def _plan(args: argparse.Namespace, robot: RobotModel, commands: list[StepComman
                 pass
     result = {**summary.result(), "out": str(args.out) if args.out else None,
               "ready_stretch": None if fitted is None else fitted.stretch,
-              "ready_posture_refusal": None if fitted is None else fitted.refusal}
+              "ready_posture_refusal": None if fitted is None else fitted.refusal or None}
     outside = float(result["min_zmp_margin"]) < 0  # type: ignore[arg-type]
     if outside and args.generator == "polynomial" and pelvis_of(args) == "cubic":  # what to change, from its terms
         result["advice"] = zmp_advice(robot, commands, float(result["min_zmp_margin_time"]),  # type: ignore[arg-type]
@@ -153,7 +162,7 @@ def _plan(args: argparse.Namespace, robot: RobotModel, commands: list[StepComman
     else:
         margin = float(result["min_zmp_margin"])  # type: ignore[arg-type]
         print(f"generator: {generator_words(args, robot)}")
-        if fitted is not None:
+        if fitted is not None and fitted.stretch is not None:
             print(fitted.words())
         print(f"{result['swings']} swings, {result['duration']:.3f} s, {result['samples']} samples at "
               f"{args.rate:g} Hz" + (f" -> {args.out}" if args.out else
