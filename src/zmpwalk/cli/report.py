@@ -114,7 +114,7 @@ def run(args: argparse.Namespace) -> int:
                                   gif=args.gif and not args.no_animation,
                                   progress=None if quiet else progress, labels=labels,
                                   balance=balance_of(args), latency=args.latency, schedule=schedule_of(args),
-                                  motors=motors_of(args), pelvis=pelvis_of(args))
+                                  motors=motors_of(args), pelvis=pelvis_of(args), planned=fitted.planned)
         except ZmpwalkError as error:
             raise fitted.in_context(error) from None
     verdict = report.verdict

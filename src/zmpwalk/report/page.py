@@ -28,7 +28,7 @@ from zmpwalk.sim.actuators import IMPACT_WINDOW, ActuatorRow, actuator_markdown,
 from zmpwalk.sim.motors import Motor, MotorFit
 from zmpwalk.sim.run import SimulationResult, write_result_csv
 from zmpwalk.sim.verdict import FAIL, PASS, SKIP, WARN, Verdict
-from zmpwalk.walk import Progress, WalkSpec, run_walk
+from zmpwalk.walk import PlannedWalk, Progress, WalkSpec, run_walk
 
 STAGES = ("pattern", "joints", "simulation", "plots", "animation", "page")
 
@@ -84,11 +84,13 @@ def build_report(
     schedule: Schedule | None = None,
     motors: list[Motor] | None = None,
     pelvis: str = "cubic",
+    planned: PlannedWalk | None = None,
 ) -> Report:
     """Generate, check, simulate and report a walk into ``folder`` (``generator``: None for the robot's own;
     ``pelvis``: the polynomial generator's pelvis curves, ``"cubic"`` or ``"quintic"``). ``animate``: the
     interactive replay (three.js); ``gif``: also the offscreen-rendered GIF (``walk.gif``, shown where WebGL is
-    missing).
+    missing). ``planned``: this very walk already planned (its ``WalkSpec`` the one made of these arguments, with
+    ``check_limits``: :func:`zmpwalk.ready_fit.fit_ready_posture`'s), not planned again.
 
     Raises:
         ZmpwalkError: The walk cannot be generated (the message says why).
@@ -97,7 +99,7 @@ def build_report(
     report = Report(folder, folder / "index.html")
     spec = WalkSpec(robot, commands, labels, generator=generator, schedule=schedule, pelvis=pelvis,
                     check_limits=True, balance=balance, latency=latency, motors=motors)
-    walk = run_walk(spec, progress=None if progress is None else _walk_progress(progress))
+    walk = run_walk(spec, progress=None if progress is None else _walk_progress(progress), planned=planned)
     pattern, result, rows, report.verdict = walk.pattern, walk.result, walk.rows, walk.verdict
     clock = time.perf_counter()
     pattern.write_csv(folder / "pattern.csv")
