@@ -58,7 +58,6 @@ class FittedWalk:
                 f"{self.spec.robot.pelvis_height:.4f} m), not the robot's {self.own_stretch:.3f}, which refuses "
                 f"this walk: {self.refusal}")
 
-
     def in_context(self, error: ZmpwalkError) -> ZmpwalkError:
         """``error`` of the walk, saying it walked from the fitted posture (as it is where it did not)."""
         if self.stretch is None:
