@@ -63,7 +63,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from zmpwalk.errors import FileFormatError, InvalidParameterError
+from zmpwalk.errors import FileFormatError
 from zmpwalk.leg_chain import LegChain
 from zmpwalk.robots.collision import Sole, collision_points, rigid_bodies, sole_face_up, sole_roll_bound
 from zmpwalk.robots.description import (
@@ -77,7 +77,7 @@ from zmpwalk.robots.description import (
 from zmpwalk.robots.legs import VIRTUAL_PREFIX, FootAtReference, Segments, build_leg, leg_joint_ids, segments
 from zmpwalk.robots.model import RobotModel, schedule_scale
 from zmpwalk.robots.pd import check_load_stiffness, coupled_joints, element_name, pd_layer
-from zmpwalk.robots.posture import hip_to_ankle, ready_posture, reference_reach
+from zmpwalk.robots.posture import hip_to_ankle, posture_set_by, ready_posture, reference_reach
 from zmpwalk.robots.tree import (
     base_mount,
     find_feet,
@@ -215,47 +215,55 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     chains = [chain for chain, _, _ in built]
     leg_joints = [joint for _, joints, _ in built for joint in joints]
     geometry = _geometry(chains, (built[0][2], built[1][2]), source)
-    polygon, ankle_height, left_hip = built[0][2].polygon, geometry.ankle_height, chains[0].hip
-    hip_x, hip_spacing, hip_drop = geometry.hip_x, geometry.hip_spacing, geometry.hip_drop
-    thigh, shank = geometry.thigh, geometry.shank
+    g, straight = geometry, geometry.thigh + geometry.shank  # [m] the straight leg
     mass = float(np.sum(model.body_mass))
     values = dict(overrides or {})
-    posture = sorted({"ready_stretch", "pelvis_height"} & set(values))
-    if len(posture) > 1:
-        raise InvalidParameterError("overrides", sorted(values), "one of ready_stretch and pelvis_height: both set "
-                                    "the ready posture")
-    distance, height_scale = reference_reach(model, data, qpos_reference, base, left_hip, foot_ids[0],
-                                              ankle_height, thigh + shank, values.get("ready_stretch"))
-    model_name = model.names[:model.names.find(b"\0")].decode()
-    robot_name = name or re.sub(r"[^A-Za-z0-9_.-]+", "-", model_name).strip("-") or path.stem
-    plant = _model_plant(model, path, base, foot_ids, key_id, leg_joint_set | {root_joint}, masses, polygon,
-                         package_paths)
-    if base != root:
-        plant = replace(plant, root_body=element_name(model, mujoco.mjtObj.mjOBJ_BODY, root))
-    ready = ready_posture(model, data, chains, legs, qpos_reference, (adr, mount), distance, hip_x, hip_spacing,
-                           hip_drop, ankle_height, values.get("pelvis_height"), source)
+    posture_set_by(values)  # one of them at most
+    distance, height_scale = reference_reach(model, data, qpos_reference, base, chains[0].hip, foot_ids[0],
+                                              g.ankle_height, straight, values.get("ready_stretch"))
+    plant = _model_plant(model, path, (base, root), foot_ids, key_id, leg_joint_set | {root_joint}, masses,
+                         built[0][2].polygon, package_paths)
+    ready = ready_posture(model, data, chains, legs, qpos_reference, (adr, mount), distance, g.hip_x, g.hip_spacing,
+                          g.hip_drop, g.ankle_height, values.get("pelvis_height"), source)
     pelvis_height, pendulum, com_offset, chains_ready, qpos = ready
-    length_scale = schedule_scale(pendulum, thigh + shank, hip_spacing)[1]
+    length_scale = schedule_scale(pendulum, straight, g.hip_spacing)[1]
     lift = _foot_lift(chains_ready, leg_joints, HUBO_FOOT_LIFT * length_scale)  # [m]
-    # The joint PD layer: gains from the ready posture's inertia; a leg joint holds the robot, m g l.
+    moment = mass * float(np.linalg.norm(model.opt.gravity)) * pendulum  # [N m] m g l, what a leg joint holds
+    plant, leg_joints = _with_pd_layer(model, data, qpos, plant, leg_joints, leg_joint_set, geometry, values,
+                                       pd_gains or {}, moment, source)
+    stretch = (hip_to_ankle(chains_ready[0]) if "pelvis_height" in values else distance) / straight  # [-]
+    plant = replace(plant, file_values=tuple(sorted(set(values) - {"load_stiffness"})), ready_stretch=stretch)
+    return _robot_model(
+        name=_robot_name(model, name, path), description=f"imported from {path.name} ({mass:.1f} kg)", mass=mass,
+        height=height_scale, geometry=geometry, pelvis_height=pelvis_height, pendulum=pendulum,
+        gravity=float(-model.opt.gravity[2]), foot_lift=lift, overrides=values, leg_joints=leg_joints,
+        com_offset=com_offset, legs=(chains_ready[0], chains_ready[1]), plant=plant)
+
+
+def _robot_name(model: Any, name: str | None, path: Path) -> str:
+    """``name``, else the model's (letters, digits, ``_.-``), else the file's stem."""
+    model_name = model.names[:model.names.find(b"\0")].decode()
+    return name or re.sub(r"[^A-Za-z0-9_.-]+", "-", model_name).strip("-") or path.stem
+
+
+def _with_pd_layer(model: Any, data: Any, qpos: Array, plant: ModelPlant, leg_joints: list[LegJoint],
+                   leg_joint_set: set[int], geometry: _Geometry, values: dict[str, float],
+                   pd_gains: dict[str, tuple[float, float | None]], moment: float, source: str
+                   ) -> tuple[ModelPlant, list[LegJoint]]:
+    """``plant`` with the joint PD layer (gains from the ready posture ``qpos``'s inertia, a leg joint holding the
+    robot's ``moment`` m g l [N m]; ``values``' ``load_stiffness``, ``pd_gains`` given) and the leg joints driven by
+    it (a five-joint leg's virtual roll with its range)."""
+    import mujoco
+
     coupled = coupled_joints(model, leg_joint_set)
     load_stiffness = check_load_stiffness(values.get("load_stiffness", PD_LOAD_STIFFNESS))
-    pd_joints = pd_layer(model, data, qpos, leg_joint_set, mass * float(np.linalg.norm(model.opt.gravity)) * pendulum,
-                          pd_gains or {}, coupled, load_stiffness)
+    pd_joints = pd_layer(model, data, qpos, leg_joint_set, moment, pd_gains, coupled, load_stiffness)
     leg_joints = _driven_joints(leg_joints, dict(pd_joints), geometry, values.get("sole_roll_limit"), source)
     names = {j: element_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in coupled}
     plant = replace(plant, joints=tuple(leg_joints), pd_joints=pd_joints, load_stiffness=load_stiffness,
-                    ready_stretch=(hip_to_ankle(chains_ready[0]) if "pelvis_height" in values else distance)
-                    / (thigh + shank),
-                    file_values=tuple(sorted(set(values) - {"load_stiffness"})),
-                    pd_given=tuple(sorted(pd_gains or {})),
-                    coupled_joints=tuple(sorted(names.values())),
+                    pd_given=tuple(sorted(pd_gains)), coupled_joints=tuple(sorted(names.values())),
                     held_joints=tuple(n for n in plant.held_joints if n not in names.values()))
-    return _robot_model(
-        name=robot_name, description=f"imported from {path.name} ({mass:.1f} kg)", mass=mass, height=height_scale,
-        geometry=geometry, pelvis_height=pelvis_height, pendulum=pendulum, gravity=float(-model.opt.gravity[2]),
-        foot_lift=lift, overrides=values, leg_joints=leg_joints, com_offset=com_offset,
-        legs=(chains_ready[0], chains_ready[1]), plant=plant)
+    return plant, leg_joints
 
 
 def _foot_lift(chains: list[LegChain], leg_joints: list[LegJoint], scaled: float) -> float:
@@ -322,10 +330,11 @@ def _driven_joints(joints: list[LegJoint], driven: dict[str, Actuator], geometry
             for joint in joints]
 
 
-def _model_plant(model: Any, path: Path, base: int, feet: list[int], key_id: int, leg_joints: set[int],
+def _model_plant(model: Any, path: Path, bases: tuple[int, int], feet: list[int], key_id: int, leg_joints: set[int],
                  masses: Segments, polygon: Array, package_paths: tuple[Path, ...]) -> ModelPlant:
     """What the simulation needs of the model (its leg joints and PD layer are filled in later): every joint but
-    ``leg_joints`` (the legs' and the base's) is held at the reference pose."""
+    ``leg_joints`` (the legs' and the base's) is held at the reference pose. ``bases``: the legs' base and the
+    floating root (named where they differ)."""
     import mujoco
 
     def name(kind: Any, index: int) -> str:
@@ -334,8 +343,10 @@ def _model_plant(model: Any, path: Path, base: int, feet: list[int], key_id: int
     qpos = model.key_qpos[key_id] if key_id >= 0 else model.qpos0
     ctrl = model.key_ctrl[key_id] if key_id >= 0 and model.nu else np.zeros(model.nu)
     rest_com = masses.rest_com
+    base, root = bases
     return ModelPlant(
         path=path.resolve(), base_body=name(mujoco.mjtObj.mjOBJ_BODY, base),
+        root_body=name(mujoco.mjtObj.mjOBJ_BODY, root) if root != base else "",
         feet=(name(mujoco.mjtObj.mjOBJ_BODY, feet[0]), name(mujoco.mjtObj.mjOBJ_BODY, feet[1])), joints=(),
         qpos_reference=tuple(float(v) for v in qpos), ctrl_reference=tuple(float(v) for v in ctrl),
         package_paths=package_paths, sole_polygon=tuple((float(x), float(y)) for x, y in polygon),

@@ -38,6 +38,20 @@ def check_stretch(stretch: object) -> float:
     return float(stretch)
 
 
+def posture_set_by(values: dict[str, float]) -> str:
+    """The field of a robot's given ``values`` that sets its ready posture, ``"ready_stretch"`` or
+    ``"pelvis_height"``; empty: none (the keyframe's).
+
+    Raises:
+        InvalidParameterError: Both are given.
+    """
+    given = sorted({"ready_stretch", "pelvis_height"} & set(values))
+    if len(given) > 1:
+        raise InvalidParameterError("overrides", given, "one of ready_stretch and pelvis_height: both set the ready "
+                                    "posture")
+    return given[0] if given else ""
+
+
 def hip_to_ankle(chain: LegChain) -> float:
     """The hip centre's distance from the ankle point in ``chain``'s reference posture [m]."""
     ankle, _ = chain.fk(chain.reference[None])
