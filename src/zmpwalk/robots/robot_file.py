@@ -16,7 +16,7 @@ from zmpwalk.files import read_toml
 from zmpwalk.robots.imported import import_robot
 from zmpwalk.robots.model import RobotModel, checked_generator, robot_from_dict, stabilizer_gains
 from zmpwalk.robots.pd import check_load_stiffness
-from zmpwalk.robots.posture import check_stretch
+from zmpwalk.robots.posture import check_stretch, posture_set_by
 
 
 def robot_from_toml(path: Path, ready_stretch: float | None = None) -> RobotModel:
@@ -80,15 +80,16 @@ def _robot_from_model_table(data: dict[str, Any], path: Path, ready_stretch: flo
     pd_gains, load_stiffness = _pd_table(data.get("pd"), source)
     if load_stiffness is not None:
         overrides["load_stiffness"] = load_stiffness
-    if {"pelvis_height", "ready_stretch"} <= set(overrides):
+    try:
+        given = posture_set_by(overrides)
+    except InvalidParameterError:
         raise FileFormatError(source, "[posture] ready_stretch and pelvis_height both set the ready posture; give "
-                              "one of them")
+                              "one of them") from None
     if ready_stretch is not None:
         ready_stretch = check_stretch(ready_stretch)  # the argument's error, not the file's
-        given = sorted({"pelvis_height", "ready_stretch"} & set(overrides))
         if given:
             raise InvalidParameterError("ready_stretch", ready_stretch, f"None: {source} sets the ready posture "
-                                        f"([posture] {', '.join(given)})")
+                                        f"([posture] {given})")
         overrides["ready_stretch"] = ready_stretch
     try:
         robot = import_robot(path.parent / str(table["file"]), feet=(feet[0], feet[1]) if feet else None,
