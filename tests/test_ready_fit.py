@@ -156,6 +156,8 @@ def test_a_joint_out_of_range_walks_from_a_taller_posture(tmp_path: Path, capsys
 def test_a_written_robot_file_keeps_what_it_set_and_leaves_the_rest_derived(free_biped: Path, tmp_path: Path,
                                                                               capsys: pytest.CaptureFixture[str]
                                                                               ) -> None:
+    import json
+
     from zmpwalk.cli import main
 
     derived = tmp_path / "derived.toml"
@@ -164,6 +166,10 @@ def test_a_written_robot_file_keeps_what_it_set_and_leaves_the_rest_derived(free
     for name in ("ready_stretch", "pelvis_height", "dsp_time", "foot_lift", "lateral_velocity"):
         assert f"\n# {name} = " in text  # derived: commented out, so a walk may fit the posture
     assert load_robot(derived).plant.posture_set_by == ""  # type: ignore[union-attr]
+    capsys.readouterr()
+    assert main(["robot", str(free_biped), "--json"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    assert printed["ready_stretch"] == pytest.approx(READY_STRETCH, abs=1e-12) and printed["posture_set_by"] is None
     for field, value in (("ready_stretch", "0.86"), ("pelvis_height", "0.53")):
         given = write(tmp_path, f"{field}.toml", f'[model]\nfile = "{free_biped}"\n[posture]\n{field} = {value}\n'
                       "[walking]\ndsp_time = 0.07\n")
