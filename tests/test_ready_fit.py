@@ -223,3 +223,21 @@ def test_the_cli_walks_and_plans_from_the_fitted_posture(free_biped: Path, tmp_p
     assert main(["report", "--robot", str(free_biped), str(steps), "--out", str(tmp_path / "report"),
                  "--no-animation", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["ready_stretch"] == pytest.approx(0.9, abs=1e-12)
+
+
+def test_the_walk_from_a_fitted_posture_says_so_first_and_in_its_errors(hubo: RobotModel,
+                                                                        capsys: pytest.CaptureFixture[str]) -> None:
+    from zmpwalk.ready_fit import FittedWalk
+
+    spec = WalkSpec(hubo, LONG)
+    fitted = FittedWalk(spec, None, 0.88, 0.92, "left ankle out of reach")
+    words = r"^walking from a ready posture of hips 0\.88 .*robot's 0\.920.*: boom$"
+    with pytest.raises(ZmpwalkError, match=words), fitted.walking():
+        raise ZmpwalkError("boom")
+    assert capsys.readouterr().out.startswith("ready posture: hips 0.88 of the straight leg")
+    with fitted.walking(say=False):
+        pass
+    assert capsys.readouterr().out == ""
+    with pytest.raises(ZmpwalkError, match=r"^boom$"), FittedWalk(spec, None).walking():
+        raise ZmpwalkError("boom")  # the robot's own posture: nothing added
+    assert capsys.readouterr().out == ""

@@ -16,7 +16,8 @@ five-joint leg's sole roll are other parameters' (their errors name them), and a
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -58,12 +59,19 @@ class FittedWalk:
                 f"{self.spec.robot.pelvis_height:.4f} m), not the robot's {self.own_stretch:.3f}, which refuses "
                 f"this walk: {self.refusal}")
 
-    def in_context(self, error: ZmpwalkError) -> ZmpwalkError:
-        """``error`` of the walk, saying it walked from the fitted posture (as it is where it did not)."""
-        if self.stretch is None:
-            return error
-        return error.in_context(f"walking from a ready posture of hips {self.stretch:.2f} of the straight leg (the "
-                                f"robot's {self.own_stretch:.3f} refuses this walk)")
+    @contextmanager
+    def walking(self, say: bool = True) -> Iterator[None]:
+        """Around the walk from :attr:`spec`: the posture fitted is printed first (``say``), and an error of the
+        walk says it walked from it (nothing of either where the posture is the robot's own)."""
+        if self.stretch is not None and say:
+            print(self.words(), flush=True)  # before the walk, which may fail
+        try:
+            yield
+        except ZmpwalkError as error:
+            if self.stretch is None:
+                raise
+            raise error.in_context(f"walking from a ready posture of hips {self.stretch:.2f} of the straight leg "
+                                   f"(the robot's {self.own_stretch:.3f} refuses this walk)") from None
 
 
 def legs_refuse(error: ZmpwalkError) -> bool:

@@ -32,7 +32,6 @@ from zmpwalk.cli.options import (
     schedule_of,
 )
 from zmpwalk.cli.printing import json_safe, margin_words, print_verdict, progress
-from zmpwalk.errors import ZmpwalkError
 from zmpwalk.scenarios import load_scenario_with_labels, load_steps_file_with_labels
 
 NAMES = ("demo", "report")
@@ -106,17 +105,13 @@ def run(args: argparse.Namespace) -> int:
                                             balance=balance_of(args), latency=args.latency, motors=motors_of(args)),
                                    lambda stretch: load_robot_of(args, stretch))
         robot = fitted.spec.robot
-        if fitted.stretch is not None and not args.json:
-            print(fitted.words(), flush=True)  # before the walk, which may fail
-        try:
+        with fitted.walking(say=not args.json):
             report = build_report(robot, commands, args.out, title=f"zmpwalk: {robot.name}, {name}",
                                   generator=args.generator, animate=not args.no_animation,
                                   gif=args.gif and not args.no_animation,
                                   progress=None if quiet else progress, labels=labels,
                                   balance=balance_of(args), latency=args.latency, schedule=schedule_of(args),
                                   motors=motors_of(args), pelvis=pelvis_of(args), planned=fitted.planned)
-        except ZmpwalkError as error:
-            raise fitted.in_context(error) from None
     verdict = report.verdict
     if args.json:
         summary = {**report.summary, "index": str(report.index), "seconds": report.seconds,

@@ -32,7 +32,6 @@ from zmpwalk.cli.options import (
     walk_of,
 )
 from zmpwalk.cli.printing import cop_margin_words, json_safe, margin_words, print_verdict, progress
-from zmpwalk.errors import ZmpwalkError
 from zmpwalk.files import write_text
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.walk import WalkSpec
@@ -118,12 +117,8 @@ def run(args: argparse.Namespace) -> int:
     show = None if args.json or not sys.stderr.isatty() else progress
     fitted = fit_ready_posture(walk_spec(args, load_robot_of(args)), lambda stretch: load_robot_of(args, stretch))
     robot = fitted.spec.robot
-    if fitted.stretch is not None and not args.json:
-        print(fitted.words(), flush=True)  # before the walk, which may fail
-    try:
+    with fitted.walking(say=not args.json):
         walk = run_walk(fitted.spec, progress=show, planned=fitted.planned)
-    except ZmpwalkError as error:
-        raise fitted.in_context(error) from None
     result, verdict, rows, fits, correction = walk.result, walk.verdict, walk.rows, walk.fits, walk.correction
     summary = {**simulation_summary(result, verdict, rows, fits, correction), "balance": walk.spec.balance,
                "generator": walk.pattern.generator, "controller": walk.controller,
