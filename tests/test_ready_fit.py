@@ -241,3 +241,36 @@ def test_the_walk_from_a_fitted_posture_says_so_first_and_in_its_errors(hubo: Ro
     with pytest.raises(ZmpwalkError, match=r"^boom$"), FittedWalk(spec, None).walking():
         raise ZmpwalkError("boom")  # the robot's own posture: nothing added
     assert capsys.readouterr().out == ""
+
+
+def test_an_export_walks_from_the_fitted_posture_and_records_it(free_biped: Path, tmp_path: Path) -> None:
+    """``zmpwalk export`` fits the posture as ``simulate`` does: 0.315 m strides (0.39375 m/s at 0.8 s) start
+    from 0.90, the record and the clip's first frame say so."""
+    from zmpwalk.export.clips import Command
+    from zmpwalk.export.run import export_command
+
+    records = export_command(str(free_biped), Command(0.315 / 0.8, 0.0, 0.0, 0.8), str(tmp_path), 50.0, swings=3)
+    assert records and all(r.ready_stretch == pytest.approx(0.9, abs=1e-12) for r in records)
+    assert all(not r.error for r in records)
+    fitted = load_robot(free_biped, ready_stretch=0.9)
+    planned = next(r for r in records if r.kind == "planned" and r.span == "whole")
+    first = np.loadtxt(tmp_path / planned.files["csv"], delimiter=",", skiprows=1)[0]  # time, root x y z, ...
+    stood = load_robot(free_biped)
+    assert first[3] == pytest.approx(fitted.pelvis_height, abs=1e-5)  # [m] the base where the fitted posture has it
+    assert fitted.pelvis_height < stood.pelvis_height - 0.01  # [m] crouched below the robot's own posture
+
+
+def test_an_export_of_a_command_the_controller_refuses_writes_no_clip(tmp_path: Path) -> None:
+    """0.24 m strides (0.3 m/s at 0.8 s) take the +-25 deg ankles out of range from every posture: the walking
+    controller refuses the first step and the robot stands; that is an error record, not a clip of standing."""
+    from zmpwalk.export.clips import Command
+    from zmpwalk.export.run import export_command
+
+    path = write(tmp_path, "narrow.xml", biped(leg("l", 0.1, NARROW_ANKLE) + leg("r", -0.1, NARROW_ANKLE)))
+    out = tmp_path / "out"
+    out.mkdir()
+    records = export_command(str(path), Command(0.3, 0.0, 0.0, 0.8), str(out), 50.0, swings=3)
+    assert len(records) == 1 and not records[0].verified and records[0].frames == 0 and not records[0].files
+    assert records[0].error.startswith("step 1 of 3 refused by the walking controller: forward = 0.24")
+    assert "ankle_pitch" in records[0].error
+    assert not any(out.iterdir())

@@ -129,6 +129,14 @@ def fit_ready_posture(spec: WalkSpec, reload: Callable[[float], RobotModel]) -> 
     return FittedWalk(spec, planned)
 
 
+def fit_ready_posture_of(robot: str, spec: WalkSpec) -> FittedWalk:
+    """:func:`fit_ready_posture` for a robot given as ``--robot`` takes it (a name, robot file or model path: a
+    sweep's or an export's workers load it themselves), reloaded at each stretch tried."""
+    from zmpwalk.robots import load_robot
+
+    return fit_ready_posture(spec, lambda stretch: load_robot(robot, ready_stretch=stretch))
+
+
 def walk_from_other_posture(spec: WalkSpec, reload: Callable[[float], RobotModel],
                             refusal: ZmpwalkError) -> FittedWalk | None:
     """``spec``'s walk planned from the first of :func:`stretches_to_try` that plans it with every joint in its range

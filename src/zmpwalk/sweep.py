@@ -71,6 +71,7 @@ def walk_scenario(robot: str, scenario: str, balance: bool = True, generator: st
         schedule: A schedule file (e.g. from ``zmpwalk tune``) instead of Tables 2-3.
         pelvis: ``"cubic"`` or ``"quintic"`` (the polynomial generator's pelvis curves).
     """
+    from zmpwalk.ready_fit import fit_ready_posture_of
     from zmpwalk.scenarios import load_scenario_with_labels
     from zmpwalk.walk import WalkSpec, planned_walk, run_walk
 
@@ -85,13 +86,14 @@ def walk_scenario(robot: str, scenario: str, balance: bool = True, generator: st
 
         tables = Schedule.from_file(Path(schedule))
     try:
-        spec = WalkSpec(model, commands, labels, generator=generator, schedule=tables, pelvis=pelvis, balance=balance)
-        planned = planned_walk(spec)
+        fitted = fit_ready_posture_of(robot, WalkSpec(model, commands, labels, generator=generator, schedule=tables,
+                                                      pelvis=pelvis, balance=balance))
+        planned = fitted.planned or planned_walk(fitted.spec)  # a box model's: not planned by the fit
     except ZmpwalkError as error:  # this walk is not possible with this generator: a result, not a crash
         return SweepResult(scenario=scenario, robot=model.name, passed=False, failed=("planned",), fell=False,
                            distance=math.nan, cop_error_rms=math.nan, simulated=0.0,
                            seconds=time.perf_counter() - start, error=str(error))
-    walk = run_walk(spec, planned=planned)
+    walk = run_walk(fitted.spec, planned=planned)
     result, verdict = walk.result, walk.verdict
     rms, _ = result.cop_error_stats()
     return SweepResult(

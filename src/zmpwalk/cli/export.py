@@ -78,7 +78,9 @@ def run(args: argparse.Namespace) -> int:
         for c in result.clips:
             check = "ok" if c.verified else "FAILED"
             print(f"{c.name:<48} {c.verdict:<4} replay {check:<6} slide {1000 * c.replay.get('slide', math.nan):5.2f} "
-                  f"mm  penetration {1000 * c.replay.get('penetration', math.nan):5.2f} mm {c.error}")
+                  f"mm  penetration {1000 * c.replay.get('penetration', math.nan):5.2f} mm"
+                  + (f"  ready posture {c.ready_stretch:.2f} of the leg" if c.ready_stretch is not None else "")
+                  + (f"  {c.error}" if c.error else ""))
         print(f"{result.verified}/{len(result.clips)} clips verified, {result.seconds:.1f} s; manifest: "
               f"{result.manifest}")
     return 0 if not failed else EXIT_FAILED

@@ -111,6 +111,8 @@ class ClipRecord:
         cop_rms: RMS of the measured CoP against the reference ZMP [m].
         foot_slip: Largest slide of a loaded sole in the simulation [m].
         error: Why the command was not walked (no clip then), else empty.
+        ready_stretch: The ready posture the walk starts from, its hips' height above the ankles over the straight
+            leg [-], where fitted to the command (:func:`zmpwalk.ready_fit.fit_ready_posture`); None: the robot's own.
     """
 
     name: str
@@ -131,6 +133,7 @@ class ClipRecord:
     cop_rms: float = math.nan  # [m]
     foot_slip: float = math.nan  # [m]
     error: str = ""
+    ready_stretch: float | None = None  # [-]
 
 
 @dataclass
@@ -204,24 +207,31 @@ def _extras(result: SimulationResult, frames: int, fps: float, measured: bool) -
 def export_command(robot_spec: str, command: Command, out: str, fps: float, swings: int = SWINGS) -> list[ClipRecord]:
     """Walk one command (``swings`` swings of it) and write its four clips (simulated and planned, whole and
     cyclic) to ``out``."""
+    from zmpwalk.ready_fit import fit_ready_posture_of
     from zmpwalk.robots import loaded_robot
     from zmpwalk.sim.plant import build_plant
     from zmpwalk.sim.verdict import HOLD, cop_margin_outside_touchdowns, walk_verdict
+    from zmpwalk.walk import WalkSpec
 
-    robot, stem = loaded_robot(robot_spec), command.name()
-    described = asdict(command)
+    stem, described = command.name(), asdict(command)
     try:
         step, count = _step(robot_spec, command, swings)
+        fitted = fit_ready_posture_of(robot_spec, WalkSpec(loaded_robot(robot_spec), [step] * count))
+        robot = fitted.spec.robot
         run, simulated, planned = walk_clips(robot, step, count, fps)
     except ZmpwalkError as error:
         return [ClipRecord(stem, described, "simulated", "whole", error=str(error))]
+    if run.rejections:  # the walk stood where it was refused: no clip of this command
+        index, _, rejection = run.rejections[0]
+        return [ClipRecord(stem, described, "simulated", "whole", ready_stretch=fitted.stretch,
+                           error=f"step {index + 1} of {count} refused by the walking controller: {rejection}")]
     result = run.result
     described["step_time"] = step.duration
     stem = replace(command, step_time=step.duration).name()
     verdict = walk_verdict(result, HOLD)
     walk = ClipRecord(stem, described, "simulated", "whole", verdict=verdict.state, failed=verdict.failed,
                       zmp_margin=result.plan_zmp_margin, cop_margin=cop_margin_outside_touchdowns(result),
-                      cop_rms=result.cop_error_stats()[0], foot_slip=result.foot_slip)
+                      cop_rms=result.cop_error_stats()[0], foot_slip=result.foot_slip, ready_stretch=fitted.stretch)
     model = build_plant(robot).model
     records = []
     for clip in (simulated, planned):
