@@ -20,7 +20,7 @@ from zmpwalk.patterns.polynomial import generate
 from zmpwalk.robots import load_robot
 from zmpwalk.robots.description import PD_BANDWIDTH, PD_LOAD_STIFFNESS
 from zmpwalk.robots.inspect import robot_summary, robot_toml
-from zmpwalk.robots.pd import check_load_stiffness, pd_gains
+from zmpwalk.robots.pd import check_load_stiffness, pd_gains, pd_physics_step
 from zmpwalk.sim.plant import build_plant, servo_offsets, servo_torques
 from zmpwalk.sim.poses import plant_qpos, set_initial_state
 
@@ -81,6 +81,20 @@ def test_the_rule_bandwidth_load_and_step_bound() -> None:
     assert kv * 0.001 / 1e-4 == pytest.approx(1.0, rel=1e-12)  # kv dt / I = 2 zeta beta, half the bound 2
     with pytest.raises(InvalidParameterError, match="inertia"):
         pd_gains(0.0, 1.0)
+
+
+def test_the_physics_step_shortens_only_where_the_bound_holds_a_leg_joint_below_its_weight_moment() -> None:
+    """``pd_physics_step``: a leg joint the 1 ms bound ``I (0.5 / dt)^2`` holds below ``W = m g l`` (a URDF's ankle
+    roll, 0.0004 kg m^2, no rotor: 100 N m/rad against 235 N m) shortens the step to the quarter at which it
+    reaches ``kappa W`` (0.25 ms: 1600 >= 940 N m/rad; at 0.5 ms 400 does not); a joint the bound holds above ``W``
+    but below ``kappa W`` (TALOS's ankle rolls: 3.2 W) keeps 1 ms."""
+    assert pd_physics_step([(0.0004, 235.0)], 0.001) == pytest.approx(0.00025, abs=1e-15)  # [s]
+    kp, _ = pd_gains(0.0004, 235.0, 0.00025)
+    assert kp == pytest.approx(4 * 235.0, rel=1e-12)  # [N m/rad] the rule's kappa W, no longer the bound
+    assert pd_gains(0.0004, 235.0, 0.001)[0] == pytest.approx(100.0, rel=1e-12)  # [N m/rad] the bound at 1 ms
+    assert pd_physics_step([(0.0079, 600.0), (0.1, 600.0)], 0.001) == pytest.approx(0.001, abs=1e-15)
+    assert pd_physics_step([(0.0004, 190.0)], 0.001, 2.0) == pytest.approx(0.0005, abs=1e-15)  # 400 >= 380 N m/rad
+    assert pd_physics_step([(1e-7, 235.0)], 0.001) == pytest.approx(0.00025, abs=1e-15)  # no step suffices: the least
 
 
 def test_motor_legs_get_the_rule_gains_and_their_limits(tmp_path: Path) -> None:

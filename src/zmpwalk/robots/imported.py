@@ -257,10 +257,11 @@ def _with_pd_layer(model: Any, data: Any, qpos: Array, plant: ModelPlant, leg_jo
 
     coupled = coupled_joints(model, leg_joint_set)
     load_stiffness = check_load_stiffness(values.get("load_stiffness", PD_LOAD_STIFFNESS))
-    pd_joints = pd_layer(model, data, qpos, leg_joint_set, moment, pd_gains, coupled, load_stiffness)
+    pd_joints, physics_step = pd_layer(model, data, qpos, leg_joint_set, moment, pd_gains, coupled, load_stiffness)
     leg_joints = _driven_joints(leg_joints, dict(pd_joints), geometry, values.get("sole_roll_limit"), source)
     names = {j: element_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in coupled}
-    plant = replace(plant, joints=tuple(leg_joints), pd_joints=pd_joints, load_stiffness=load_stiffness,
+    plant = replace(plant, joints=tuple(leg_joints), pd_joints=pd_joints, physics_step=physics_step,
+                    load_stiffness=load_stiffness,
                     pd_given=tuple(sorted(pd_gains)), coupled_joints=tuple(sorted(names.values())),
                     held_joints=tuple(n for n in plant.held_joints if n not in names.values()))
     return plant, leg_joints

@@ -15,6 +15,8 @@ from zmpwalk.robots.description import (
     PD_BANDWIDTH,
     PD_DAMPING_RATIO,
     PD_LOAD_STIFFNESS,
+    PD_STEP_LIMIT,
+    PHYSICS_STEP,
     Actuator,
 )
 from zmpwalk.robots.model import RobotModel
@@ -55,6 +57,7 @@ def robot_summary(robot: RobotModel, statics: StaticTorques | None = None) -> di
         summary["feet"] = list(plant.feet)
         summary["keyframe"] = plant.keyframe
         summary["ready_stretch"] = plant.ready_stretch  # [-] hip-to-ankle distance over the straight leg
+        summary["physics_step"] = plant.physics_step  # [s] the simulation's step, the PD layer's period
         summary["posture_set_by"] = plant.posture_set_by or None
         summary["held_joints"] = list(plant.held_joints)
         summary["coupled_joints"] = list(plant.coupled_joints)
@@ -149,8 +152,12 @@ def robot_table(robot: RobotModel, statics: StaticTorques | None = None) -> str:
         lines += _joint_lines(s["joints"], statics)
         if any(joint["actuator"] and joint["actuator"]["pd_layer"] for joint in s["joints"]) or s["pd_joints"]:
             kappa = robot.plant.load_stiffness if robot.plant is not None else PD_LOAD_STIFFNESS
-            lines.append(f"PD layer (the firmware's joint loop, run at the physics step, clipped at 'max'): kp = "
-                         f"max(I w^2, {kappa:g} W) with w = 2 pi x {PD_BANDWIDTH / (2 * math.pi):g} Hz, "
+            step = robot.plant.physics_step if robot.plant is not None else PHYSICS_STEP
+            shortened = (f", shortened from {PHYSICS_STEP * 1e3:g} ms: at that step the bound held a leg joint below "
+                         "W" if step < PHYSICS_STEP * (1 - 1e-9) else "")
+            lines.append(f"PD layer (the firmware's joint loop, run at the physics step dt = {step * 1e3:g} ms"
+                         f"{shortened}; clipped at 'max'): kp = min(max(I w^2, {kappa:g} W), I ({PD_STEP_LIMIT:g} / "
+                         f"dt)^2) with w = 2 pi x {PD_BANDWIDTH / (2 * math.pi):g} Hz, "
                          f"W = m g l = {robot.mass * robot.gravity * robot.pendulum_length:.1f} N m for a leg joint; "
                          f"kv = 2 x {PD_DAMPING_RATIO:g} sqrt(kp I); I [kg m^2] its reflected inertia "
                          "(docs/robot-import.md), or the robot file's [pd]")

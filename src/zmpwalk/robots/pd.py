@@ -20,6 +20,7 @@ from zmpwalk.robots.description import (
     PD_PREFIX,
     PD_STEP_LIMIT,
     PHYSICS_STEP,
+    PHYSICS_SUBSTEPS,
     Actuator,
 )
 
@@ -125,10 +126,13 @@ def pd_gains(inertia: float, moment: float, timestep: float = PHYSICS_STEP,
         raise InvalidParameterError("timestep", timestep, "a physics step > 0 s")
     if not moment >= 0:
         raise InvalidParameterError("moment", moment, "a weight moment >= 0 N m")
-    kappa = check_load_stiffness(load_stiffness)
-    kp = max(inertia * PD_BANDWIDTH ** 2, kappa * moment)
-    kp = min(kp, inertia * (PD_STEP_LIMIT / timestep) ** 2)
+    kp = min(rule_stiffness(inertia, moment, load_stiffness), inertia * (PD_STEP_LIMIT / timestep) ** 2)
     return kp, 2.0 * PD_DAMPING_RATIO * math.sqrt(kp * inertia)
+
+
+def rule_stiffness(inertia: float, moment: float, load_stiffness: float = PD_LOAD_STIFFNESS) -> float:
+    """The rule's ``kp = max(I omega^2, kappa W)`` [N m/rad] before the discrete bound (:func:`pd_gains`)."""
+    return max(inertia * PD_BANDWIDTH ** 2, check_load_stiffness(load_stiffness) * moment)
 
 
 def check_load_stiffness(load_stiffness: object) -> float:
@@ -178,15 +182,39 @@ def coupled_joints(model: Any, leg_joints: set[int]) -> frozenset[int]:
     return frozenset(coupled)
 
 
+def pd_physics_step(leg_joints: list[tuple[float, float]], timestep: float,
+                    load_stiffness: float = PD_LOAD_STIFFNESS) -> float:
+    """The PD layer's period [s]: ``timestep``, or where the discrete bound ``I (beta / dt)^2`` of
+    :func:`pd_gains` would hold a leg joint below the weight moment ``W = m g l`` it holds per radian (the joint
+    then softer than the robot toppling over it: a URDF's ankles, which carry no rotor inertia), the longest of
+    ``timestep`` over :data:`PHYSICS_SUBSTEPS` at which every leg joint reaches the rule's ``kp``, else the
+    shortest.
+
+    Args:
+        leg_joints: Each leg joint the layer drives: (reflected inertia ``I`` [kg m^2], weight moment ``W`` [N m]).
+        timestep: The model's physics step, at most :data:`PHYSICS_STEP` [s].
+        load_stiffness: ``kappa`` [-].
+    """
+    if all(inertia * (PD_STEP_LIMIT / timestep) ** 2 >= moment for inertia, moment in leg_joints):
+        return timestep
+    for count in PHYSICS_SUBSTEPS:
+        step = timestep / count
+        if all(inertia * (PD_STEP_LIMIT / step) ** 2 >= rule_stiffness(inertia, moment, load_stiffness)
+               for inertia, moment in leg_joints):
+            return step
+    return timestep / PHYSICS_SUBSTEPS[-1]
+
+
 def pd_layer(model: Any, data: Any, qpos: Array, leg_joints: set[int], leg_moment: float,
-              given: dict[str, tuple[float, float | None]], coupled: frozenset[int] = frozenset(),
-              load_stiffness: float = PD_LOAD_STIFFNESS) -> tuple[tuple[str, Actuator], ...]:
+             given: dict[str, tuple[float, float | None]], coupled: frozenset[int] = frozenset(),
+             load_stiffness: float = PD_LOAD_STIFFNESS) -> tuple[tuple[tuple[str, Actuator], ...], float]:
     """The joints the PD layer drives, with their actuators (gains from :func:`pd_gains` at the posture ``qpos``,
     or ``given``: joint name -> (kp, kv or None for critical damping)): every torque motor on a hinge or slide,
     every leg joint without an actuator, and every joint of a model without actuators (a URDF), but the
     ``coupled`` joints (moved by a leg joint through a joint equality: :func:`coupled_joints`). A leg joint holds
     ``leg_moment`` [N m]; another hinge the weight of what it moves (:func:`_weight_moment`); a slide nothing;
-    ``load_stiffness`` is the rule's ``kappa``.
+    ``load_stiffness`` is the rule's ``kappa``. With them the layer's period, the physics step
+    (:func:`pd_physics_step`) [s].
 
     Raises:
         InvalidParameterError: ``given`` names a joint the layer does not drive, a leg joint's torque
@@ -198,8 +226,7 @@ def pd_layer(model: Any, data: Any, qpos: Array, leg_joints: set[int], leg_momen
     mujoco.mj_forward(model, data)
     inertia = np.zeros((model.nv, model.nv))
     mujoco.mj_fullM(model, data, inertia)
-    timestep = min(float(model.opt.timestep), PHYSICS_STEP)
-    layer = []
+    driven = []
     for j in range(model.njnt):
         hinge = int(model.jnt_type[j]) == mujoco.mjtJoint.mjJNT_HINGE  # a numpy integer is never `in` enums
         if not hinge and int(model.jnt_type[j]) != mujoco.mjtJoint.mjJNT_SLIDE:
@@ -219,14 +246,18 @@ def pd_layer(model: Any, data: Any, qpos: Array, leg_joints: set[int], leg_momen
             continue  # the model holds it passive
         dof = int(model.jnt_dofadr[j])
         moment = leg_moment if j in leg_joints else _weight_moment(model, data, j) if hinge else 0.0
-        reflected = float(inertia[dof, dof])
+        driven.append((name, existing, float(inertia[dof, dof]), moment, j in leg_joints))
+    unknown = sorted(set(given) - {name for name, *_ in driven})
+    if unknown:
+        raise InvalidParameterError("pd joint", unknown[0], "a joint the PD layer drives (a torque motor's or an "
+                                    "unactuated leg joint): " + ", ".join(name for name, *_ in driven))
+    timestep = pd_physics_step([(i, w) for name, _, i, w, leg in driven if leg and name not in given],
+                               min(float(model.opt.timestep), PHYSICS_STEP), load_stiffness)
+    layer = []
+    for name, existing, reflected, moment, _ in driven:
         kp, kv = pd_gains(reflected, moment, timestep, load_stiffness)
         if name in given:
             kp, wanted = given[name]
             kv = 2.0 * PD_DAMPING_RATIO * math.sqrt(kp * reflected) if wanted is None else wanted
         layer.append((name, replace(existing, kp=kp, kv=kv, pd_layer=True, inertia=reflected)))
-    unknown = sorted(set(given) - {name for name, _ in layer})
-    if unknown:
-        raise InvalidParameterError("pd joint", unknown[0], "a joint the PD layer drives (a torque motor's or an "
-                                    "unactuated leg joint): " + ", ".join(name for name, _ in layer))
-    return tuple(layer)
+    return tuple(layer), timestep

@@ -8,7 +8,8 @@ model, unmodified in its meshes, masses, inertias, contacts and actuators, with:
 * sensors added where zmpwalk measures, as on the robot: a force-torque sensor at each ankle point
   (a site in the foot body, axes of the foot frame), the pose of the base and of each ankle, and each
   leg joint's angle, rate and actuator torque (``jointactuatorfrc``);
-* a time step of at most :data:`MAX_TIMESTEP` (the 1 kHz servo period of the references);
+* a time step of at most the robot's ``physics_step`` (:data:`MAX_TIMESTEP`, the 1 kHz servo period of the
+  references, or a half or a quarter of it: :func:`zmpwalk.robots.pd.pd_physics_step`);
 * the joint PD layer a humanoid's firmware runs, where the model has torque motors or no actuators
   (:func:`add_pd_layer`);
 * no control range on its position servos (:func:`lift_control_ranges`): the control carries the target angle
@@ -116,8 +117,8 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
     plant = robot.plant
     spec = load_model_spec(plant.path, plant.package_paths)
     model = spec.compile()
-    if model.opt.timestep > MAX_TIMESTEP:
-        spec.option.timestep = MAX_TIMESTEP
+    if model.opt.timestep > plant.physics_step:  # the PD layer's period (robots.pd.pd_physics_step)
+        spec.option.timestep = plant.physics_step
     if not any(g.type == mujoco.mjtGeom.mjGEOM_PLANE for g in spec.worldbody.geoms):
         spec.worldbody.add_geom(name="zmpwalk_floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 0.05])
     for index, actuator in enumerate(spec.actuators):  # the names the robot gives them (robots.pd.element_name)
