@@ -20,7 +20,7 @@ from zmpwalk.patterns.polynomial import generate
 from zmpwalk.robots import load_robot
 from zmpwalk.robots.description import PD_BANDWIDTH, PD_LOAD_STIFFNESS
 from zmpwalk.robots.inspect import robot_summary, robot_toml
-from zmpwalk.robots.pd import check_load_stiffness, pd_gains, pd_physics_step
+from zmpwalk.robots.pd import check_load_stiffness, pd_gains, pd_physics_step, rule_stiffness
 from zmpwalk.sim.plant import build_plant, servo_offsets, servo_torques
 from zmpwalk.sim.poses import plant_qpos, set_initial_state
 
@@ -87,14 +87,17 @@ def test_the_physics_step_shortens_only_where_the_bound_holds_a_leg_joint_below_
     """``pd_physics_step``: a leg joint the 1 ms bound ``I (0.5 / dt)^2`` holds below ``W = m g l`` (a URDF's ankle
     roll, 0.0004 kg m^2, no rotor: 100 N m/rad against 235 N m) shortens the step to the quarter at which it
     reaches ``kappa W`` (0.25 ms: 1600 >= 940 N m/rad; at 0.5 ms 400 does not); a joint the bound holds above ``W``
-    but below ``kappa W`` (TALOS's ankle rolls: 3.2 W) keeps 1 ms."""
-    assert pd_physics_step([(0.0004, 235.0)], 0.001) == pytest.approx(0.00025, abs=1e-15)  # [s]
-    kp, _ = pd_gains(0.0004, 235.0, 0.00025)
-    assert kp == pytest.approx(4 * 235.0, rel=1e-12)  # [N m/rad] the rule's kappa W, no longer the bound
+    but below ``kappa W`` (TALOS's ankle rolls: 3.2 W) keeps 1 ms; a robot file's ``kp`` is the stiffness needed."""
+    needed = rule_stiffness(0.0004, 235.0)
+    assert needed == pytest.approx(940.0, rel=1e-12)  # [N m/rad] kappa W
+    assert pd_physics_step([(0.0004, 235.0, needed)], 0.001) == pytest.approx(0.00025, abs=1e-15)  # [s]
+    assert pd_gains(0.0004, 235.0, 0.00025)[0] == pytest.approx(needed, rel=1e-12)  # the rule's, not the bound
     assert pd_gains(0.0004, 235.0, 0.001)[0] == pytest.approx(100.0, rel=1e-12)  # [N m/rad] the bound at 1 ms
-    assert pd_physics_step([(0.0079, 600.0), (0.1, 600.0)], 0.001) == pytest.approx(0.001, abs=1e-15)
-    assert pd_physics_step([(0.0004, 190.0)], 0.001, 2.0) == pytest.approx(0.0005, abs=1e-15)  # 400 >= 380 N m/rad
-    assert pd_physics_step([(1e-7, 235.0)], 0.001) == pytest.approx(0.00025, abs=1e-15)  # no step suffices: the least
+    talos = (0.0104, 824.8, rule_stiffness(0.0104, 824.8))  # [kg m^2], [N m], [N m/rad]
+    assert pd_physics_step([talos, (0.1, 824.8, 3299.2)], 0.001) == pytest.approx(0.001, abs=1e-15)
+    assert pd_physics_step([(0.0004, 190.0, 380.0)], 0.001) == pytest.approx(0.0005, abs=1e-15)  # 400 >= 380
+    assert pd_physics_step([(0.0004, 235.0, 300.0)], 0.0005) == pytest.approx(0.0005, abs=1e-15)  # 400 >= 235
+    assert pd_physics_step([(1e-7, 235.0, 940.0)], 0.001) == pytest.approx(0.00025, abs=1e-15)  # none fits: the least
 
 
 def test_motor_legs_get_the_rule_gains_and_their_limits(tmp_path: Path) -> None:
@@ -310,8 +313,9 @@ def box(mass: float, x: float, y: float, z: float) -> tuple[float, float, float]
 EFFORT = 60.0  # [N m] every joint's <limit effort> in the URDF
 
 
-def urdf_biped() -> str:
-    """An 18.6 kg URDF biped with no actuators: a torso, 6-joint legs with masses and inertias, box feet."""
+def urdf_biped(foot_mass: float = 0.6) -> str:
+    """An 18.6 kg URDF biped with no actuators: a torso, 6-joint legs with masses and inertias, box feet of
+    ``foot_mass`` [kg]."""
     parts = ['<robot name="urdf_biped">', f'<link name="torso">{inertial(10.0, "0 0 0.1", box(10.0, 0.2, 0.3, 0.3))}'
              "</link>"]
     for side, y in (("l", 0.1), ("r", -0.1)):
@@ -322,7 +326,8 @@ def urdf_biped() -> str:
                 ("hip_pitch", "0 1 0", "0 0 0", -1.6, 1.0, 1.5, "0 0 -0.15", box(1.5, 0.06, 0.06, 0.3)),
                 ("knee", "0 1 0", "0 0 -0.3", 0.0, 2.4, 1.0, "0 0 -0.15", box(1.0, 0.05, 0.05, 0.3)),
                 ("ankle_pitch", "0 1 0", "0 0 -0.3", -1.0, 1.0, 0.2, "0 0 0", (2e-4, 2e-4, 2e-4)),
-                ("ankle_roll", "1 0 0", "0 0 0", -0.5, 0.5, 0.6, "0.02 0 -0.05", box(0.6, 0.22, 0.14, 0.02))):
+                ("ankle_roll", "1 0 0", "0 0 0", -0.5, 0.5, foot_mass, "0.02 0 -0.05",
+                 box(foot_mass, 0.22, 0.14, 0.02))):
             link = f"{side}_{name}_link"
             sole = ('<collision><origin xyz="0.02 0 -0.05"/><geometry><box size="0.22 0.14 0.02"/></geometry>'
                     "</collision>") if name == "ankle_roll" else ""
@@ -448,3 +453,33 @@ def test_the_feedforward_carries_the_joints_own_damping_and_friction(tmp_path: P
         batch[name] = torques_batch[10, plant.leg_actuators[3]]  # [N m] a middle sample (central differences)
     assert batch["lossy"] - batch["plain"] == pytest.approx(1.9 * 1.0 + 3.0 * math.tanh(1.0 / FRICTION_RATE),
                                                             abs=1e-9)
+
+
+def test_a_urdfs_light_feet_shorten_the_physics_step_to_hold_them(tmp_path: Path,
+                                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    """Feet of 50 g (no rotor inertia, as a URDF gives them): at 1 ms the bound would hold the ankle rolls below
+    ``m g l``; the simulation runs at 0.25 ms (four steps a 1 kHz tick) and they get the rule's ``kappa W``. The
+    same gains given in a robot file keep that step."""
+    from zmpwalk.cli import main
+    from zmpwalk.sim.plant import build_plant
+
+    urdf = write(tmp_path, "light.urdf", urdf_biped(foot_mass=0.05))
+    robot = load_robot(urdf)
+    assert robot.plant is not None
+    weight_moment = robot.mass * robot.gravity * robot.pendulum_length  # [N m]
+    roll = next(j for j in robot.plant.joints if j.role == "ankle_roll")
+    assert roll.actuator is not None and roll.actuator.inertia * (0.5 / 0.001) ** 2 < weight_moment
+    assert robot.plant.model_step == pytest.approx(0.001, abs=1e-15)
+    assert robot.plant.physics_step == pytest.approx(0.00025, abs=1e-15)  # [s]
+    assert roll.actuator.kp == pytest.approx(4.0 * weight_moment, rel=1e-9)  # [N m/rad] the rule, not the bound
+    assert build_plant(robot).model.opt.timestep == pytest.approx(0.00025, abs=1e-15)
+    assert main(["robot", str(urdf)]) == 0
+    assert "dt = 0.25 ms, shortened from the model's 1 ms" in capsys.readouterr().out
+    gains = "".join(f'"{j.name}" = {{kp = {j.actuator.kp!r}, kv = {j.actuator.kv!r}}}\n'
+                    for j in robot.plant.joints if j.actuator is not None and j.actuator.pd_layer)
+    given = load_robot(write(tmp_path, "light.toml", f'[model]\nfile = "{urdf}"\n[pd]\n{gains}'))
+    assert given.plant is not None and given.plant.physics_step == pytest.approx(0.00025, abs=1e-15)
+    heavy = load_robot(write(tmp_path, "heavy.urdf", urdf_biped()))
+    assert heavy.plant is not None and heavy.plant.physics_step == pytest.approx(0.001, abs=1e-15)
+    assert main(["robot", str(write(tmp_path, "heavy2.urdf", urdf_biped()))]) == 0
+    assert "dt = 1 ms;" in capsys.readouterr().out

@@ -271,6 +271,6 @@ def test_an_export_of_a_command_the_controller_refuses_writes_no_clip(tmp_path: 
     out.mkdir()
     records = export_command(str(path), Command(0.3, 0.0, 0.0, 0.8), str(out), 50.0, swings=3)
     assert len(records) == 1 and not records[0].verified and records[0].frames == 0 and not records[0].files
-    assert records[0].error.startswith("step 1 of 3 refused by the walking controller: forward = 0.24")
+    assert records[0].error.startswith("step 1 of 3, refused by the walking controller: forward = 0.24")
     assert "ankle_pitch" in records[0].error
     assert not any(out.iterdir())

@@ -88,12 +88,13 @@ def walk_scenario(robot: str, scenario: str, balance: bool = True, generator: st
     try:
         fitted = fit_ready_posture_of(robot, WalkSpec(model, commands, labels, generator=generator, schedule=tables,
                                                       pelvis=pelvis, balance=balance))
-        planned = fitted.planned or planned_walk(fitted.spec)  # a box model's: not planned by the fit
+        planned = fitted.planned or planned_walk(fitted.spec)  # a box model's or a posture a file sets: not planned
     except ZmpwalkError as error:  # this walk is not possible with this generator: a result, not a crash
         return SweepResult(scenario=scenario, robot=model.name, passed=False, failed=("planned",), fell=False,
                            distance=math.nan, cop_error_rms=math.nan, simulated=0.0,
                            seconds=time.perf_counter() - start, error=str(error))
-    walk = run_walk(fitted.spec, planned=planned)
+    with fitted.walking(say=False):  # an error of the walk says which posture it walked from
+        walk = run_walk(fitted.spec, planned=planned)
     result, verdict = walk.result, walk.verdict
     rms, _ = result.cop_error_stats()
     return SweepResult(

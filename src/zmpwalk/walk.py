@@ -370,9 +370,7 @@ def _controller_walk(spec: WalkSpec, progress: Callable[[float], None] | None) -
                                    capture=spec.capture, clock=simulated_clock(CONTROL_RATE))
     run = simulate_controller(spec.robot, spec.commands, controller=controller, plant=plant, hold=spec.hold,
                               settle=spec.settle, progress=progress)
-    if run.rejections:
-        index, _, error = run.rejections[0]
-        label = spec.labels[index] if spec.labels is not None and index < len(spec.labels) else f"step {index + 1}"
-        error = error.in_context(f"{spec.source}: {label}" if spec.source else label)
-        raise error
+    refusal = run.refusal(spec.labels, spec.source)
+    if refusal is not None:
+        raise refusal
     return run.result

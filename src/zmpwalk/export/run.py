@@ -217,14 +217,18 @@ def export_command(robot_spec: str, command: Command, out: str, fps: float, swin
     try:
         step, count = _step(robot_spec, command, swings)
         fitted = fit_ready_posture_of(robot_spec, WalkSpec(loaded_robot(robot_spec), [step] * count))
-        robot = fitted.spec.robot
-        run, simulated, planned = walk_clips(robot, step, count, fps)
     except ZmpwalkError as error:
         return [ClipRecord(stem, described, "simulated", "whole", error=str(error))]
-    if run.rejections:  # the walk stood where it was refused: no clip of this command
-        index, _, rejection = run.rejections[0]
-        return [ClipRecord(stem, described, "simulated", "whole", ready_stretch=fitted.stretch,
-                           error=f"step {index + 1} of {count} refused by the walking controller: {rejection}")]
+    robot = fitted.spec.robot
+    try:
+        with fitted.walking(say=False):
+            run, simulated, planned = walk_clips(robot, step, count, fps)
+            refusal = run.refusal([f"step {i + 1} of {count}, refused by the walking controller"
+                                   for i in range(count)])
+            if refusal is not None:  # the robot stood where it was refused: no clip of this command
+                raise refusal
+    except ZmpwalkError as error:
+        return [ClipRecord(stem, described, "simulated", "whole", ready_stretch=fitted.stretch, error=str(error))]
     result = run.result
     described["step_time"] = step.duration
     stem = replace(command, step_time=step.duration).name()

@@ -14,8 +14,8 @@ from numpy.typing import NDArray
 Array = NDArray[np.float64]
 
 
-PHYSICS_STEP = 0.001  # [s] the simulation's physics step at most (zmpwalk.sim.plant), the PD layer's period
-PHYSICS_SUBSTEPS = (1, 2, 4)  # [-] PHYSICS_STEP over these: the steps the PD layer may shorten it to (robots.pd)
+PHYSICS_STEP = 0.001  # [s] the simulation's physics step at most (zmpwalk.sim.plant), the PD layer's period at most
+PHYSICS_SUBSTEPS = (1, 2, 4)  # [-] the model's step (at most PHYSICS_STEP) over these: the PD layer's periods
 
 
 HUBO_FOOT_LIFT = 0.04  # [m] HUBO's foot lift, scaled by the leg length for another robot
@@ -119,9 +119,10 @@ class ModelPlant:
         rest_mass: Mass of everything but the leg segments (rigid with the base) [kg].
         rest_com: Its centre of mass in the pelvis frame [m].
         pd_joints: Every joint driven by the joint PD layer, leg joints included: (joint name, its actuator).
-        physics_step: The simulation's physics step, the PD layer's period [s]: :data:`PHYSICS_STEP`, or a half or
+        physics_step: The simulation's physics step, the PD layer's period [s]: :attr:`model_step`, or a half or
             a quarter of it where the layer's discrete bound would hold a leg joint below the robot's ``m g l``
             (:func:`zmpwalk.robots.pd.pd_physics_step`).
+        model_step: The model's own physics step, at most :data:`PHYSICS_STEP` [s].
         load_stiffness: The PD layer's ``kappa`` [-] (:func:`~zmpwalk.robots.pd.pd_gains`) its gains were derived
             with.
         pd_given: The joints whose PD gains the robot file gives (names), not derived.
@@ -147,6 +148,7 @@ class ModelPlant:
     rest_com: tuple[float, float, float] = (0.0, 0.0, 0.0)  # [m]
     pd_joints: tuple[tuple[str, Actuator], ...] = ()
     physics_step: float = PHYSICS_STEP  # [s]
+    model_step: float = PHYSICS_STEP  # [s]
     load_stiffness: float = PD_LOAD_STIFFNESS  # [-]
     pd_given: tuple[str, ...] = ()
     root_body: str = ""

@@ -76,7 +76,7 @@ from zmpwalk.robots.description import (
 )
 from zmpwalk.robots.legs import VIRTUAL_PREFIX, FootAtReference, Segments, build_leg, leg_joint_ids, segments
 from zmpwalk.robots.model import RobotModel, schedule_scale
-from zmpwalk.robots.pd import check_load_stiffness, coupled_joints, element_name, pd_layer
+from zmpwalk.robots.pd import check_load_stiffness, coupled_joints, element_name, model_physics_step, pd_layer
 from zmpwalk.robots.posture import hip_to_ankle, posture_set_by, ready_posture, reference_reach
 from zmpwalk.robots.tree import (
     base_mount,
@@ -261,6 +261,7 @@ def _with_pd_layer(model: Any, data: Any, qpos: Array, plant: ModelPlant, leg_jo
     leg_joints = _driven_joints(leg_joints, dict(pd_joints), geometry, values.get("sole_roll_limit"), source)
     names = {j: element_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in coupled}
     plant = replace(plant, joints=tuple(leg_joints), pd_joints=pd_joints, physics_step=physics_step,
+                    model_step=model_physics_step(model),
                     load_stiffness=load_stiffness,
                     pd_given=tuple(sorted(pd_gains)), coupled_joints=tuple(sorted(names.values())),
                     held_joints=tuple(n for n in plant.held_joints if n not in names.values()))

@@ -182,26 +182,32 @@ def coupled_joints(model: Any, leg_joints: set[int]) -> frozenset[int]:
     return frozenset(coupled)
 
 
-def pd_physics_step(leg_joints: list[tuple[float, float]], timestep: float,
-                    load_stiffness: float = PD_LOAD_STIFFNESS) -> float:
+def model_physics_step(model: Any) -> float:
+    """The model's own physics step, at most :data:`PHYSICS_STEP` [s]: the step the simulation starts from."""
+    return min(float(model.opt.timestep), PHYSICS_STEP)
+
+
+def pd_physics_step(leg_joints: list[tuple[float, float, float]], timestep: float) -> float:
     """The PD layer's period [s]: ``timestep``, or where the discrete bound ``I (beta / dt)^2`` of
-    :func:`pd_gains` would hold a leg joint below the weight moment ``W = m g l`` it holds per radian (the joint
-    then softer than the robot toppling over it: a URDF's ankles, which carry no rotor inertia), the longest of
-    ``timestep`` over :data:`PHYSICS_SUBSTEPS` at which every leg joint reaches the rule's ``kp``, else the
-    shortest.
+    :func:`pd_gains` would hold a leg joint below its weight moment ``W = m g l`` per radian (the joint then softer
+    than the robot toppling over it: a URDF's ankles, which carry no rotor inertia), the longest of ``timestep``
+    over :data:`PHYSICS_SUBSTEPS` at which every leg joint's bound reaches the stiffness it needs, else the shortest
+    of them.
 
     Args:
-        leg_joints: Each leg joint the layer drives: (reflected inertia ``I`` [kg m^2], weight moment ``W`` [N m]).
+        leg_joints: Each leg joint the layer drives: reflected inertia ``I`` [kg m^2], weight moment ``W`` [N m]
+            and the stiffness it needs [N m/rad] (the rule's ``max(I omega^2, kappa W)``, or a robot file's
+            ``kp``).
         timestep: The model's physics step, at most :data:`PHYSICS_STEP` [s].
-        load_stiffness: ``kappa`` [-].
     """
-    if all(inertia * (PD_STEP_LIMIT / timestep) ** 2 >= moment for inertia, moment in leg_joints):
+    def bound(inertia: float, step: float) -> float:
+        return inertia * (PD_STEP_LIMIT / step) ** 2
+
+    if all(bound(inertia, timestep) >= min(moment, needed) for inertia, moment, needed in leg_joints):
         return timestep
     for count in PHYSICS_SUBSTEPS:
-        step = timestep / count
-        if all(inertia * (PD_STEP_LIMIT / step) ** 2 >= rule_stiffness(inertia, moment, load_stiffness)
-               for inertia, moment in leg_joints):
-            return step
+        if all(bound(inertia, timestep / count) >= needed for inertia, _, needed in leg_joints):
+            return timestep / count
     return timestep / PHYSICS_SUBSTEPS[-1]
 
 
@@ -251,8 +257,8 @@ def pd_layer(model: Any, data: Any, qpos: Array, leg_joints: set[int], leg_momen
     if unknown:
         raise InvalidParameterError("pd joint", unknown[0], "a joint the PD layer drives (a torque motor's or an "
                                     "unactuated leg joint): " + ", ".join(name for name, *_ in driven))
-    timestep = pd_physics_step([(i, w) for name, _, i, w, leg in driven if leg and name not in given],
-                               min(float(model.opt.timestep), PHYSICS_STEP), load_stiffness)
+    timestep = pd_physics_step([(i, w, given[name][0] if name in given else rule_stiffness(i, w, load_stiffness))
+                                for name, _, i, w, leg in driven if leg], model_physics_step(model))
     layer = []
     for name, existing, reflected, moment, _ in driven:
         kp, kv = pd_gains(reflected, moment, timestep, load_stiffness)

@@ -70,6 +70,15 @@ class ControllerRun:
     faults: int
     controller: WalkingController
 
+    def refusal(self, labels: Sequence[str] | None = None, source: str = "") -> ZmpwalkError | None:
+        """The first refusal, prefixed with its command's label (``labels[i]``, else ``step i+1``) and ``source``
+        (a steps file); None where the controller took every command."""
+        if not self.rejections:
+            return None
+        index, _, error = self.rejections[0]
+        label = labels[index] if labels is not None and index < len(labels) else f"step {index + 1}"
+        return error.in_context(f"{source}: {label}" if source else label)
+
 
 class _Operator:
     """Gives a list of commands as an operator does: the first at once, each next one ``phase`` of the step

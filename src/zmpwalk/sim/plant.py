@@ -9,7 +9,8 @@ model, unmodified in its meshes, masses, inertias, contacts and actuators, with:
   (a site in the foot body, axes of the foot frame), the pose of the base and of each ankle, and each
   leg joint's angle, rate and actuator torque (``jointactuatorfrc``);
 * a time step of at most the robot's ``physics_step`` (:data:`MAX_TIMESTEP`, the 1 kHz servo period of the
-  references, or a half or a quarter of it: :func:`zmpwalk.robots.pd.pd_physics_step`);
+  references, or a half or a quarter of the model's own where the PD layer needs it:
+  :func:`zmpwalk.robots.pd.pd_physics_step`);
 * the joint PD layer a humanoid's firmware runs, where the model has torque motors or no actuators
   (:func:`add_pd_layer`);
 * no control range on its position servos (:func:`lift_control_ranges`): the control carries the target angle
@@ -55,7 +56,7 @@ LEFT_SUPPORT, RIGHT_SUPPORT = int(Support.LEFT), int(Support.RIGHT)  # plain int
 
 Array = NDArray[np.float64]
 
-MAX_TIMESTEP = PHYSICS_STEP  # [s]
+MAX_TIMESTEP = PHYSICS_STEP  # [s] the physics step at most (a robot's ModelPlant.physics_step may be shorter)
 FEEDFORWARD_PERIOD = 0.005  # [s] the static feedforward is computed at this period and interpolated
 FRICTION_RATE = 0.05  # [rad/s] (m/s on a slide) a joint's dry friction enters the feedforward as f tanh(q' / this)
 
@@ -264,7 +265,8 @@ def add_pd_layer(spec: mujoco.MjSpec, plant: ModelPlant) -> None:
 
     .. math:: \tau = \mathrm{clip}(k_p (u - q) - k_v \dot q,\ -\tau_{max},\ \tau_{max})
 
-    MuJoCo then runs the PD law at every physics step (1 kHz, as firmware does). A control ``u = q_ref +
+    MuJoCo then runs the PD law at every physics step (1 kHz, as firmware does, or 2 or 4 kHz:
+    :attr:`ModelPlant.physics_step`). A control ``u = q_ref +
     tau_ff / kp`` (:func:`servo_offsets`) is the same as a feedforward torque: ``kp (q_ref + tau_ff / kp - q)
     = kp (q_ref - q) + tau_ff``. The motor's control range (a torque) is dropped: the control is an angle.
     """
