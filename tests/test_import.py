@@ -246,14 +246,14 @@ def test_torque_driven_legs_get_the_pd_layer(capsys: pytest.CaptureFixture[str])
     assert talos.plant is not None
     talos_mgl = talos.mass * talos.gravity * talos.pendulum_length
     assert talos_mgl == pytest.approx(824.83, abs=0.01)  # [N m]
-    for index, (joint, limit) in enumerate(zip(talos.plant.joints, [100.0, 160.0, 160.0, 400.0, 160.0, 100.0] * 2,
-                                               strict=True)):
+    # the ankle roll, 0.0104 kg m^2: at 1 ms the step bound (sqrt(kp / I) dt = 0.5) would hold it at 2605.7 N m/rad,
+    # so the physics step halves and every leg joint has the load term
+    roll = talos.plant.joints[5].actuator
+    assert roll is not None and roll.inertia * (0.5 / 0.001) ** 2 == pytest.approx(2605.7, abs=0.1)
+    assert talos.plant.physics_step == pytest.approx(0.0005, abs=1e-15)  # [s]
+    for joint, limit in zip(talos.plant.joints, [100.0, 160.0, 160.0, 400.0, 160.0, 100.0] * 2, strict=True):
         assert joint.actuator is not None and joint.actuator.label == "torque motor + PD"
-        if index % 6 == 5:  # the ankle roll, 0.0104 kg m^2: the step bound, sqrt(kp / I) dt = 0.5 (2605.7 N m/rad)
-            assert joint.actuator.kp == pytest.approx(joint.actuator.inertia * (0.5 / 0.001) ** 2, rel=1e-9)
-            assert joint.actuator.kp == pytest.approx(2605.7, abs=0.1) and joint.actuator.kp < 4 * talos_mgl
-        else:
-            assert joint.actuator.kp == pytest.approx(4 * talos_mgl, rel=1e-9)  # 3299.3 N m/rad: the load term
+        assert joint.actuator.kp == pytest.approx(4 * talos_mgl, rel=1e-9)  # 3299.3 N m/rad: the load term
         assert joint.actuator.force_limit == limit  # [N m] the motor's ctrlrange (and the joint's actuatorfrcrange)
     assert len(talos.plant.pd_joints) == 32  # the legs, torso, head, arms and grippers: every motor
     n1 = load_robot(N1)

@@ -83,21 +83,22 @@ def test_the_rule_bandwidth_load_and_step_bound() -> None:
         pd_gains(0.0, 1.0)
 
 
-def test_the_physics_step_shortens_only_where_the_bound_holds_a_leg_joint_below_its_weight_moment() -> None:
-    """``pd_physics_step``: a leg joint the 1 ms bound ``I (0.5 / dt)^2`` holds below ``W = m g l`` (a URDF's ankle
-    roll, 0.0004 kg m^2, no rotor: 100 N m/rad against 235 N m) shortens the step to the quarter at which it
-    reaches ``kappa W`` (0.25 ms: 1600 >= 940 N m/rad; at 0.5 ms 400 does not); a joint the bound holds above ``W``
-    but below ``kappa W`` (TALOS's ankle rolls: 3.2 W) keeps 1 ms; a robot file's ``kp`` is the stiffness needed."""
+def test_the_physics_step_shortens_where_the_bound_holds_a_leg_joint_below_the_rule() -> None:
+    """``pd_physics_step``: the longest of 1, 1/2, 1/4 of the step at which every leg joint's bound
+    ``I (0.5 / dt)^2`` reaches the stiffness it needs. A URDF's ankle roll (0.0004 kg m^2, no rotor; ``4 m g l`` =
+    940 N m/rad): 100 at 1 ms, 400 at 0.5 ms, 1600 at 0.25 ms; TALOS's ankle roll (0.0104 kg m^2, 3299.2): 2600 at 1
+    ms, 10400 at 0.5 ms; a robot file's ``kp`` is the stiffness needed."""
     needed = rule_stiffness(0.0004, 235.0)
     assert needed == pytest.approx(940.0, rel=1e-12)  # [N m/rad] kappa W
-    assert pd_physics_step([(0.0004, 235.0, needed)], 0.001) == pytest.approx(0.00025, abs=1e-15)  # [s]
+    assert pd_physics_step([(0.0004, needed)], 0.001) == pytest.approx(0.00025, abs=1e-15)  # [s]
     assert pd_gains(0.0004, 235.0, 0.00025)[0] == pytest.approx(needed, rel=1e-12)  # the rule's, not the bound
     assert pd_gains(0.0004, 235.0, 0.001)[0] == pytest.approx(100.0, rel=1e-12)  # [N m/rad] the bound at 1 ms
-    talos = (0.0104, 824.8, rule_stiffness(0.0104, 824.8))  # [kg m^2], [N m], [N m/rad]
-    assert pd_physics_step([talos, (0.1, 824.8, 3299.2)], 0.001) == pytest.approx(0.001, abs=1e-15)
-    assert pd_physics_step([(0.0004, 190.0, 380.0)], 0.001) == pytest.approx(0.0005, abs=1e-15)  # 400 >= 380
-    assert pd_physics_step([(0.0004, 235.0, 300.0)], 0.0005) == pytest.approx(0.0005, abs=1e-15)  # 400 >= 235
-    assert pd_physics_step([(1e-7, 235.0, 940.0)], 0.001) == pytest.approx(0.00025, abs=1e-15)  # none fits: the least
+    talos = (0.0104, rule_stiffness(0.0104, 824.8))  # [kg m^2], [N m/rad]
+    assert pd_physics_step([talos, (0.1, 3299.2)], 0.001) == pytest.approx(0.0005, abs=1e-15)
+    assert pd_physics_step([(0.1, 3299.2), (0.0253, 3299.2)], 0.001) == pytest.approx(0.001, abs=1e-15)  # TALOS knee
+    assert pd_physics_step([(0.0004, 380.0)], 0.001) == pytest.approx(0.0005, abs=1e-15)  # 400 >= 380
+    assert pd_physics_step([(0.0004, 300.0)], 0.0005) == pytest.approx(0.0005, abs=1e-15)  # 400 >= 300
+    assert pd_physics_step([(1e-7, 940.0)], 0.001) == pytest.approx(0.00025, abs=1e-15)  # none fits: the least
 
 
 def test_motor_legs_get_the_rule_gains_and_their_limits(tmp_path: Path) -> None:

@@ -120,7 +120,7 @@ class ModelPlant:
         rest_com: Its centre of mass in the pelvis frame [m].
         pd_joints: Every joint driven by the joint PD layer, leg joints included: (joint name, its actuator).
         physics_step: The simulation's physics step, the PD layer's period [s]: :attr:`model_step`, or a half or
-            a quarter of it where the layer's discrete bound would hold a leg joint below the robot's ``m g l``
+            a quarter of it where the layer's discrete bound would hold a leg joint below the rule's stiffness
             (:func:`zmpwalk.robots.pd.pd_physics_step`).
         model_step: The model's own physics step, at most :data:`PHYSICS_STEP` [s].
         load_stiffness: The PD layer's ``kappa`` [-] (:func:`~zmpwalk.robots.pd.pd_gains`) its gains were derived

@@ -154,8 +154,8 @@ def robot_table(robot: RobotModel, statics: StaticTorques | None = None) -> str:
             kappa = robot.plant.load_stiffness if robot.plant is not None else PD_LOAD_STIFFNESS
             step, own = ((robot.plant.physics_step, robot.plant.model_step) if robot.plant is not None
                          else (PHYSICS_STEP, PHYSICS_STEP))
-            shortened = (f", shortened from the model's {own * 1e3:g} ms: there the bound held a leg joint below W"
-                         if step < own * (1 - 1e-9) else "")
+            shortened = (f", shortened from the model's {own * 1e3:g} ms, where the bound held a leg joint below "
+                         "the rule" if step < own * (1 - 1e-9) else "")
             lines.append(f"PD layer (the firmware's joint loop, run at the physics step dt = {step * 1e3:g} ms"
                          f"{shortened}; clipped at 'max'): kp = min(max(I w^2, {kappa:g} W), I ({PD_STEP_LIMIT:g} / "
                          f"dt)^2) with w = 2 pi x {PD_BANDWIDTH / (2 * math.pi):g} Hz, "

@@ -187,26 +187,20 @@ def model_physics_step(model: Any) -> float:
     return min(float(model.opt.timestep), PHYSICS_STEP)
 
 
-def pd_physics_step(leg_joints: list[tuple[float, float, float]], timestep: float) -> float:
-    """The PD layer's period [s]: ``timestep``, or where the discrete bound ``I (beta / dt)^2`` of
-    :func:`pd_gains` would hold a leg joint below its weight moment ``W = m g l`` per radian (the joint then softer
-    than the robot toppling over it: a URDF's ankles, which carry no rotor inertia), the longest of ``timestep``
-    over :data:`PHYSICS_SUBSTEPS` at which every leg joint's bound reaches the stiffness it needs, else the shortest
-    of them.
+def pd_physics_step(leg_joints: list[tuple[float, float]], timestep: float) -> float:
+    """The PD layer's period [s]: the longest of ``timestep`` over :data:`PHYSICS_SUBSTEPS` at which the discrete
+    bound ``I (beta / dt)^2`` of :func:`pd_gains` lets every leg joint have the stiffness it needs, else the
+    shortest of them. The bound is the simulation's, not the robot's (a motor driver runs its joint loop at several
+    kHz): where it binds, the joint would be simulated softer than the rule, by as much as its reflected inertia
+    is small (a URDF's ankles carry no rotor inertia).
 
     Args:
-        leg_joints: Each leg joint the layer drives: reflected inertia ``I`` [kg m^2], weight moment ``W`` [N m]
-            and the stiffness it needs [N m/rad] (the rule's ``max(I omega^2, kappa W)``, or a robot file's
-            ``kp``).
+        leg_joints: Each leg joint the layer drives: its reflected inertia ``I`` [kg m^2] and the stiffness it
+            needs [N m/rad] (the rule's ``max(I omega^2, kappa W)``, or a robot file's ``kp``).
         timestep: The model's physics step, at most :data:`PHYSICS_STEP` [s].
     """
-    def bound(inertia: float, step: float) -> float:
-        return inertia * (PD_STEP_LIMIT / step) ** 2
-
-    if all(bound(inertia, timestep) >= min(moment, needed) for inertia, moment, needed in leg_joints):
-        return timestep
     for count in PHYSICS_SUBSTEPS:
-        if all(bound(inertia, timestep / count) >= needed for inertia, _, needed in leg_joints):
+        if all(inertia * (PD_STEP_LIMIT * count / timestep) ** 2 >= needed for inertia, needed in leg_joints):
             return timestep / count
     return timestep / PHYSICS_SUBSTEPS[-1]
 
@@ -257,7 +251,7 @@ def pd_layer(model: Any, data: Any, qpos: Array, leg_joints: set[int], leg_momen
     if unknown:
         raise InvalidParameterError("pd joint", unknown[0], "a joint the PD layer drives (a torque motor's or an "
                                     "unactuated leg joint): " + ", ".join(name for name, *_ in driven))
-    timestep = pd_physics_step([(i, w, given[name][0] if name in given else rule_stiffness(i, w, load_stiffness))
+    timestep = pd_physics_step([(i, given[name][0] if name in given else rule_stiffness(i, w, load_stiffness))
                                 for name, _, i, w, leg in driven if leg], model_physics_step(model))
     layer = []
     for name, existing, reflected, moment, _ in driven:
