@@ -8,9 +8,9 @@ model, unmodified in its meshes, masses, inertias, contacts and actuators, with:
 * sensors added where zmpwalk measures, as on the robot: a force-torque sensor at each ankle point
   (a site in the foot body, axes of the foot frame), the pose of the base and of each ankle, and each
   leg joint's angle, rate and actuator torque (``jointactuatorfrc``);
-* a time step of at most the robot's ``physics_step`` (:data:`MAX_TIMESTEP`, the 1 kHz servo period of the
-  references, or a half or a quarter of the model's own where the PD layer needs it:
-  :func:`zmpwalk.robots.pd.pd_physics_step`);
+* a time step of at most the robot's ``physics_step`` (the model's own, at most
+  :data:`~zmpwalk.robots.description.PHYSICS_STEP`, the 1 kHz servo period of the references, or a half or a
+  quarter of it where the PD layer needs it: :func:`zmpwalk.robots.pd.pd_physics_step`);
 * the joint PD layer a humanoid's firmware runs, where the model has torque motors or no actuators
   (:func:`add_pd_layer`);
 * no control range on its position servos (:func:`lift_control_ranges`): the control carries the target angle
@@ -43,7 +43,7 @@ from numpy.typing import NDArray
 
 from zmpwalk.errors import InvalidParameterError
 from zmpwalk.kinematics import JOINT_COLUMNS
-from zmpwalk.robots.description import PHYSICS_STEP, ModelPlant
+from zmpwalk.robots.description import ModelPlant
 from zmpwalk.robots.imported import load_model_spec
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.robots.pd import is_position_servo
@@ -56,7 +56,6 @@ LEFT_SUPPORT, RIGHT_SUPPORT = int(Support.LEFT), int(Support.RIGHT)  # plain int
 
 Array = NDArray[np.float64]
 
-MAX_TIMESTEP = PHYSICS_STEP  # [s] the physics step at most (a robot's ModelPlant.physics_step may be shorter)
 FEEDFORWARD_PERIOD = 0.005  # [s] the static feedforward is computed at this period and interpolated
 FRICTION_RATE = 0.05  # [rad/s] (m/s on a slide) a joint's dry friction enters the feedforward as f tanh(q' / this)
 
