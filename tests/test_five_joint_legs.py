@@ -19,6 +19,7 @@ from zmpwalk.kinematics import JOINT_COLUMNS, JointLimitError, pattern_joint_tra
 from zmpwalk.leg_chain import LegChain
 from zmpwalk.patterns.polynomial import generate
 from zmpwalk.robots import load_robot
+from zmpwalk.robots.description import PD_WEAK_ANKLE_LOAD_STIFFNESS
 from zmpwalk.robots.collision import SOLE_BAND, sole_roll_bound
 from zmpwalk.scenarios import load_steps_file
 
@@ -231,6 +232,8 @@ def test_a_flat_soled_five_joint_leg_keeps_its_sole_and_rolls_the_body(biped_pat
     from zmpwalk.balance import Stabilizer
 
     robot = load_robot(biped_path)
+    assert robot.plant is not None and robot.plant.ankle_roll_torque == 0.0  # no ankle roll: the hips' kappa
+    assert robot.plant.load_stiffness == PD_WEAK_ANKLE_LOAD_STIFFNESS
     pattern = generate(robot, [StepCommand(duration=0.8, forward=0.05)], rate=1000.0)
     with pytest.raises(JointLimitError, match="no ankle roll"):
         pattern_joint_trajectory(pattern)

@@ -18,8 +18,8 @@ from zmpwalk.errors import FileFormatError, InvalidParameterError
 from zmpwalk.kinematics import pattern_joint_trajectory
 from zmpwalk.patterns.polynomial import generate
 from zmpwalk.robots import load_robot
-from zmpwalk.robots.description import PD_BANDWIDTH, PD_LOAD_STIFFNESS
-from zmpwalk.robots.inspect import robot_summary, robot_toml
+from zmpwalk.robots.description import PD_BANDWIDTH, PD_LOAD_STIFFNESS, PD_WEAK_ANKLE_LOAD_STIFFNESS
+from zmpwalk.robots.inspect import robot_summary, robot_table, robot_toml
 from zmpwalk.robots.pd import check_load_stiffness, pd_gains, pd_physics_step, rule_stiffness
 from zmpwalk.sim.plant import build_plant, servo_offsets, servo_torques
 from zmpwalk.sim.poses import plant_qpos, set_initial_state
@@ -484,3 +484,32 @@ def test_a_urdfs_light_feet_shorten_the_physics_step_to_hold_them(tmp_path: Path
     assert heavy.plant is not None and heavy.plant.physics_step == pytest.approx(0.001, abs=1e-15)
     assert main(["robot", str(write(tmp_path, "heavy2.urdf", urdf_biped()))]) == 0
     assert "dt = 1 ms;" in capsys.readouterr().out
+
+
+def test_ankle_rolls_weaker_than_the_weight_at_the_sole_edge_double_the_rules_kappa(tmp_path: Path) -> None:
+    """The rule's kappa is 8 where an ankle roll cannot hold the robot's weight with the CoP on the sole's side
+    edge (20.4 kg x 9.81 m/s^2 x 0.05 m = 10.0 N m for the 0.1 m wide soles): ankle rolls of 8 N m double every
+    leg joint's load term; 12 N m keep 4; a five-joint leg (no ankle roll) counts as none; a robot file's kappa
+    still rules, and the file written from the derived robot leaves it commented out."""
+    def with_ankle_rolls(limit: float) -> str:
+        return motor_biped().replace('joint="l_ar" ctrlrange="-40 40"', f'joint="l_ar" ctrlrange="-{limit} {limit}"')
+
+    weak = load_robot(write(tmp_path, "weak.xml", with_ankle_rolls(8)))
+    strong = load_robot(write(tmp_path, "strong.xml", with_ankle_rolls(12)))
+    assert weak.plant is not None and strong.plant is not None
+    assert weak.plant.sole_edge_moment == pytest.approx(20.4 * 9.81 * 0.05, rel=1e-9)  # [N m] 10.0
+    assert (weak.plant.ankle_roll_torque, strong.plant.ankle_roll_torque) == (8.0, 12.0)  # the weaker of the two
+    assert (weak.plant.load_stiffness, strong.plant.load_stiffness) == (PD_WEAK_ANKLE_LOAD_STIFFNESS, 4.0)
+    weight_moment = weak.mass * weak.gravity * weak.pendulum_length  # [N m]
+    knee = {j.name: j.actuator for j in weak.plant.joints}["l_kn"]
+    assert knee is not None and knee.kp == pytest.approx(8.0 * weight_moment, rel=1e-12)
+    summary = robot_summary(weak)
+    assert (summary["load_stiffness"], summary["ankle_roll_torque"]) == (8.0, 8.0)
+    assert "kappa = 8 (the ankle rolls hold 8 N m, the weight at the sole's side edge 10 N m: the hips carry" \
+        in robot_table(weak)
+    text = robot_toml(weak, tmp_path)
+    assert "\n# load_stiffness = 8   # [-]" in text  # derived, not the file's
+    assert load_robot(write(tmp_path, "weak.toml", text)).plant == weak.plant
+    given = load_robot(write(tmp_path, "given.toml", text.replace("# load_stiffness = 8", "load_stiffness = 4")))
+    assert given.plant is not None and given.plant.load_stiffness == 4.0
+    assert "kappa = 4: the robot file's (derived: 8," in robot_table(given)

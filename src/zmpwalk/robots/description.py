@@ -29,6 +29,9 @@ PD_DAMPING_RATIO = 1.0  # [-] zeta: damping of a PD joint on its own inertia (cr
 PD_LOAD_STIFFNESS = 4.0  # [-] kappa: a PD joint is at least this many times the weight moment it holds per rad
 
 
+PD_WEAK_ANKLE_LOAD_STIFFNESS = 8.0  # [-] kappa where an ankle roll cannot hold the weight at the sole's side edge
+
+
 PD_STEP_LIMIT = 0.5  # [-] beta: sqrt(kp / I) times the physics step at most (discrete stability below 2)
 
 
@@ -125,6 +128,9 @@ class ModelPlant:
         model_step: The model's own physics step, at most :data:`PHYSICS_STEP` [s].
         load_stiffness: The PD layer's ``kappa`` [-] (:func:`~zmpwalk.robots.pd.pd_gains`) its gains were derived
             with.
+        ankle_roll_torque: The weaker ankle roll's torque limit [N m] (0 for a five-joint leg, inf unlimited).
+        sole_edge_moment: The robot's weight times the lateral distance from the ankle to the sole's nearer side
+            edge [N m]: the ankle roll torque that holds the weight with the CoP on that edge.
         pd_given: The joints whose PD gains the robot file gives (names), not derived.
         root_body: Name of the floating base where it is not ``base_body``, else empty.
         coupled_joints: Joints a leg joint moves through a joint equality (names): neither held nor driven (their
@@ -150,11 +156,23 @@ class ModelPlant:
     physics_step: float = PHYSICS_STEP  # [s]
     model_step: float = PHYSICS_STEP  # [s]
     load_stiffness: float = PD_LOAD_STIFFNESS  # [-]
+    ankle_roll_torque: float = math.inf  # [N m]
+    sole_edge_moment: float = 0.0  # [N m]
     pd_given: tuple[str, ...] = ()
     root_body: str = ""
     coupled_joints: tuple[str, ...] = ()
     ready_stretch: float = 0.0  # [-]
     file_values: tuple[str, ...] = ()
+
+    @property
+    def derived_load_stiffness(self) -> float:
+        """The rule's ``kappa`` for this robot where no robot file sets it [-]: :data:`PD_LOAD_STIFFNESS`, or
+        :data:`PD_WEAK_ANKLE_LOAD_STIFFNESS` where an ankle roll cannot hold the robot's weight with the CoP on
+        the sole's side edge (``ankle_roll_torque < sole_edge_moment``; a five-joint leg has none): on one foot
+        the hips then carry the sideways balance the ankle cannot, and twice the stiffness halves what they yield
+        to it (docs/robot-import.md: PNDbotics Adam Lite, Unitree's H2 URDF and BXI Elf2 walk their three example
+        walks at 8; at 4 the first two fail them)."""
+        return PD_WEAK_ANKLE_LOAD_STIFFNESS if self.ankle_roll_torque < self.sole_edge_moment else PD_LOAD_STIFFNESS
 
     @property
     def posture_set_by(self) -> str:

@@ -69,14 +69,20 @@ from zmpwalk.robots.collision import Sole, collision_points, rigid_bodies, sole_
 from zmpwalk.robots.description import (
     HUBO_FOOT_LIFT,
     LIFT_RANGE_MARGIN,
-    PD_LOAD_STIFFNESS,
     Actuator,
     LegJoint,
     ModelPlant,
 )
 from zmpwalk.robots.legs import VIRTUAL_PREFIX, FootAtReference, Segments, build_leg, leg_joint_ids, segments
 from zmpwalk.robots.model import RobotModel, schedule_scale
-from zmpwalk.robots.pd import check_load_stiffness, coupled_joints, element_name, model_physics_step, pd_layer
+from zmpwalk.robots.pd import (
+    check_load_stiffness,
+    coupled_joints,
+    element_name,
+    joint_torque_limit,
+    model_physics_step,
+    pd_layer,
+)
 from zmpwalk.robots.posture import hip_to_ankle, posture_set_by, ready_posture, reference_reach
 from zmpwalk.robots.tree import (
     base_mount,
@@ -228,9 +234,10 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     pelvis_height, pendulum, com_offset, chains_ready, qpos = ready
     length_scale = schedule_scale(pendulum, straight, g.hip_spacing)[1]
     lift = _foot_lift(chains_ready, leg_joints, HUBO_FOOT_LIFT * length_scale)  # [m]
-    moment = mass * float(np.linalg.norm(model.opt.gravity)) * pendulum  # [N m] m g l, what a leg joint holds
+    weight = mass * float(np.linalg.norm(model.opt.gravity))  # [N]
+    moment = weight * pendulum  # [N m] m g l, what a leg joint holds
     plant, leg_joints = _with_pd_layer(model, data, qpos, plant, leg_joints, leg_joint_set, geometry, values,
-                                       pd_gains or {}, moment, source)
+                                       pd_gains or {}, weight, moment, source)
     stretch = (hip_to_ankle(chains_ready[0]) if "pelvis_height" in values else distance) / straight  # [-]
     plant = replace(plant, file_values=tuple(sorted(set(values) - {"load_stiffness"})), ready_stretch=stretch)
     return _robot_model(
@@ -248,15 +255,19 @@ def _robot_name(model: Any, name: str | None, path: Path) -> str:
 
 def _with_pd_layer(model: Any, data: Any, qpos: Array, plant: ModelPlant, leg_joints: list[LegJoint],
                    leg_joint_set: set[int], geometry: _Geometry, values: dict[str, float],
-                   pd_gains: dict[str, tuple[float, float | None]], moment: float, source: str
+                   pd_gains: dict[str, tuple[float, float | None]], weight: float, moment: float, source: str
                    ) -> tuple[ModelPlant, list[LegJoint]]:
     """``plant`` with the joint PD layer (gains from the ready posture ``qpos``'s inertia, a leg joint holding the
-    robot's ``moment`` m g l [N m]; ``values``' ``load_stiffness``, ``pd_gains`` given) and the leg joints driven by
-    it (a five-joint leg's virtual roll with its range)."""
+    robot's ``moment`` m g l [N m], ``weight`` m g [N]; ``values``' ``load_stiffness``, else the robot's
+    :attr:`~zmpwalk.robots.description.ModelPlant.derived_load_stiffness`; ``pd_gains`` given) and the leg joints
+    driven by it (a five-joint leg's virtual roll with its range)."""
     import mujoco
 
     coupled = coupled_joints(model, leg_joint_set)
-    load_stiffness = check_load_stiffness(values.get("load_stiffness", PD_LOAD_STIFFNESS))
+    _, y_min, _, y_max = geometry.sole_box
+    plant = replace(plant, ankle_roll_torque=_ankle_roll_torque(model, leg_joints),
+                    sole_edge_moment=weight * min(abs(y_min), abs(y_max)))
+    load_stiffness = check_load_stiffness(values.get("load_stiffness", plant.derived_load_stiffness))
     pd_joints, physics_step = pd_layer(model, data, qpos, leg_joint_set, moment, pd_gains, coupled, load_stiffness)
     leg_joints = _driven_joints(leg_joints, dict(pd_joints), geometry, values.get("sole_roll_limit"), source)
     names = {j: element_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in coupled}
@@ -308,6 +319,17 @@ def _zero_pose(model: Any, data: Any, qpos_reference: Array, leg_joints: set[int
     data.qpos[:] = zero
     mujoco.mj_kinematics(model, data)
     return data.xmat[base].reshape(3, 3).copy(), data.xpos[base].copy()
+
+
+def _ankle_roll_torque(model: Any, joints: list[LegJoint]) -> float:
+    """The weaker ankle roll's torque limit [N m]: 0 for a five-joint leg (its roll is virtual), inf where nothing
+    limits it."""
+    import mujoco
+
+    limits = [0.0 if joint.name.startswith(VIRTUAL_PREFIX)
+              else joint_torque_limit(model, mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint.name))
+              for joint in joints if joint.role == "ankle_roll"]
+    return min(limits, default=math.inf)
 
 
 def _driven_joints(joints: list[LegJoint], driven: dict[str, Actuator], geometry: _Geometry,

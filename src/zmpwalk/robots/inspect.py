@@ -16,8 +16,10 @@ from zmpwalk.robots.description import (
     PD_DAMPING_RATIO,
     PD_LOAD_STIFFNESS,
     PD_STEP_LIMIT,
+    PD_WEAK_ANKLE_LOAD_STIFFNESS,
     PHYSICS_STEP,
     Actuator,
+    ModelPlant,
 )
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.robots.posture import READY_STRETCH
@@ -58,6 +60,9 @@ def robot_summary(robot: RobotModel, statics: StaticTorques | None = None) -> di
         summary["keyframe"] = plant.keyframe
         summary["ready_stretch"] = plant.ready_stretch  # [-] hip-to-ankle distance over the straight leg
         summary["physics_step"] = plant.physics_step  # [s] the simulation's step, the PD layer's period
+        summary["load_stiffness"] = plant.load_stiffness  # [-] the PD rule's kappa
+        summary["ankle_roll_torque"] = plant.ankle_roll_torque  # [N m] the weaker ankle roll's limit
+        summary["sole_edge_moment"] = plant.sole_edge_moment  # [N m] the weight at the sole's nearer side edge
         summary["posture_set_by"] = plant.posture_set_by or None
         summary["held_joints"] = list(plant.held_joints)
         summary["coupled_joints"] = list(plant.coupled_joints)
@@ -162,6 +167,8 @@ def robot_table(robot: RobotModel, statics: StaticTorques | None = None) -> str:
                          f"W = m g l = {robot.mass * robot.gravity * robot.pendulum_length:.1f} N m for a leg joint; "
                          f"kv = 2 x {PD_DAMPING_RATIO:g} sqrt(kp I); I [kg m^2] its reflected inertia "
                          "(docs/robot-import.md), or the robot file's [pd]")
+            if robot.plant is not None:
+                lines.append(_kappa_line(robot.plant))
         if s["pd_joints"]:
             lines.append("held by the PD layer (kp [N m/rad], kv [N m s/rad], max [N m]): " + ", ".join(
                 f"{name} {a['kp']:.1f}/{a['kv']:.2f}/{a['force_limit']:.3g}" for name, a in s["pd_joints"].items()))
@@ -246,7 +253,7 @@ def robot_toml(robot: RobotModel, folder: Path) -> str:
                   "# by zmpwalk's rule (docs/robot-import.md): kp = max(I w^2, kappa W), critical damping. Set the",
                   "# rule's kappa here, or give a joint's own (uncommented: the robot file's) with your firmware's:",
                   "# kp [N m/rad], kv [N m s/rad] (kv may be left out: critical damping).",
-                  f"{'' if robot.plant.load_stiffness != PD_LOAD_STIFFNESS else '# '}load_stiffness = "
+                  f"{'' if robot.plant.load_stiffness != robot.plant.derived_load_stiffness else '# '}load_stiffness = "
                   f"{robot.plant.load_stiffness:.12g}   # [-] the rule's kappa for every joint not given below"]
         lines += [f"{'' if name in robot.plant.pd_given else '# '}{_quote(name)} = "
                   f"{{kp = {actuator.kp:.6g}, kv = {actuator.kv:.6g}}}" for name, actuator in robot.plant.pd_joints]
@@ -257,6 +264,19 @@ def robot_toml(robot: RobotModel, folder: Path) -> str:
 
 def _quote(text: str) -> str:
     return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def _kappa_line(plant: ModelPlant) -> str:
+    """Which ``kappa`` the PD rule took and why: the robot file's, or the derived one (the ankle rolls against the
+    weight at the sole's side edge, :attr:`~zmpwalk.robots.description.ModelPlant.derived_load_stiffness`)."""
+    derived = plant.derived_load_stiffness
+    hold = (f"the ankle rolls hold {plant.ankle_roll_torque:.3g} N m, the weight at the sole's side edge "
+            f"{plant.sole_edge_moment:.3g} N m" if plant.ankle_roll_torque > 0 else "no ankle roll joint")
+    why = ("the hips carry the sideways balance on one foot" if derived == PD_WEAK_ANKLE_LOAD_STIFFNESS
+           else "the ankles hold it")
+    if plant.load_stiffness != derived:
+        return f"kappa = {plant.load_stiffness:g}: the robot file's (derived: {derived:g}, {hold})"
+    return f"kappa = {derived:g} ({hold}: {why})"
 
 
 def _lift_line(robot: RobotModel) -> str:

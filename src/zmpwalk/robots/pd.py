@@ -82,6 +82,13 @@ def _is_motor(model: Any, actuator: int) -> bool:
                 and model.actuator_dyntype[actuator] == mujoco.mjtDyn.mjDYN_NONE)
 
 
+def joint_torque_limit(model: Any, joint: int) -> float:
+    """The most torque a joint's actuator (or, without one, the joint's own ``actuatorfrcrange``) can apply [N m];
+    inf where nothing limits it."""
+    actuator = joint_actuator(model, joint)
+    return actuator.force_limit if actuator is not None else _joint_torque_limit(model, joint)
+
+
 def _joint_torque_limit(model: Any, joint: int) -> float:
     """The joint's own limit on its actuators' total torque, ``actuatorfrcrange`` (a URDF's ``<limit effort>``)
     [N m]; inf where it has none."""
