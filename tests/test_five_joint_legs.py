@@ -19,8 +19,8 @@ from zmpwalk.kinematics import JOINT_COLUMNS, JointLimitError, pattern_joint_tra
 from zmpwalk.leg_chain import LegChain
 from zmpwalk.patterns.polynomial import generate
 from zmpwalk.robots import load_robot
-from zmpwalk.robots.description import PD_WEAK_ANKLE_LOAD_STIFFNESS
 from zmpwalk.robots.collision import SOLE_BAND, sole_roll_bound
+from zmpwalk.robots.description import PD_WEAK_ANKLE_LOAD_STIFFNESS
 from zmpwalk.scenarios import load_steps_file
 
 ROBOTS = Path(__file__).resolve().parents[2] / "shared" / "robots"

@@ -133,8 +133,9 @@ class ModelPlant:
             edge [N m]: the ankle roll torque that holds the weight with the CoP on that edge.
         pd_given: The joints whose PD gains the robot file gives (names), not derived.
         root_body: Name of the floating base where it is not ``base_body``, else empty.
-        coupled_joints: Joints a leg joint moves through a joint equality (names): neither held nor driven (their
-            actuators' controls 0).
+        coupled_joints: Joints a driven joint moves through an equality (names; a geared hip yaw's drive, a parallel
+            ankle's or waist's cranks and rods: :func:`~zmpwalk.robots.pd.coupled_joints`): neither held nor driven
+            (their actuators' controls 0).
         ready_stretch: The ready posture's hip-to-ankle distance over the straight leg [-] (the left leg's).
         file_values: The fields of the robot file's ``[posture]`` and ``[walking]`` (or ``load_robot``'s
             ``ready_stretch``) that replace derived values (names).

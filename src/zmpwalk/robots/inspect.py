@@ -180,7 +180,7 @@ def robot_table(robot: RobotModel, statics: StaticTorques | None = None) -> str:
         if s["held_joints"]:
             lines.append(f"held at the reference pose: {', '.join(s['held_joints'])}")
         if s["coupled_joints"]:
-            lines.append("moved by a leg joint through a joint equality (its PD loop drives them; not held): "
+            lines.append("moved through an equality by a joint the PD layer drives (not held): "
                          + ", ".join(s["coupled_joints"]))
     return "\n".join(lines)
 

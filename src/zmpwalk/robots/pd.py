@@ -173,20 +173,74 @@ def _weight_moment(model: Any, data: Any, joint: int) -> float:
 
 
 def coupled_joints(model: Any, leg_joints: set[int]) -> frozenset[int]:
-    """Joints tied to a leg joint by an active joint equality (ToddlerBot's hip yaw motor, whose gear turns the
-    passive joint in the leg): the leg joint's PD loop moves them through the equality, and nothing holds them
-    at the reference pose (a hold would pull against the leg's loop)."""
+    """Joints a driven joint moves through an active equality: tied to a leg joint by a joint equality
+    (ToddlerBot's hip yaw motor, whose gear turns the passive joint in the leg), or the actuated and ball joints of
+    a loop that a connect or weld equality closes through an unactuated hinge (a parallel ankle's cranks and rods,
+    which turn its pitch and roll; a parallel waist's): the PD layer drives the loop's unactuated hinges
+    (:func:`loop_driven_joints`), as a robot's firmware maps their targets onto its cranks, and nothing holds the
+    coupled joints at the reference pose (a hold would pull against that loop)."""
     import mujoco
 
-    coupled = set()
+    coupled: set[int] = set()
     for e in range(model.neq):
-        if int(model.eq_type[e]) != mujoco.mjtEq.mjEQ_JOINT or not model.eq_active0[e]:
-            continue
-        pair = (int(model.eq_obj1id[e]), int(model.eq_obj2id[e]))
-        for mine, other in (pair, pair[::-1]):
-            if mine in leg_joints and other >= 0 and other not in leg_joints:
-                coupled.add(other)
+        if model.eq_active0[e] and int(model.eq_type[e]) == mujoco.mjtEq.mjEQ_JOINT:
+            pair = (int(model.eq_obj1id[e]), int(model.eq_obj2id[e]))
+            for mine, other in (pair, pair[::-1]):
+                if mine in leg_joints and other >= 0 and other not in leg_joints:
+                    coupled.add(other)
+    for loop in _equality_loops(model):
+        if _unactuated_hinges(model, loop):
+            coupled |= {j for j in loop if j not in leg_joints and not _unactuated_hinges(model, {j})
+                        and int(model.jnt_type[j]) != mujoco.mjtJoint.mjJNT_FREE}
     return frozenset(coupled)
+
+
+def loop_driven_joints(model: Any) -> frozenset[int]:
+    """The unactuated hinges of the loops that active connect or weld equalities close (a parallel waist's pitch
+    and roll; a parallel ankle's, which are leg joints): the PD layer drives them (:func:`coupled_joints`)."""
+    driven: set[int] = set()
+    for loop in _equality_loops(model):
+        driven |= _unactuated_hinges(model, loop)
+    return frozenset(driven)
+
+
+def _equality_loops(model: Any) -> list[set[int]]:
+    """The joints of each loop an active connect or weld equality between two bodies closes."""
+    import mujoco
+
+    return [_loop_joints(model, int(model.eq_obj1id[e]), int(model.eq_obj2id[e])) for e in range(model.neq)
+            if model.eq_active0[e] and int(model.eq_type[e]) in (mujoco.mjtEq.mjEQ_CONNECT, mujoco.mjtEq.mjEQ_WELD)
+            and int(model.eq_objtype[e]) == mujoco.mjtObj.mjOBJ_BODY]
+
+
+def _unactuated_hinges(model: Any, joints: set[int]) -> set[int]:
+    """The hinges among ``joints`` that no actuator drives."""
+    import mujoco
+
+    return {j for j in joints if int(model.jnt_type[j]) == mujoco.mjtJoint.mjJNT_HINGE and joint_actuator(model, j)
+            is None}
+
+
+def _loop_joints(model: Any, first: int, second: int) -> set[int]:
+    """The joints of the loop an equality between bodies ``first`` and ``second`` closes: those on the tree's
+    paths from each body up to their nearest common ancestor."""
+    def chain(body: int) -> list[int]:
+        bodies = [body]
+        while body > 0:
+            body = int(model.body_parentid[body])
+            bodies.append(body)
+        return bodies
+
+    up, other = chain(first), set(chain(second))
+    common = next(body for body in up if body in other)
+    joints: set[int] = set()
+    for start in (first, second):
+        body = start
+        while body != common:
+            adr, count = int(model.body_jntadr[body]), int(model.body_jntnum[body])
+            joints.update(range(adr, adr + count))
+            body = int(model.body_parentid[body])
+    return joints
 
 
 def model_physics_step(model: Any) -> float:
@@ -233,6 +287,7 @@ def pd_layer(model: Any, data: Any, qpos: Array, leg_joints: set[int], leg_momen
     mujoco.mj_forward(model, data)
     inertia = np.zeros((model.nv, model.nv))
     mujoco.mj_fullM(model, data, inertia)
+    loop_driven = loop_driven_joints(model)
     driven = []
     for j in range(model.njnt):
         hinge = int(model.jnt_type[j]) == mujoco.mjtJoint.mjJNT_HINGE  # a numpy integer is never `in` enums
@@ -242,7 +297,7 @@ def pd_layer(model: Any, data: Any, qpos: Array, leg_joints: set[int], leg_momen
             continue
         name = element_name(model, mujoco.mjtObj.mjOBJ_JOINT, j)
         existing = joint_actuator(model, j)
-        if existing is None and (j in leg_joints or model.nu == 0):
+        if existing is None and (j in leg_joints or model.nu == 0 or j in loop_driven):
             existing = Actuator(PD_PREFIX + name, "none", 0.0, 0.0, _joint_torque_limit(model, j))
         if existing is None or existing.kind not in ("motor", "none"):
             continue

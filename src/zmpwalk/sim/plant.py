@@ -75,6 +75,9 @@ class Plant:
         imported: True for the robot's own model, False for the box model.
         mount: Where the legs' base (the pelvis, whose pose the plan gives and the sensors read) sits on the
             floating root below a waist (:func:`~zmpwalk.robots.tree.base_mount`); None where it is the root.
+        coupled_dofs: The degrees of freedom of the joints a driven joint moves through an equality
+            (:attr:`~zmpwalk.robots.description.ModelPlant.coupled_joints`), (k,): placed where the equalities
+            hold when the robot is stood (:func:`~zmpwalk.sim.poses.close_loops`).
     """
 
     model: mujoco.MjModel
@@ -85,6 +88,7 @@ class Plant:
     imported: bool
     leg_columns: NDArray[np.intp] = field(default_factory=lambda: np.arange(12))
     mount: Mount | None = None
+    coupled_dofs: NDArray[np.intp] = field(default_factory=lambda: np.zeros(0, dtype=np.intp))
 
     @cached_property
     def root_in_base(self) -> tuple[float, ...] | None:
@@ -125,12 +129,13 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
         if not actuator.name:
             actuator.name = f"#{index}"
     _release_coupled(spec, plant)
+    sites = _sole_bodies(spec, model, plant)
     add_pd_layer(spec, plant)
     lift_control_ranges(spec, model)
     qpos = np.array(plant.qpos_reference)
     root = floating_base(model, str(plant.path))
     mount = base_mount(model, qpos, root, mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, plant.base_body))
-    _add_sites(spec, model, robot, plant, qpos, (int(model.jnt_qposadr[model.body_jntadr[root]]), mount))
+    _add_sites(spec, model, robot, plant, qpos, (int(model.jnt_qposadr[model.body_jntadr[root]]), mount), sites)
     virtual = _virtual_columns(robot)
     _add_sensors(spec, plant, virtual)
     model = spec.compile()
@@ -141,15 +146,24 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
     columns = np.array([i for i in range(12) if i not in virtual], dtype=np.intp)
     leg_qpos = np.array([model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, plant.joints[i].name)]
                          for i in columns])
-    return Plant(model, np.array(actuators), leg_qpos, _held_controls(model, plant), qpos, True, columns, mount)
+    coupled = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name) for name in plant.coupled_joints]
+    dofs = np.array([int(model.jnt_dofadr[j]) + k for j in coupled for k in range(_DOF_COUNT[int(model.jnt_type[j])])],
+                    dtype=np.intp)
+    return Plant(model, np.array(actuators), leg_qpos, _held_controls(model, plant), qpos, True, columns, mount,
+                 dofs)
+
+
+_DOF_COUNT = {int(mujoco.mjtJoint.mjJNT_FREE): 6, int(mujoco.mjtJoint.mjJNT_BALL): 3,
+              int(mujoco.mjtJoint.mjJNT_SLIDE): 1, int(mujoco.mjtJoint.mjJNT_HINGE): 1}  # degrees of freedom
 
 
 def _add_sites(spec: mujoco.MjSpec, model: mujoco.MjModel, robot: RobotModel, plant: ModelPlant,
-               qpos: Array, root: tuple[int, Mount | None]) -> None:
+               qpos: Array, root: tuple[int, Mount | None], bodies: dict[str, str]) -> None:
     """Add the ``pelvis`` site at the base body's origin and an ``{left,right}_ankle`` site at each ankle point
     (axes of the sole frame), placed in the foot bodies from the zero pose of the legs with the base at the origin
     (``qpos``: the reference pose, the other joints' angles; ``root``: the floating root's ``qpos`` address and
-    where the legs' base sits on it)."""
+    where the legs' base sits on it); a foot's site on the body ``bodies`` names for it, where it names one (its
+    sole body, :func:`_sole_bodies`, whose frame is the foot's)."""
     data = mujoco.MjData(model)
     joint_ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint.name) for joint in plant.joints]
     zero = qpos.copy()
@@ -170,7 +184,61 @@ def _add_sites(spec: mujoco.MjSpec, model: mujoco.MjModel, robot: RobotModel, pl
         position = rotation.T @ (chain.ankle - data.xpos[body])
         quaternion = np.empty(4)
         mujoco.mju_mat2Quat(quaternion, (rotation.T @ chain.sole_rotation).flatten())  # site axes: the sole frame
-        spec.body(foot).add_site(name=f"{label}_ankle", pos=position, quat=quaternion, size=[0.005, 0.005, 0.005])
+        spec.body(bodies.get(foot, foot)).add_site(name=f"{label}_ankle", pos=position, quat=quaternion,
+                                                   size=[0.005, 0.005, 0.005])
+
+
+SOLE_BODY = "zmpwalk_{}_sole"  # the body that carries a foot's collision geoms where an equality acts on the foot
+_GEOM_FIELDS = ("name", "type", "size", "pos", "quat", "fromto", "friction", "solref", "solimp", "solmix", "condim",
+                "contype", "conaffinity", "margin", "gap", "priority", "group", "rgba", "meshname", "hfieldname",
+                "material")
+
+
+def _sole_bodies(spec: mujoco.MjSpec, model: mujoco.MjModel, plant: ModelPlant) -> dict[str, str]:
+    """For each foot that an active connect or weld equality acts on (the rods of a parallel ankle), a massless
+    body welded to it in the foot's frame that carries the foot's collision geoms: the ankle's force-torque
+    sensors on it then read the ground's wrench alone, where on the foot they would read the joint's, which the
+    rods bypass (a real parallel-ankle foot measures its sole, not the ankle joint). The foot keeps its mass
+    (made explicit where its geoms gave it); contacts the model excludes for the foot are excluded for the sole
+    too, and so is the foot's parent. Returns foot body name -> sole body name; empty for every other robot."""
+    pushed = set()
+    for e in range(model.neq):
+        if model.eq_active0[e] and int(model.eq_type[e]) in (mujoco.mjtEq.mjEQ_CONNECT, mujoco.mjtEq.mjEQ_WELD) \
+                and int(model.eq_objtype[e]) == mujoco.mjtObj.mjOBJ_BODY:
+            pushed.update({int(model.body_weldid[int(model.eq_obj1id[e])]),
+                           int(model.body_weldid[int(model.eq_obj2id[e])])})
+    soles = {}
+    for label, foot in zip(("left", "right"), plant.feet, strict=True):
+        body_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, foot)
+        if int(model.body_weldid[body_id]) not in pushed:
+            continue
+        body = spec.body(foot)
+        if not body.explicitinertial:  # keep the mass the geoms gave it on the foot itself
+            body.explicitinertial = True
+            body.mass, body.ipos = float(model.body_mass[body_id]), model.body_ipos[body_id].copy()
+            body.iquat, body.inertia = model.body_iquat[body_id].copy(), model.body_inertia[body_id].copy()
+        sole = body.add_body(name=SOLE_BODY.format(label))
+        for geom in list(body.geoms):
+            if geom.contype == 0 and geom.conaffinity == 0:
+                continue  # visual
+            values = {name: getattr(geom, name) for name in _GEOM_FIELDS}
+            spec.delete(geom)
+            moved = sole.add_geom()
+            for name, value in values.items():
+                setattr(moved, name, value)
+            moved.mass, moved.density = 0.0, 0.0
+        parent = int(model.body_parentid[body_id])
+        for other in [model.body(parent).name] + [_excluded_partner(spec, pair, foot) for pair in spec.excludes]:
+            if other:
+                spec.add_exclude(bodyname1=sole.name, bodyname2=other)
+        soles[foot] = sole.name
+    return soles
+
+
+def _excluded_partner(spec: mujoco.MjSpec, pair: object, body: str) -> str:
+    """The other body of an ``<exclude>`` pair that names ``body``, else empty."""
+    names = (getattr(pair, "bodyname1", ""), getattr(pair, "bodyname2", ""))
+    return names[1] if names[0] == body else names[0] if names[1] == body else ""
 
 
 def _add_sensors(spec: mujoco.MjSpec, plant: ModelPlant, virtual: set[int]) -> None:
@@ -198,8 +266,8 @@ def _add_sensors(spec: mujoco.MjSpec, plant: ModelPlant, virtual: set[int]) -> N
 
 
 def _release_coupled(spec: mujoco.MjSpec, plant: ModelPlant) -> None:
-    """Make the model's actuators on the joints a leg joint moves through an equality do nothing (gain and bias
-    0): the leg joint's loop drives them, and a hold would pull against it."""
+    """Make the model's actuators on the joints a driven joint moves through an equality do nothing (gain and bias
+    0): the driven joint's loop moves them, and a hold would pull against it."""
     coupled = set(plant.coupled_joints)
     for actuator in spec.actuators:
         if actuator.trntype == mujoco.mjtTrn.mjTRN_JOINT and actuator.target in coupled:

@@ -1,0 +1,142 @@
+"""Closed linkages: a parallel ankle (two cranks on the shank, each pushing the foot through a rod: LimX Luna's
+class) and a parallel waist. The PD layer drives the loop's unactuated hinges (the ankle's pitch and roll, the
+waist's pitch), the cranks and rods follow through the equalities, the stand starts with every loop closed, and
+the ankle's force-torque sensor reads the ground under the sole, not the joint the rods bypass
+(zmpwalk.robots.pd.coupled_joints, zmpwalk.sim.poses.close_loops, zmpwalk.sim.plant)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from zmpwalk.robots import load_robot
+from zmpwalk.robots.description import PD_LOAD_STIFFNESS
+from zmpwalk.sim.loop import simulate_controller
+from zmpwalk.sim.plant import build_plant
+from zmpwalk.sim.poses import LOOP_TOLERANCE, close_loops
+
+LEG = """
+<body name="{s}_hip" pos="0 {y} -0.1"><joint name="{s}_hy" axis="0 0 1"/><geom size="0.02" mass="1"/>
+ <body name="{s}_hr"><joint name="{s}_hr" axis="1 0 0"/><geom size="0.02" mass="1"/>
+  <body name="{s}_hp"><joint name="{s}_hp" axis="0 1 0"/><geom size="0.02" mass="1"/>
+   <body name="{s}_shank" pos="0 0 -0.3"><joint name="{s}_kn" axis="0 1 0" range="0 2.4"/>
+    <geom size="0.02" mass="1"/>
+    <body name="{s}_ank" pos="0 0 -0.3"><joint name="{s}_ap" axis="0 1 0"/>
+     <geom size="0.02" mass="0.2" contype="0" conaffinity="0"/>
+     <body name="{s}_foot"><joint name="{s}_ar" axis="1 0 0"/>
+      <geom type="box" size="0.1 0.05 0.01" pos="0 0 -0.05" mass="0.5"/>
+     </body>
+    </body>{cranks}
+   </body>
+  </body>
+ </body>
+</body>"""
+CRANK = """
+    <body name="{s}_crank_{k}" pos="0 {y} -0.1"><joint name="{s}_crank_{k}" axis="0 1 0"/>
+     <geom type="capsule" fromto="0 0 0 -0.04 0 0" size="0.005" mass="0.05" contype="0" conaffinity="0"/>
+     <body name="{s}_rod_{k}" pos="-0.04 0 0"><joint name="{s}_rod_{k}" type="ball"/>
+      <geom type="capsule" fromto="0 0 0 0 0 -0.18" size="0.004" mass="0.05" contype="0" conaffinity="0"/></body>
+    </body>"""
+TORSO_MASS = 6.0  # [kg], its centre 0.2 m above the waist pitch axis
+ROD = 0.18  # [m] each rod's length: its end meets the foot 20 mm above the ankle, 40 mm behind it
+
+
+def linkage_biped() -> str:
+    """A 19.9 kg biped whose ankles are turned by two crank-and-rod pairs each (motors on the cranks, none on the
+    ankle joints) and whose 6 kg torso sits on an unactuated waist pitch that a crank holds through a rod."""
+    legs = "".join(LEG.format(s=s, y=y, cranks=CRANK.format(s=s, k="a", y=0.03) + CRANK.format(s=s, k="b", y=-0.03))
+                   for s, y in (("l", 0.1), ("r", -0.1)))
+    motors = "".join(f'<motor name="{s}_{j}_m" joint="{s}_{j}" ctrlrange="-40 40"/>'
+                     for s in ("l", "r") for j in ("hy", "hr", "hp", "kn", "crank_a", "crank_b"))
+    connects = "".join(f'<connect body1="{s}_rod_{k}" body2="{s}_foot" anchor="0 0 -{ROD}"/>'
+                       for s in ("l", "r") for k in ("a", "b"))
+    return f"""<mujoco><compiler angle="radian"/><default><joint armature="0.01" damping="0.1"/></default>
+<worldbody><geom type="plane" size="5 5 .1"/>
+<body name="base" pos="0 0 0.8"><freejoint/><geom type="box" size="0.1 0.15 0.05" mass="4"/>
+ <body name="torso"><joint name="waist_pitch" axis="0 1 0" range="-0.5 0.5"/>
+  <geom type="box" size="0.08 0.12 0.1" pos="0 0 0.2" mass="{TORSO_MASS}" contype="0" conaffinity="0"/>
+  <body name="waist_crank" pos="0.05 0 0.1"><joint name="waist_crank" axis="0 1 0"/>
+   <geom type="capsule" fromto="0 0 0 0.04 0 0" size="0.005" mass="0.05" contype="0" conaffinity="0"/>
+   <body name="waist_rod" pos="0.04 0 0"><joint name="waist_rod" type="ball"/>
+    <geom type="capsule" fromto="0 0 0 0 0 -0.1" size="0.004" mass="0.05" contype="0" conaffinity="0"/></body>
+  </body>
+ </body>
+{legs}</body></worldbody>
+<equality><connect body1="waist_rod" body2="base" anchor="0 0 -0.1"/>{connects}</equality>
+<actuator>{motors}<motor name="waist_m" joint="waist_crank" ctrlrange="-40 40"/></actuator></mujoco>"""
+
+
+@pytest.fixture(scope="module")
+def model_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    path = tmp_path_factory.mktemp("linkage") / "linkage.xml"
+    path.write_text(linkage_biped(), encoding="utf-8")
+    return path
+
+
+def _residual(model: mujoco.MjModel, data: mujoco.MjData) -> float:
+    """The largest residual of the model's equalities [m]."""
+    mujoco.mj_forward(model, data)
+    rows = data.efc_type[:data.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+    return float(np.abs(data.efc_pos[:data.nefc][rows]).max())
+
+
+def test_the_pd_layer_drives_the_loops_unactuated_hinges_and_releases_the_cranks(model_path: Path) -> None:
+    robot = load_robot(model_path)
+    assert robot.plant is not None
+    joints = {joint.role: joint.actuator for joint in robot.plant.joints[:6]}
+    for role in ("ankle_pitch", "ankle_roll"):  # no motor of their own: the PD layer's, on the rule's gains
+        actuator = joints[role]
+        assert actuator is not None and actuator.kind == "none" and actuator.pd_layer
+        assert actuator.kp == pytest.approx(PD_LOAD_STIFFNESS * robot.mass * robot.gravity * robot.pendulum_length,
+                                            rel=1e-12)
+    cranks = {f"{s}_{part}_{k}" for s in ("l", "r") for part in ("crank", "rod") for k in ("a", "b")}
+    assert set(robot.plant.coupled_joints) == cranks | {"waist_crank", "waist_rod"}
+    held = dict(robot.plant.pd_joints)
+    assert "waist_pitch" in held and not cranks & set(held) and "waist_crank" not in held
+    # the waist pitch holds the torso: at least 4 times the weight moment it carries (6 kg, 0.2 m up)
+    assert held["waist_pitch"].kp >= PD_LOAD_STIFFNESS * TORSO_MASS * 9.81 * 0.2 - 1e-9
+    assert "waist_pitch" in robot.plant.held_joints
+
+
+def test_the_stand_closes_every_loop_and_the_ankle_sensor_reads_the_ground(model_path: Path) -> None:
+    robot = load_robot(model_path)
+    plant = build_plant(robot)
+    model = plant.model
+    assert len(plant.coupled_dofs) == 2 * (2 * (1 + 3)) + (1 + 3)  # cranks (hinges) and rods (balls)
+    data = mujoco.MjData(model)
+    data.qpos[:] = plant.qpos_hold
+    assert robot.legs is not None
+    for chain in robot.legs:  # the ready posture's knees and ankles: the rods torn from the feet
+        for name, angle in zip(chain.joint_names, chain.reference, strict=True):
+            data.qpos[model.joint(name).qposadr[0]] = angle
+    assert _residual(model, data) > 0.005  # [m]
+    close_loops(plant, data)
+    assert _residual(model, data) < LOOP_TOLERANCE * 10
+    for label in ("left", "right"):  # the sensors sit on a massless sole body that carries the foot's geoms
+        sole = int(model.site_bodyid[model.site(f"{label}_ankle").id])
+        assert model.body(sole).name == f"zmpwalk_{label}_sole" and model.body_mass[sole] == 0.0
+        assert int(model.body_parentid[sole]) == model.body(f"{label[0]}_foot").id
+        assert (model.geom_bodyid == sole).sum() == 1 and model.body_mass[model.body(f"{label[0]}_foot").id] == 0.5
+    run = simulate_controller(robot, (), duration=1.5)  # standing: the soles carry the whole weight
+    total = run.result.force_left[-200:] + run.result.force_right[-200:]
+    weight = float(np.sum(model.body_mass)) * robot.gravity
+    assert not run.result.fell
+    assert np.abs(total - weight).max() < 0.01 * weight  # [N]
+
+
+@pytest.mark.slow
+def test_a_parallel_ankled_biped_walks(model_path: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from zmpwalk.cli import main
+
+    steps = tmp_path / "steps.toml"
+    steps.write_text("[[steps]]\nduration = 0.8\nforward = 0.08\nrepeat = 6\n", encoding="utf-8")
+    code = main(["simulate", "--robot", str(model_path), str(steps), "--json"])
+    summary = json.loads(capsys.readouterr().out)
+    assert code == 0 and summary["verdict"]["state"] == "PASS" and not summary["fell"]
+    assert summary["final_feet_error"] < 0.01  # [m]
+    assert summary["cop_error_rms"] < 0.03  # [m]
+    assert summary["distance"] == pytest.approx(0.48, abs=0.04)  # [m]
