@@ -1,4 +1,4 @@
-"""The multibody-ZMP correction of a pattern (``zmpwalk.patterns.correction``): the multibody ZMP of Eq. 3
+"""The multibody-ZMP correction of a pattern (``zmpwalk.correction``): the multibody ZMP of Eq. 3
 follows the planned ZMP after it, nothing but the pelvis moves, and the pelvis stays smooth."""
 
 from __future__ import annotations
@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from zmpwalk.commands import StepCommand
+from zmpwalk.correction import correct_pattern
 from zmpwalk.dynamics import compare_zmp
 from zmpwalk.errors import InvalidParameterError
-from zmpwalk.patterns.correction import correct_pattern
 from zmpwalk.patterns.polynomial import generate
 from zmpwalk.patterns.preview import generate_preview
 from zmpwalk.robots import load_robot

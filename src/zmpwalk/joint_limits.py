@@ -15,12 +15,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk.errors import ZmpwalkError
-from zmpwalk.robots.model import JOINT_NAMES, RobotModel
+from zmpwalk.robots.model import JOINT_COLUMNS, JOINT_NAMES, RobotModel
 
 Array = NDArray[np.float64]
 
 LEG_JOINTS = JOINT_NAMES  # hip_yaw, hip_roll, hip_pitch, knee, ankle_pitch, ankle_roll
-JOINT_COLUMNS = tuple(f"{side}_{joint}" for side in ("left", "right") for joint in LEG_JOINTS)
 
 
 class JointLimitError(ZmpwalkError, ValueError):

@@ -28,8 +28,8 @@ from zmpwalk.sim.verdict import HOLD, SETTLE
 
 if TYPE_CHECKING:
     from zmpwalk.capture import CaptureSettings
+    from zmpwalk.correction import ZmpCorrection
     from zmpwalk.kinematics import JointTrajectory
-    from zmpwalk.patterns.correction import ZmpCorrection
     from zmpwalk.patterns.result import WalkingPattern
     from zmpwalk.sim.actuators import ActuatorRow
     from zmpwalk.sim.disturbances import Disturbances, SensorNoise
@@ -60,7 +60,7 @@ class WalkSpec:
             ``pelvis`` do not apply); None: ``commands``.
         rate: Sampling rate of the pattern and of the stabilizer [Hz].
         zmp_correction: Move the pelvis until the multibody ZMP follows the planned ZMP
-            (:func:`zmpwalk.patterns.correction.correct_pattern`; box models with link masses).
+            (:func:`zmpwalk.correction.correct_pattern`; box models with link masses).
         check_limits: Raise :class:`~zmpwalk.kinematics.JointLimitError` where a planned joint angle leaves its
             range (as ``report`` and ``demo`` do); False: the verdict judges the joints instead.
         balance: Close the loop with the stabilizer; False: the pattern alone (open loop).
@@ -217,7 +217,7 @@ def walk_pattern(spec: WalkSpec) -> tuple[WalkingPattern, ZmpCorrection | None]:
             raise (error.in_context(spec.source) if spec.source else error) from None
     if not spec.zmp_correction:
         return pattern, None
-    from zmpwalk.patterns.correction import correct_pattern
+    from zmpwalk.correction import correct_pattern
 
     correction = correct_pattern(pattern)
     return correction.pattern, correction

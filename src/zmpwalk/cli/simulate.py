@@ -37,7 +37,7 @@ from zmpwalk.robots.model import RobotModel
 from zmpwalk.walk import WalkSpec
 
 if TYPE_CHECKING:
-    from zmpwalk.patterns.correction import ZmpCorrection
+    from zmpwalk.correction import ZmpCorrection
     from zmpwalk.sim.actuators import ActuatorRow
     from zmpwalk.sim.motors import MotorFit
     from zmpwalk.sim.run import SimulationResult

@@ -117,7 +117,7 @@ class WalkingPattern:
         support_phases: Support polygons over time.
         position_com_in_world: Whole-body centre of mass [m], (n, 3), where it differs from the pelvis point
             and is known (a box model's pattern corrected by its multibody ZMP,
-            :func:`zmpwalk.patterns.correction.correct_pattern`); None: the pelvis point stands for it.
+            :func:`zmpwalk.correction.correct_pattern`); None: the pelvis point stands for it.
     """
 
     robot: RobotModel

@@ -5,9 +5,11 @@ from __future__ import annotations
 import math
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
-from zmpwalk.joint_limits import JOINT_COLUMNS
+import numpy as np
+from numpy.typing import NDArray
+
 from zmpwalk.robots.collision import tilt_of
 from zmpwalk.robots.description import (
     HUBO_FOOT_LIFT,
@@ -21,11 +23,29 @@ from zmpwalk.robots.description import (
     Actuator,
     ModelPlant,
 )
-from zmpwalk.robots.model import RobotModel
+from zmpwalk.robots.model import JOINT_COLUMNS, RobotModel
 from zmpwalk.robots.posture import READY_STRETCH
 
-if TYPE_CHECKING:
-    from zmpwalk.sim.statics import StaticTorques
+
+class StaticTorques(Protocol):
+    """What the sheet reads of the ready posture's static torques (:class:`zmpwalk.sim.statics.StaticTorques`,
+    which the simulation layer computes): each leg joint's torque [N m], (12,) in the leg-column order, on both
+    feet, on either foot and on the larger of the two, and the joints held over their limit standing."""
+
+    @property
+    def both_feet(self) -> NDArray[np.float64]: ...
+
+    @property
+    def on_left(self) -> NDArray[np.float64]: ...
+
+    @property
+    def on_right(self) -> NDArray[np.float64]: ...
+
+    @property
+    def one_foot(self) -> NDArray[np.float64]: ...
+
+    @property
+    def over_limit(self) -> list[str]: ...
 
 
 def robot_summary(robot: RobotModel, statics: StaticTorques | None = None) -> dict[str, Any]:

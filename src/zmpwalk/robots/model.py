@@ -26,6 +26,7 @@ if TYPE_CHECKING:
     from zmpwalk.robots.description import ModelPlant
 
 JOINT_NAMES = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll")
+JOINT_COLUMNS = tuple(f"{side}_{joint}" for side in ("left", "right") for joint in JOINT_NAMES)  # the 12 columns
 HUBO_PENDULUM = 0.62  # [m] pendulum length the HUBO tables were tuned for (robots/data/hubo.toml)
 HUBO_HIP_SPACING = 0.17  # [m] HUBO's hip spacing (robots/data/hubo.toml)
 HUBO_LEG_LENGTH = 0.60  # [m] HUBO's thigh plus shank (robots/data/hubo.toml)
@@ -406,7 +407,7 @@ def robot_from_dict(data: dict[str, Any], source: str = "<robot>") -> RobotModel
                     raise FileFormatError(source, f"[{section}] {key} = {value:g} must be > 0")
             values[attribute] = value
     limits: dict[str, tuple[float, float]] = {}
-    columns = [f"{side}_{joint}" for side in ("left", "right") for joint in JOINT_NAMES]
+    columns = list(JOINT_COLUMNS)
     for joint, bounds in data.get("limits", {}).items():
         if joint not in JOINT_NAMES and joint not in columns:
             raise FileFormatError(source, f"[limits] unknown joint {joint!r}; known: {', '.join(JOINT_NAMES)} "
