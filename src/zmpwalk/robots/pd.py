@@ -205,12 +205,14 @@ def loop_driven_joints(model: Any) -> frozenset[int]:
 
 
 def _equality_loops(model: Any) -> list[set[int]]:
-    """The joints of each loop an active connect or weld equality between two bodies closes."""
+    """The joints of each loop an active connect or weld equality between two bodies closes within the robot (a
+    loop through its floating joint ties it to the world: not a linkage of its own)."""
     import mujoco
 
-    return [_loop_joints(model, int(model.eq_obj1id[e]), int(model.eq_obj2id[e])) for e in range(model.neq)
-            if model.eq_active0[e] and int(model.eq_type[e]) in (mujoco.mjtEq.mjEQ_CONNECT, mujoco.mjtEq.mjEQ_WELD)
-            and int(model.eq_objtype[e]) == mujoco.mjtObj.mjOBJ_BODY]
+    loops = [_loop_joints(model, int(model.eq_obj1id[e]), int(model.eq_obj2id[e])) for e in range(model.neq)
+             if model.eq_active0[e] and int(model.eq_type[e]) in (mujoco.mjtEq.mjEQ_CONNECT, mujoco.mjtEq.mjEQ_WELD)
+             and int(model.eq_objtype[e]) == mujoco.mjtObj.mjOBJ_BODY]
+    return [loop for loop in loops if all(int(model.jnt_type[j]) != mujoco.mjtJoint.mjJNT_FREE for j in loop)]
 
 
 def _unactuated_hinges(model: Any, joints: set[int]) -> set[int]:
