@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+import numpy as np
 import pytest
 
 from zmpwalk import StepCommand, generate
@@ -248,3 +249,24 @@ def test_the_schedule_option_takes_a_name_or_a_file(tmp_path, capsys):
     assert rows[("forward", 0.7, 0.2)] < 0.0 < rows[("forward", 0.8, 0.2)]
     assert main(["plan", "--scenario", "fig27", "--schedule", str(tmp_path / "nope")]) == 2
     assert "--schedule" in capsys.readouterr().err
+
+
+def test_a_lookup_interpolates_each_columns_defined_cells_as_numpy_does():
+    """The prepared blocks (each step time's rows as columns, NaN cells left out, built once) give every column
+    numpy.interp over its defined cells at every tabulated step time, side steps with the on-the-spot row in front:
+    the values the planner reads, to the last bit."""
+    schedule = Schedule.hubo()
+    rng = np.random.default_rng(5)
+    for grid, prepend in ((schedule._forward, None), (schedule._side, schedule.on_spot_row)):
+        for tabulated in grid.durations:
+            rows = grid.by_duration[tabulated]
+            if prepend is not None:
+                rows = [prepend(tabulated), *rows]
+            table = np.array(rows)
+            for key in rng.uniform(table[:, grid.key_index].min(), table[:, grid.key_index].max(), 20):
+                row, _ = grid.lookup(tabulated, float(key), prepend)
+                for index, name in enumerate(grid.columns):
+                    defined = ~np.isnan(table[:, index])
+                    expected = float(np.interp(key, table[defined, grid.key_index], table[defined, index])) \
+                        if defined.any() else math.nan
+                    assert row[name] == expected or (math.isnan(row[name]) and math.isnan(expected))

@@ -114,6 +114,7 @@ class _Grid:
             block = data[data[:, 0] == duration]
             self.by_duration[duration] = block[np.argsort(block[:, key_index])].tolist()
         self.key_index = key_index
+        self._prepared: dict[tuple[float, object], _Block] = {}  # by (step time, prepend): the rows as columns
 
     def lookup(
         self, duration: float, key: float, prepend: Callable[[float], list[float]] | None = None
@@ -136,36 +137,54 @@ class _Grid:
             source = "interpolated"
         result = dict.fromkeys(self.columns, 0.0)
         for tabulated, weight in pairs:
-            block = self.by_duration[tabulated]
-            if prepend is not None:
-                block = [prepend(tabulated), *block]
-            row, row_source = _interpolate_rows(block, self.key_index, key)
+            row, row_source = _interpolate_rows(self._block(tabulated, prepend), key)
             if row_source != "table" and source != "extrapolated":
                 source = row_source
             for index, name in enumerate(self.columns):
                 result[name] += weight * row[index]
         return result, source
 
+    def _block(self, tabulated: float, prepend: Callable[[float], list[float]] | None) -> _Block:
+        """The rows of step time ``tabulated`` (after ``prepend``'s row, where given), column by column: prepared
+        once (a schedule is not modified after reading, so neither is a row ``prepend`` makes from it)."""
+        cached = self._prepared.get((tabulated, prepend))
+        if cached is None:
+            block = self.by_duration[tabulated]
+            if prepend is not None:
+                block = [prepend(tabulated), *block]
+            cached = self._prepared[(tabulated, prepend)] = _Block.of(block, self.key_index)
+        return cached
+
 
 EXACT = 1e-12  # [s] or table units: a query this close to a tabulated value is that value
 
 
-def _interpolate_rows(block: list[list[float]], key_index: int, key: float) -> tuple[list[float], str]:
-    """Linear interpolation along ``key`` in one step time's rows (sorted by ``key``), column by column.
+@dataclass(frozen=True)
+class _Block:
+    """One step time's rows (sorted by the key), as the interpolation reads them: the keys, and for each column the
+    keys and values of its defined cells (NaN cells, 'x', skipped)."""
 
-    NaN cells ('x') are skipped: the column uses its defined rows only.
-    """
-    keys = [row[key_index] for row in block]
+    keys: list[float]
+    columns: list[tuple[list[float], list[float]]]
+
+    @classmethod
+    def of(cls, block: list[list[float]], key_index: int) -> _Block:
+        columns = []
+        for column in range(len(block[0])):
+            defined = [(row[key_index], row[column]) for row in block if not math.isnan(row[column])]
+            columns.append(([k for k, _ in defined], [v for _, v in defined]))
+        return cls([row[key_index] for row in block], columns)
+
+
+def _interpolate_rows(block: _Block, key: float) -> tuple[list[float], str]:
+    """Linear interpolation along ``key`` in one step time's rows, column by column (each over its defined cells)."""
+    keys = block.keys
     source = "table"
     if key < keys[0] - EXACT or key > keys[-1] + EXACT:
         source = "extrapolated"
     elif not any(abs(k - key) <= EXACT + 1e-5 * abs(key) for k in keys):
         source = "interpolated"
-    out = []
-    for column in range(len(block[0])):
-        defined = [(row[key_index], row[column]) for row in block if not math.isnan(row[column])]
-        out.append(_interp(key, [k for k, _ in defined], [v for _, v in defined]))
-    return out, source
+    return [_interp(key, xp, fp) for xp, fp in block.columns], source
 
 
 def _interp(x: float, xp: list[float], fp: list[float]) -> float:
