@@ -140,3 +140,12 @@ def test_a_parallel_ankled_biped_walks(model_path: Path, tmp_path: Path, capsys:
     assert summary["final_feet_error"] < 0.01  # [m]
     assert summary["cop_error_rms"] < 0.03  # [m]
     assert summary["distance"] == pytest.approx(0.48, abs=0.04)  # [m]
+
+
+def test_an_export_refuses_the_rods_ball_joints_naming_one(model_path: Path) -> None:
+    """Every clip format has one column per joint after the free base: a rod's ball joint is named in the error."""
+    from zmpwalk.errors import InvalidParameterError
+    from zmpwalk.export.names import joint_names
+
+    with pytest.raises(InvalidParameterError, match=r"'waist_rod \(ball joint\)'.*ball-jointed rods"):
+        joint_names(build_plant(load_robot(model_path)).model)

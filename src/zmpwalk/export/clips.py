@@ -37,7 +37,7 @@ from zmpwalk.robots.collision import collision_points, rigid_bodies
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.sim.loop import ControllerRun, simulate_controller, simulated_clock
 from zmpwalk.sim.mujoco_plant import MujocoPlant, _ankle_sites, _base_position
-from zmpwalk.sim.poses import set_base_pose
+from zmpwalk.sim.poses import close_loops, set_base_pose
 
 Array = NDArray[np.float64]
 
@@ -107,6 +107,10 @@ class _RecordingPlant(MujocoPlant):
             set_base_pose(self.plant, qpos, _base_position(self.plant, self._scratch, sample, angles, self._sites),
                           sample.yaw_pelvis_in_world)
             qpos[self.plant.leg_qpos] = angles[self.plant.leg_columns]
+            if len(self.plant.coupled_dofs):  # a linkage's cranks and rods where the planned legs put them
+                self._scratch.qpos[:] = qpos
+                close_loops(self.plant, self._scratch)
+                qpos = self._scratch.qpos.copy()
             self.planned.append(qpos)
 
     def step(self) -> None:

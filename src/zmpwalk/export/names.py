@@ -21,7 +21,11 @@ def joint_names(model: mujoco.MjModel) -> list[str]:
     names = []
     for j in range(model.njnt):
         if j > 0 and int(model.jnt_type[j]) not in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):
-            raise InvalidParameterError("model", f"joint {j}", "hinge or slide joints after the free base")
+            name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j) or f"joint {j}"
+            kind = "ball" if int(model.jnt_type[j]) == mujoco.mjtJoint.mjJNT_BALL else "free"
+            raise InvalidParameterError("model", f"{name} ({kind} joint)", "hinge or slide joints after the free "
+                                        "base: a clip has one column per joint (a linkage's ball-jointed rods, "
+                                        "as in a parallel ankle, are not exported)")
         names.append(mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j) or ("root" if j == 0 else f"joint{j}"))
     return names
 
