@@ -15,9 +15,10 @@ import pytest
 
 from zmpwalk.robots import load_robot
 from zmpwalk.robots.description import PD_LOAD_STIFFNESS
+from zmpwalk.robots.linkages import LOOP_TOLERANCE
 from zmpwalk.sim.loop import simulate_controller
 from zmpwalk.sim.plant import build_plant
-from zmpwalk.sim.poses import LOOP_TOLERANCE, close_loops
+from zmpwalk.sim.poses import close_loops
 
 LEG = """
 <body name="{s}_hip" pos="0 {y} -0.1"><joint name="{s}_hy" axis="0 0 1"/><geom size="0.02" mass="1"/>
@@ -149,3 +150,36 @@ def test_an_export_refuses_the_rods_ball_joints_naming_one(model_path: Path) -> 
 
     with pytest.raises(InvalidParameterError, match=r"'waist_rod \(ball joint\)'.*ball-jointed rods"):
         joint_names(build_plant(load_robot(model_path)).model)
+
+
+def test_the_ankles_torque_limits_come_from_the_cranks_through_the_linkage(model_path: Path) -> None:
+    """The ankle's pitch and roll get the torque their two 40 N m cranks can give them (virtual work,
+    ``tau_ankle = G^T tau_cranks``, ``G = d q_cranks / d q_ankle`` in the ready posture with its loops closed):
+    ``G`` from the equalities' Jacobian against finite differences of the closed linkage."""
+    from zmpwalk.robots.linkages import close_equalities, joint_dofs
+
+    robot = load_robot(model_path)
+    assert robot.plant is not None and robot.legs is not None
+    model = mujoco.MjModel.from_xml_path(str(model_path))
+    data = mujoco.MjData(model)
+    for chain in robot.legs:  # the ready posture
+        for name, angle in zip(chain.joint_names, chain.reference, strict=True):
+            data.qpos[model.joint(name).qposadr[0]] = angle
+    coupled = joint_dofs(model, [model.joint(name).id for name in robot.plant.coupled_joints])
+    close_equalities(model, data, coupled)
+    base = data.qpos.copy()
+    cranks = [model.joint(f"l_crank_{k}").qposadr[0] for k in ("a", "b")]
+    gear = np.zeros((2, 2))  # d q_cranks / d q_ankle, by central differences
+    for column, name in enumerate(("l_ap", "l_ar")):
+        moved = []
+        for sign in (1.0, -1.0):
+            data.qpos[:] = base
+            data.qpos[model.joint(name).qposadr[0]] += sign * 1e-6
+            close_equalities(model, data, coupled)
+            moved.append(data.qpos[cranks].copy())
+        gear[:, column] = (moved[0] - moved[1]) / 2e-6
+    to_cranks = np.linalg.inv(gear.T)
+    expected = [float(np.min(40.0 / np.abs(to_cranks[:, j]))) for j in range(2)]  # [N m]
+    limits = {joint.name: joint.actuator.force_limit for joint in robot.plant.joints if joint.actuator is not None}
+    assert [limits["l_ap"], limits["l_ar"]] == pytest.approx(expected, rel=1e-4)
+    assert 60.0 < limits["l_ap"] < 120.0 and 40.0 < limits["l_ar"] < 80.0  # [N m]: two 40 N m cranks, 40 mm levers

@@ -23,6 +23,7 @@ from zmpwalk.robots.description import (
     PHYSICS_SUBSTEPS,
     Actuator,
 )
+from zmpwalk.robots.linkages import close_equalities, driven_torque_limits, equality_loops, joint_dofs
 
 Array = NDArray[np.float64]
 
@@ -188,7 +189,7 @@ def coupled_joints(model: Any, leg_joints: set[int]) -> frozenset[int]:
             for mine, other in (pair, pair[::-1]):
                 if mine in leg_joints and other >= 0 and other not in leg_joints:
                     coupled.add(other)
-    for loop in _equality_loops(model):
+    for loop in equality_loops(model):
         if _unactuated_hinges(model, loop):
             coupled |= {j for j in loop if j not in leg_joints and not _unactuated_hinges(model, {j})
                         and int(model.jnt_type[j]) != mujoco.mjtJoint.mjJNT_FREE}
@@ -199,20 +200,9 @@ def loop_driven_joints(model: Any) -> frozenset[int]:
     """The unactuated hinges of the loops that active connect or weld equalities close (a parallel waist's pitch
     and roll; a parallel ankle's, which are leg joints): the PD layer drives them (:func:`coupled_joints`)."""
     driven: set[int] = set()
-    for loop in _equality_loops(model):
+    for loop in equality_loops(model):
         driven |= _unactuated_hinges(model, loop)
     return frozenset(driven)
-
-
-def _equality_loops(model: Any) -> list[set[int]]:
-    """The joints of each loop an active connect or weld equality between two bodies closes within the robot (a
-    loop through its floating joint ties it to the world: not a linkage of its own)."""
-    import mujoco
-
-    loops = [_loop_joints(model, int(model.eq_obj1id[e]), int(model.eq_obj2id[e])) for e in range(model.neq)
-             if model.eq_active0[e] and int(model.eq_type[e]) in (mujoco.mjtEq.mjEQ_CONNECT, mujoco.mjtEq.mjEQ_WELD)
-             and int(model.eq_objtype[e]) == mujoco.mjtObj.mjOBJ_BODY]
-    return [loop for loop in loops if all(int(model.jnt_type[j]) != mujoco.mjtJoint.mjJNT_FREE for j in loop)]
 
 
 def _unactuated_hinges(model: Any, joints: set[int]) -> set[int]:
@@ -223,26 +213,37 @@ def _unactuated_hinges(model: Any, joints: set[int]) -> set[int]:
             is None}
 
 
-def _loop_joints(model: Any, first: int, second: int) -> set[int]:
-    """The joints of the loop an equality between bodies ``first`` and ``second`` closes: those on the tree's
-    paths from each body up to their nearest common ancestor."""
-    def chain(body: int) -> list[int]:
-        bodies = [body]
-        while body > 0:
-            body = int(model.body_parentid[body])
-            bodies.append(body)
-        return bodies
+def _linkage_limits(model: Any, qpos: Array, coupled: frozenset[int]) -> dict[int, float]:
+    """The torque limit [N m] of each unactuated hinge a linkage's motors turn (a parallel ankle's pitch and roll),
+    from the motors' limits through the linkage (:func:`~zmpwalk.robots.linkages.driven_torque_limits`) in the
+    posture ``qpos`` with its loops closed; the loops sharing driven hinges make one linkage."""
+    import mujoco
 
-    up, other = chain(first), set(chain(second))
-    common = next(body for body in up if body in other)
-    joints: set[int] = set()
-    for start in (first, second):
-        body = start
-        while body != common:
-            adr, count = int(model.body_jntadr[body]), int(model.body_jntnum[body])
-            joints.update(range(adr, adr + count))
-            body = int(model.body_parentid[body])
-    return joints
+    linkages: list[tuple[set[int], set[int]]] = []  # (driven hinges, every joint)
+    for loop in equality_loops(model):
+        driven = _unactuated_hinges(model, loop)
+        if not driven:
+            continue
+        for index, (hinges, joints) in enumerate(linkages):
+            if hinges & driven:
+                linkages[index] = (hinges | driven, joints | loop)
+                break
+        else:
+            linkages.append((driven, set(loop)))
+    if not linkages:
+        return {}
+    data = mujoco.MjData(model)
+    data.qpos[:] = qpos
+    close_equalities(model, data, joint_dofs(model, sorted(coupled)))
+    limits: dict[int, float] = {}
+    for hinges, joints in linkages:
+        turned, rest = sorted(hinges), sorted(joints - hinges)
+        motors = [j for j in rest if joint_actuator(model, j) is not None]
+        others = [j for j in rest if j not in motors]
+        motor_limits = [joint_torque_limit(model, j) for j in motors]
+        limits.update(zip(turned, driven_torque_limits(model, data, turned, motors, others, motor_limits),
+                          strict=True))
+    return limits
 
 
 def model_physics_step(model: Any) -> float:
@@ -290,6 +291,7 @@ def pd_layer(model: Any, data: Any, qpos: Array, leg_joints: set[int], leg_momen
     inertia = np.zeros((model.nv, model.nv))
     mujoco.mj_fullM(model, data, inertia)
     loop_driven = loop_driven_joints(model)
+    through_linkage = _linkage_limits(model, qpos, coupled)
     driven = []
     for j in range(model.njnt):
         hinge = int(model.jnt_type[j]) == mujoco.mjtJoint.mjJNT_HINGE  # a numpy integer is never `in` enums
@@ -300,7 +302,8 @@ def pd_layer(model: Any, data: Any, qpos: Array, leg_joints: set[int], leg_momen
         name = element_name(model, mujoco.mjtObj.mjOBJ_JOINT, j)
         existing = joint_actuator(model, j)
         if existing is None and (j in leg_joints or model.nu == 0 or j in loop_driven):
-            existing = Actuator(PD_PREFIX + name, "none", 0.0, 0.0, _joint_torque_limit(model, j))
+            existing = Actuator(PD_PREFIX + name, "none", 0.0, 0.0,
+                                min(_joint_torque_limit(model, j), through_linkage.get(j, math.inf)))
         if existing is None or existing.kind not in ("motor", "none"):
             continue
         if existing.force_limit == 0.0:

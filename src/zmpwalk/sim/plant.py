@@ -45,6 +45,7 @@ from zmpwalk.errors import InvalidParameterError
 from zmpwalk.kinematics import JOINT_COLUMNS
 from zmpwalk.robots.description import ModelPlant
 from zmpwalk.robots.imported import load_model_spec
+from zmpwalk.robots.linkages import joint_dofs
 from zmpwalk.robots.model import RobotModel
 from zmpwalk.robots.pd import is_position_servo
 from zmpwalk.robots.tree import Mount, base_mount, floating_base, root_from_base
@@ -147,14 +148,10 @@ def build_plant(robot: RobotModel, mass_scale: float = 1.0) -> Plant:
     leg_qpos = np.array([model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, plant.joints[i].name)]
                          for i in columns])
     coupled = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name) for name in plant.coupled_joints]
-    dofs = np.array([int(model.jnt_dofadr[j]) + k for j in coupled for k in range(_DOF_COUNT[int(model.jnt_type[j])])],
-                    dtype=np.intp)
+    dofs = joint_dofs(model, coupled)
     return Plant(model, np.array(actuators), leg_qpos, _held_controls(model, plant), qpos, True, columns, mount,
                  dofs)
 
-
-_DOF_COUNT = {int(mujoco.mjtJoint.mjJNT_FREE): 6, int(mujoco.mjtJoint.mjJNT_BALL): 3,
-              int(mujoco.mjtJoint.mjJNT_SLIDE): 1, int(mujoco.mjtJoint.mjJNT_HINGE): 1}  # degrees of freedom
 
 
 def _add_sites(spec: mujoco.MjSpec, model: mujoco.MjModel, robot: RobotModel, plant: ModelPlant,

@@ -11,6 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk.robots.collision import collision_points, rigid_bodies
+from zmpwalk.robots.linkages import close_equalities
 from zmpwalk.robots.tree import root_from_base
 from zmpwalk.sim.plant import Plant
 
@@ -69,42 +70,13 @@ def set_initial_state(plant: Plant, data: mujoco.MjData, position_base: Array, y
     mujoco.mj_forward(model, data)
 
 
-LOOP_TOLERANCE = 1e-9  # [m, rad] the equalities' residual a closed loop is placed within
-LOOP_ITERATIONS = 50  # Gauss-Newton steps at most
-
-
 def close_loops(plant: Plant, data: mujoco.MjData) -> None:
     """Place the joints the driven joints move through an equality (:attr:`Plant.coupled_dofs`: a parallel ankle's
     or waist's cranks and rods, a geared hip yaw's drive) where the model's equalities hold with the legs and the
-    held joints as ``data.qpos`` has them: Gauss-Newton on the residuals (``efc_pos``) of the equalities those
-    joints take part in, over their degrees of freedom alone, so that the simulation does not start with its
-    linkages torn apart (MuJoCo's stiff equalities would snap them together in the first steps, jolting the feet).
-    Nothing to do where the robot has no such joints."""
-    dofs = plant.coupled_dofs
-    if len(dofs) == 0:
-        return
-    model = plant.model
-    step = np.zeros(model.nv)
-    for _ in range(LOOP_ITERATIONS):
-        mujoco.mj_forward(model, data)
-        rows = np.flatnonzero(data.efc_type[:data.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY)
-        jacobian = _efc_jacobian(model, data, rows)[:, dofs]
-        moved = np.abs(jacobian).max(axis=1, initial=0.0) > 0.0  # the equalities these joints take part in
-        jacobian, residual = jacobian[moved], data.efc_pos[rows[moved]]
-        if len(residual) == 0 or float(np.max(np.abs(residual))) < LOOP_TOLERANCE:
-            return
-        step[:] = 0.0
-        step[dofs] = -np.linalg.lstsq(jacobian, residual, rcond=None)[0]
-        mujoco.mj_integratePos(model, data.qpos, step, 1.0)
-
-
-def _efc_jacobian(model: mujoco.MjModel, data: mujoco.MjData, rows: NDArray[np.intp]) -> NDArray[np.float64]:
-    """The constraint Jacobian's ``rows`` (k, nv), dense whatever the model's ``jacobian`` option."""
-    if mujoco.mj_isSparse(model):
-        dense = np.zeros((data.nefc, model.nv))
-        mujoco.mju_sparse2dense(dense, data.efc_J, data.efc_J_rownnz, data.efc_J_rowadr, data.efc_J_colind)
-        return dense[rows]
-    return np.asarray(data.efc_J[:data.nefc * model.nv].reshape(data.nefc, model.nv)[rows], dtype=np.float64)
+    held joints as ``data.qpos`` has them (:func:`zmpwalk.robots.linkages.close_equalities`), so that the simulation
+    does not start with its linkages torn apart (MuJoCo's stiff equalities would snap them together in the first
+    steps, jolting the feet). Nothing to do where the robot has no such joints."""
+    close_equalities(plant.model, data, plant.coupled_dofs)
 
 
 def plant_qpos(plant: Plant, position_base: Array, yaw: Array, angles: Array) -> Array:
