@@ -13,6 +13,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from test_pd_layer import LEG
 from zmpwalk.robots import load_robot
 from zmpwalk.robots.description import PD_LOAD_STIFFNESS
 from zmpwalk.robots.linkages import LOOP_TOLERANCE
@@ -20,22 +21,6 @@ from zmpwalk.sim.loop import simulate_controller
 from zmpwalk.sim.plant import build_plant
 from zmpwalk.sim.poses import close_loops
 
-LEG = """
-<body name="{s}_hip" pos="0 {y} -0.1"><joint name="{s}_hy" axis="0 0 1"/><geom size="0.02" mass="1"/>
- <body name="{s}_hr"><joint name="{s}_hr" axis="1 0 0"/><geom size="0.02" mass="1"/>
-  <body name="{s}_hp"><joint name="{s}_hp" axis="0 1 0"/><geom size="0.02" mass="1"/>
-   <body name="{s}_shank" pos="0 0 -0.3"><joint name="{s}_kn" axis="0 1 0" range="0 2.4"/>
-    <geom size="0.02" mass="1"/>
-    <body name="{s}_ank" pos="0 0 -0.3"><joint name="{s}_ap" axis="0 1 0"/>
-     <geom size="0.02" mass="0.2" contype="0" conaffinity="0"/>
-     <body name="{s}_foot"><joint name="{s}_ar" axis="1 0 0"/>
-      <geom type="box" size="0.1 0.05 0.01" pos="0 0 -0.05" mass="0.5"/>
-     </body>
-    </body>{cranks}
-   </body>
-  </body>
- </body>
-</body>"""
 CRANK = """
     <body name="{s}_crank_{k}" pos="0 {y} -0.1"><joint name="{s}_crank_{k}" axis="0 1 0"/>
      <geom type="capsule" fromto="0 0 0 -0.04 0 0" size="0.005" mass="0.05" contype="0" conaffinity="0"/>
@@ -49,7 +34,9 @@ ROD = 0.18  # [m] each rod's length: its end meets the foot 20 mm above the ankl
 def linkage_biped() -> str:
     """A 19.9 kg biped whose ankles are turned by two crank-and-rod pairs each (motors on the cranks, none on the
     ankle joints) and whose 6 kg torso sits on an unactuated waist pitch that a crank holds through a rod."""
-    legs = "".join(LEG.format(s=s, y=y, cranks=CRANK.format(s=s, k="a", y=0.03) + CRANK.format(s=s, k="b", y=-0.03))
+    ankle_end = "     </body>\n    </body>\n   </body>"  # the foot, ankle and shank ends
+    legs = "".join(LEG.format(s=s, y=y, knee="").replace(ankle_end, ankle_end[:-11] + CRANK.format(s=s, k="a", y=0.03)
+                                                        + CRANK.format(s=s, k="b", y=-0.03) + "\n   </body>")
                    for s, y in (("l", 0.1), ("r", -0.1)))
     motors = "".join(f'<motor name="{s}_{j}_m" joint="{s}_{j}" ctrlrange="-40 40"/>'
                      for s in ("l", "r") for j in ("hy", "hr", "hp", "kn", "crank_a", "crank_b"))
