@@ -170,3 +170,39 @@ def test_the_ankles_torque_limits_come_from_the_cranks_through_the_linkage(model
     limits = {joint.name: joint.actuator.force_limit for joint in robot.plant.joints if joint.actuator is not None}
     assert [limits["l_ap"], limits["l_ar"]] == pytest.approx(expected, rel=1e-4)
     assert 60.0 < limits["l_ap"] < 120.0 and 40.0 < limits["l_ar"] < 80.0  # [N m]: two 40 N m cranks, 40 mm levers
+
+
+def test_the_soles_geoms_keep_their_pose_and_unnamed_rods_are_found(tmp_path: Path) -> None:
+    """A foot geom turned by ``euler`` and one placed in a ``<frame>`` sit where the model puts them once moved to
+    the sole body; rods whose ball joints have no name are the coupled joints all the same (each its own three
+    degrees of freedom)."""
+    text = linkage_biped().replace(
+        '<geom type="box" size="0.1 0.05 0.01" pos="0 0 -0.05" mass="0.5"/>',
+        '<geom type="box" size="0.1 0.05 0.01" pos="0 0 -0.05" mass="0.5"/>'
+        '<geom type="box" size="0.02 0.01 0.005" pos="0.05 0 -0.04" euler="0 0 0.5" mass="0"/>'
+        '<frame pos="-0.05 0.01 -0.03"><geom type="sphere" size="0.01" pos="0 0 -0.005" mass="0"/></frame>')
+    for side in ("l", "r"):
+        for k in ("a", "b"):
+            text = text.replace(f'<joint name="{side}_rod_{k}" type="ball"/>', '<joint type="ball"/>')
+    path = tmp_path / "unnamed.xml"
+    path.write_text(text, encoding="utf-8")
+    robot = load_robot(path)
+    plant = build_plant(robot)
+    original = mujoco.MjModel.from_xml_path(str(path))
+    assert robot.plant is not None and len(plant.coupled_dofs) == len(set(plant.coupled_dofs.tolist())) == 20
+    assert {int(plant.model.dof_jntid[d]) for d in plant.coupled_dofs} == {
+        j for j in range(original.njnt) if int(original.jnt_type[j]) == mujoco.mjtJoint.mjJNT_BALL
+        or original.joint(j).name.endswith(("crank_a", "crank_b", "waist_crank"))}
+    placed, moved = mujoco.MjData(original), mujoco.MjData(plant.model)
+    placed.qpos[:] = moved.qpos[:] = original.qpos0
+    mujoco.mj_kinematics(original, placed)
+    mujoco.mj_kinematics(plant.model, moved)
+    sole = plant.model.body("zmpwalk_left_sole").id
+    foot = original.body("l_foot").id
+    before = sorted((placed.geom_xpos[g].round(9).tolist(), placed.geom_xmat[g].round(9).tolist())
+                    for g in range(original.ngeom) if original.geom_bodyid[g] == foot)
+    after = sorted((moved.geom_xpos[g].round(9).tolist(), moved.geom_xmat[g].round(9).tolist())
+                   for g in range(plant.model.ngeom) if plant.model.geom_bodyid[g] == sole)
+    assert len(before) == len(after) == 3 and np.allclose(np.array([p for p, _ in before]),
+                                                           np.array([p for p, _ in after]), atol=1e-9)
+    assert np.allclose(np.array([m for _, m in before]), np.array([m for _, m in after]), atol=1e-9)

@@ -74,12 +74,14 @@ from zmpwalk.robots.description import (
     ModelPlant,
 )
 from zmpwalk.robots.legs import VIRTUAL_PREFIX, FootAtReference, Segments, build_leg, leg_joint_ids, segments
+from zmpwalk.robots.linkages import joint_id
 from zmpwalk.robots.model import RobotModel, schedule_scale
 from zmpwalk.robots.pd import (
     check_load_stiffness,
     coupled_joints,
     element_name,
     joint_torque_limit,
+    linkage_limits,
     model_physics_step,
     pd_layer,
 )
@@ -265,7 +267,8 @@ def _with_pd_layer(model: Any, data: Any, qpos: Array, plant: ModelPlant, leg_jo
 
     coupled = coupled_joints(model, leg_joint_set)
     _, y_min, _, y_max = geometry.sole_box
-    plant = replace(plant, ankle_roll_torque=_ankle_roll_torque(model, leg_joints),
+    linkage = linkage_limits(model, qpos, coupled)  # a parallel ankle's roll: its motors' torque through the rods
+    plant = replace(plant, ankle_roll_torque=_ankle_roll_torque(model, leg_joints, linkage),
                     sole_edge_moment=weight * min(abs(y_min), abs(y_max)))
     load_stiffness = check_load_stiffness(values.get("load_stiffness", plant.derived_load_stiffness))
     pd_joints, physics_step = pd_layer(model, data, qpos, leg_joint_set, moment, pd_gains, coupled, load_stiffness)
@@ -321,14 +324,18 @@ def _zero_pose(model: Any, data: Any, qpos_reference: Array, leg_joints: set[int
     return data.xmat[base].reshape(3, 3).copy(), data.xpos[base].copy()
 
 
-def _ankle_roll_torque(model: Any, joints: list[LegJoint]) -> float:
-    """The weaker ankle roll's torque limit [N m]: 0 for a five-joint leg (its roll is virtual), inf where nothing
-    limits it."""
-    import mujoco
-
-    limits = [0.0 if joint.name.startswith(VIRTUAL_PREFIX)
-              else joint_torque_limit(model, mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint.name))
-              for joint in joints if joint.role == "ankle_roll"]
+def _ankle_roll_torque(model: Any, joints: list[LegJoint], linkage: dict[int, float]) -> float:
+    """The weaker ankle roll's torque limit [N m]: its actuator's, or its linkage's motors' through the rods
+    (``linkage``: joint id -> limit); 0 for a five-joint leg (its roll is virtual), inf where nothing limits it."""
+    limits = []
+    for joint in joints:
+        if joint.role != "ankle_roll":
+            continue
+        if joint.name.startswith(VIRTUAL_PREFIX):
+            limits.append(0.0)
+            continue
+        index = joint_id(model, joint.name)
+        limits.append(min(joint_torque_limit(model, index), linkage.get(index, math.inf)))
     return min(limits, default=math.inf)
 
 

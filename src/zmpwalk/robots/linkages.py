@@ -10,21 +10,60 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from zmpwalk.errors import InvalidParameterError
+
 Array = NDArray[np.float64]
 
 LOOP_TOLERANCE = 1e-9  # [m, rad] the equalities' residual a closed loop is placed within
 LOOP_ITERATIONS = 50  # Gauss-Newton steps at most
+LOOP_CLOSED = 1e-6  # [m, rad] the residual above which a loop counts as not closed
+
+
+def equality_pairs(model: Any) -> list[tuple[int, int]]:
+    """The two bodies of each active connect or weld equality (given by bodies or by sites on them)."""
+    import mujoco
+
+    pairs = []
+    for e in range(model.neq):
+        if not model.eq_active0[e] or int(model.eq_type[e]) not in (mujoco.mjtEq.mjEQ_CONNECT, mujoco.mjtEq.mjEQ_WELD):
+            continue
+        first, second = int(model.eq_obj1id[e]), int(model.eq_obj2id[e])
+        if int(model.eq_objtype[e]) == mujoco.mjtObj.mjOBJ_SITE:
+            first, second = int(model.site_bodyid[first]), int(model.site_bodyid[second])
+        elif int(model.eq_objtype[e]) != mujoco.mjtObj.mjOBJ_BODY:
+            continue
+        pairs.append((first, second))
+    return pairs
+
+
+def equality_bodies(model: Any) -> set[int]:
+    """Every body an active connect or weld equality acts on."""
+    return {body for pair in equality_pairs(model) for body in pair}
 
 
 def equality_loops(model: Any) -> list[set[int]]:
-    """The joints of each loop an active connect or weld equality between two bodies closes within the robot (a
-    loop through its floating joint ties it to the world: not a linkage of its own)."""
+    """The joints of each loop an active connect or weld equality closes within the robot (a loop through its
+    floating joint ties it to the world: not a linkage of its own)."""
     import mujoco
 
-    loops = [_loop_joints(model, int(model.eq_obj1id[e]), int(model.eq_obj2id[e])) for e in range(model.neq)
-             if model.eq_active0[e] and int(model.eq_type[e]) in (mujoco.mjtEq.mjEQ_CONNECT, mujoco.mjtEq.mjEQ_WELD)
-             and int(model.eq_objtype[e]) == mujoco.mjtObj.mjOBJ_BODY]
+    loops = [_loop_joints(model, first, second) for first, second in equality_pairs(model)]
     return [loop for loop in loops if all(int(model.jnt_type[j]) != mujoco.mjtJoint.mjJNT_FREE for j in loop)]
+
+
+def joint_id(model: Any, name: str) -> int:
+    """The id of the joint ``name`` (``#N``: the unnamed joint N, as :func:`zmpwalk.robots.pd.element_name` names
+    it).
+
+    Raises:
+        InvalidParameterError: No such joint in ``model``.
+    """
+    import mujoco
+
+    index = int(name[1:]) if name.startswith("#") and name[1:].isdigit() else \
+        mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)
+    if not 0 <= index < model.njnt:
+        raise InvalidParameterError("joint", name, f"a joint of the model (it has {model.njnt})")
+    return index
 
 
 def _loop_joints(model: Any, first: int, second: int) -> set[int]:
@@ -59,25 +98,40 @@ def joint_dofs(model: Any, joints: list[int]) -> NDArray[np.intp]:
                     dtype=np.intp)
 
 
-def close_equalities(model: Any, data: Any, dofs: NDArray[np.intp]) -> None:
+def close_equalities(model: Any, data: Any, dofs: NDArray[np.intp]) -> float:
     """Move the degrees of freedom ``dofs`` of ``data.qpos`` until the equalities they take part in hold: Gauss-Newton
-    on those equalities' residuals (``efc_pos``) over ``dofs`` alone, every other joint kept."""
+    on those equalities' residuals (``efc_pos``) over ``dofs`` alone, every other joint kept. Returns the largest
+    residual left [m or rad] (below :data:`LOOP_TOLERANCE` once closed; 0 with no ``dofs``)."""
     import mujoco
 
-    if len(dofs) == 0:
-        return
+    largest = 0.0
     step = np.zeros(model.nv)
-    for _ in range(LOOP_ITERATIONS):
+    for _ in range(LOOP_ITERATIONS if len(dofs) else 0):
         mujoco.mj_forward(model, data)
         rows = np.flatnonzero(data.efc_type[:data.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY)
         jacobian = equality_jacobian(model, data, rows)[:, dofs]
         moved = np.abs(jacobian).max(axis=1, initial=0.0) > 0.0  # the equalities these joints take part in
         jacobian, residual = jacobian[moved], data.efc_pos[rows[moved]]
-        if len(residual) == 0 or float(np.max(np.abs(residual))) < LOOP_TOLERANCE:
-            return
+        largest = float(np.max(np.abs(residual), initial=0.0))
+        if largest < LOOP_TOLERANCE:
+            break
         step[:] = 0.0
         step[dofs] = -np.linalg.lstsq(jacobian, residual, rcond=None)[0]
         mujoco.mj_integratePos(model, data.qpos, step, 1.0)
+    return largest
+
+
+def close_or_refuse(model: Any, data: Any, dofs: NDArray[np.intp]) -> None:
+    """:func:`close_equalities`, and an error where the loops do not close.
+
+    Raises:
+        InvalidParameterError: A residual over :data:`LOOP_CLOSED` is left (a linkage the posture cannot
+            close: a rod too short for where the legs put the foot).
+    """
+    residual = close_equalities(model, data, dofs)
+    if residual > LOOP_CLOSED:
+        raise InvalidParameterError("linkage residual", f"{residual:.3g} m", f"at most {LOOP_CLOSED:g} m: the "
+                                    "model's equalities (its linkages' rods) must close in the ready posture")
 
 
 def equality_jacobian(model: Any, data: Any, rows: NDArray[np.intp]) -> Array:

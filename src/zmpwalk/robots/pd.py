@@ -206,14 +206,30 @@ def loop_driven_joints(model: Any) -> frozenset[int]:
 
 
 def _unactuated_hinges(model: Any, joints: set[int]) -> set[int]:
-    """The hinges among ``joints`` that no actuator drives."""
+    """The hinges among ``joints`` that no actuator drives, on the joint or through a fixed tendon."""
     import mujoco
 
-    return {j for j in joints if int(model.jnt_type[j]) == mujoco.mjtJoint.mjJNT_HINGE and joint_actuator(model, j)
-            is None}
+    by_tendon = _tendon_driven(model)
+    return {j for j in joints if int(model.jnt_type[j]) == mujoco.mjtJoint.mjJNT_HINGE and j not in by_tendon
+            and joint_actuator(model, j) is None}
 
 
-def _linkage_limits(model: Any, qpos: Array, coupled: frozenset[int]) -> dict[int, float]:
+def _tendon_driven(model: Any) -> set[int]:
+    """The joints of the fixed tendons that an actuator drives (a tendon-driven gripper's, ToddlerBot's waist)."""
+    import mujoco
+
+    joints = set()
+    for a in range(model.nu):
+        if int(model.actuator_trntype[a]) != mujoco.mjtTrn.mjTRN_TENDON:
+            continue
+        tendon = int(model.actuator_trnid[a][0])
+        start, count = int(model.tendon_adr[tendon]), int(model.tendon_num[tendon])
+        joints |= {int(model.wrap_objid[w]) for w in range(start, start + count)
+                   if int(model.wrap_type[w]) == mujoco.mjtWrap.mjWRAP_JOINT}
+    return joints
+
+
+def linkage_limits(model: Any, qpos: Array, coupled: frozenset[int]) -> dict[int, float]:
     """The torque limit [N m] of each unactuated hinge a linkage's motors turn (a parallel ankle's pitch and roll),
     from the motors' limits through the linkage (:func:`~zmpwalk.robots.linkages.driven_torque_limits`) in the
     posture ``qpos`` with its loops closed; the loops sharing driven hinges make one linkage."""
@@ -274,9 +290,10 @@ def pd_layer(model: Any, data: Any, qpos: Array, leg_joints: set[int], leg_momen
              load_stiffness: float = PD_LOAD_STIFFNESS) -> tuple[tuple[tuple[str, Actuator], ...], float]:
     """The joints the PD layer drives, with their actuators (gains from :func:`pd_gains` at the posture ``qpos``,
     or ``given``: joint name -> (kp, kv or None for critical damping)): every torque motor on a hinge or slide,
-    every leg joint without an actuator, and every joint of a model without actuators (a URDF), but the
-    ``coupled`` joints (moved by a leg joint through a joint equality: :func:`coupled_joints`). A leg joint holds
-    ``leg_moment`` [N m]; another hinge the weight of what it moves (:func:`_weight_moment`); a slide nothing;
+    every leg joint without an actuator, every unactuated hinge a linkage's motors turn (:func:`loop_driven_joints`,
+    its torque limit theirs through the linkage: :func:`linkage_limits`), and every joint of a model without
+    actuators (a URDF), but the ``coupled`` joints (moved through an equality: :func:`coupled_joints`). A leg joint
+    holds ``leg_moment`` [N m]; another hinge the weight of what it moves (:func:`_weight_moment`); a slide nothing;
     ``load_stiffness`` is the rule's ``kappa``. With them the layer's period, the physics step
     (:func:`pd_physics_step`) [s].
 
@@ -291,7 +308,7 @@ def pd_layer(model: Any, data: Any, qpos: Array, leg_joints: set[int], leg_momen
     inertia = np.zeros((model.nv, model.nv))
     mujoco.mj_fullM(model, data, inertia)
     loop_driven = loop_driven_joints(model)
-    through_linkage = _linkage_limits(model, qpos, coupled)
+    through_linkage = linkage_limits(model, qpos, coupled)
     driven = []
     for j in range(model.njnt):
         hinge = int(model.jnt_type[j]) == mujoco.mjtJoint.mjJNT_HINGE  # a numpy integer is never `in` enums

@@ -11,7 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zmpwalk.robots.collision import collision_points, rigid_bodies
-from zmpwalk.robots.linkages import close_equalities
+from zmpwalk.robots.linkages import close_or_refuse
 from zmpwalk.robots.tree import root_from_base
 from zmpwalk.sim.plant import Plant
 
@@ -75,8 +75,12 @@ def close_loops(plant: Plant, data: mujoco.MjData) -> None:
     or waist's cranks and rods, a geared hip yaw's drive) where the model's equalities hold with the legs and the
     held joints as ``data.qpos`` has them (:func:`zmpwalk.robots.linkages.close_equalities`), so that the simulation
     does not start with its linkages torn apart (MuJoCo's stiff equalities would snap them together in the first
-    steps, jolting the feet). Nothing to do where the robot has no such joints."""
-    close_equalities(plant.model, data, plant.coupled_dofs)
+    steps, jolting the feet). Nothing to do where the robot has no such joints.
+
+    Raises:
+        InvalidParameterError: The loops do not close (:func:`zmpwalk.robots.linkages.close_or_refuse`).
+    """
+    close_or_refuse(plant.model, data, plant.coupled_dofs)
 
 
 def plant_qpos(plant: Plant, position_base: Array, yaw: Array, angles: Array) -> Array:
