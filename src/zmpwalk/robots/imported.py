@@ -236,10 +236,9 @@ def import_robot(path: str | Path, *, feet: tuple[str, str] | None = None, keyfr
     pelvis_height, pendulum, com_offset, chains_ready, qpos = ready
     length_scale = schedule_scale(pendulum, straight, g.hip_spacing)[1]
     lift = _foot_lift(chains_ready, leg_joints, HUBO_FOOT_LIFT * length_scale)  # [m]
-    weight = mass * float(np.linalg.norm(model.opt.gravity))  # [N]
-    moment = weight * pendulum  # [N m] m g l, what a leg joint holds
+    weight = mass * float(np.linalg.norm(model.opt.gravity))  # [N]; a leg joint holds m g l [N m]
     plant, leg_joints = _with_pd_layer(model, data, qpos, plant, leg_joints, leg_joint_set, geometry, values,
-                                       pd_gains or {}, weight, moment, source)
+                                       pd_gains or {}, weight, weight * pendulum, source)
     stretch = (hip_to_ankle(chains_ready[0]) if "pelvis_height" in values else distance) / straight  # [-]
     plant = replace(plant, file_values=tuple(sorted(set(values) - {"load_stiffness"})), ready_stretch=stretch)
     return _robot_model(
