@@ -206,3 +206,25 @@ def test_the_soles_geoms_keep_their_pose_and_unnamed_rods_are_found(tmp_path: Pa
     assert len(before) == len(after) == 3 and np.allclose(np.array([p for p, _ in before]),
                                                            np.array([p for p, _ in after]), atol=1e-9)
     assert np.allclose(np.array([m for _, m in before]), np.array([m for _, m in after]), atol=1e-9)
+
+
+def test_a_joint_name_the_model_lacks_and_a_loop_that_cannot_close_are_errors(model_path: Path) -> None:
+    """``joint_id`` names the joint it cannot find; a loop that the joints given cannot close (a crank turned alone,
+    its rod held) is refused naming its residual, the posture's other joints untouched."""
+    from zmpwalk.errors import InvalidParameterError
+    from zmpwalk.robots.linkages import close_or_refuse, joint_dofs, joint_id
+
+    model = mujoco.MjModel.from_xml_path(str(model_path))
+    assert joint_id(model, "l_crank_a") == model.joint("l_crank_a").id
+    assert joint_id(model, f"#{model.joint('l_rod_a').id}") == model.joint("l_rod_a").id  # an unnamed joint's name
+    for bad in ("no_such_joint", "#999"):
+        with pytest.raises(InvalidParameterError, match=r"joint = .*a joint of the model"):
+            joint_id(model, bad)
+    data = mujoco.MjData(model)
+    data.qpos[model.joint("l_ap").qposadr[0]] = 0.5  # the foot turned: its anchor leaves the crank's circle
+    kept = data.qpos.copy()
+    cranks = [model.joint("l_crank_a").id]  # the crank alone, its rod held: one angle for a 3-D anchor
+    with pytest.raises(InvalidParameterError, match=r"linkage residual = .* m.*must close"):
+        close_or_refuse(model, data, joint_dofs(model, cranks))
+    legs = [model.joint(n).qposadr[0] for n in ("l_kn", "l_ap", "l_ar", "l_hp")]
+    assert np.array_equal(data.qpos[legs], kept[legs])  # only the loop's own joints were moved

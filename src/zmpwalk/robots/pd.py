@@ -190,9 +190,9 @@ def coupled_joints(model: Any, leg_joints: set[int]) -> frozenset[int]:
                 if mine in leg_joints and other >= 0 and other not in leg_joints:
                     coupled.add(other)
     for loop in equality_loops(model):
-        if _unactuated_hinges(model, loop):
-            coupled |= {j for j in loop if j not in leg_joints and not _unactuated_hinges(model, {j})
-                        and int(model.jnt_type[j]) != mujoco.mjtJoint.mjJNT_FREE}
+        hinges = _unactuated_hinges(model, loop)
+        if hinges:
+            coupled |= {j for j in loop - hinges - leg_joints if int(model.jnt_type[j]) != mujoco.mjtJoint.mjJNT_FREE}
     return frozenset(coupled)
 
 
